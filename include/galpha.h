@@ -1,0 +1,354 @@
+/*
+ * galpha — the generalized-alpha method of Arnold & Bruls for constrained mechanical systems.
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ * This header is the whole public interface of libgalpha: plain C99, no C++ types, usable from
+ * C, C++, Fortran (iso_c_binding) and Python (ctypes).
+ *
+ * ## The problem
+ *
+ * galpha integrates index-3 differential-algebraic equations of constrained mechanics
+ *
+ *     M(q) q'' = f(q, q', t) - Phi_q(q, t)^T lambda        (n equations)
+ *            0 = Phi(q, t)                                 (m equations)
+ *
+ * with q in R^n (generalized coordinates) and lambda in R^m (Lagrange multipliers). Note the sign
+ * convention: the constraint force is -Phi_q^T lambda. M may be singular (massless nodes) as long
+ * as the saddle-point matrix [M Phi_q^T; Phi_q 0] is regular; M is never inverted.
+ *
+ * ## The method
+ *
+ * Algorithm 1 of M. Arnold, O. Bruls, "Convergence of the generalized-alpha scheme for
+ * constrained mechanical systems", Multibody Syst. Dyn. 18 (2007): the dynamic equilibrium is
+ * enforced exactly at t_{n+1} (non-weighted residual), an auxiliary acceleration-like vector `a`
+ * follows (1-alpha_m) a_{n+1} + alpha_m a_n = (1-alpha_f) q''_{n+1} + alpha_f q''_n, positions
+ * and velocities follow the Newmark formulas driven by `a`, and each step solves the nonlinear
+ * equations by Newton's method on the iteration matrix scaled as proposed by Bottasso et al.
+ * q, q', q'' and lambda converge with order 2.
+ *
+ * ## Life cycle
+ *
+ *     ga_create -> ga_set_callbacks -> [ga_set_* options] -> ga_init -> ga_step ... -> ga_free
+ *
+ * All memory is allocated by ga_create and ga_init; ga_step never allocates.
+ *
+ * ## Conventions
+ *  - Every function that can fail returns a ::ga_status (0 = GA_OK, negative = error);
+ *    ga_strerror() names the status, ga_last_error() gives the details for one solver.
+ *  - The library never prints, never exits, never aborts, and never lets a C++ exception out.
+ *  - Dense matrices are column-major with leading dimension equal to the number of rows
+ *    (Fortran, LAPACK and Eigen agree). M is n x n, Phi_q is m x n.
+ *  - Arrays passed in are read during the call only; arrays passed out are filled by copying.
+ *    Nothing returned by the library must be freed by the caller, except the solver by ga_free.
+ *  - Callbacks return 0 on success, a positive value for a recoverable failure (the step is
+ *    rejected; the caller may retry, e.g. with a smaller h) and a negative value for a fatal one.
+ *  - Threads: there is no global mutable state. Any number of solvers may run in parallel
+ *    threads; one solver must not be used by two threads at the same time.
+ *  - A call on a solver from inside one of its own callbacks is refused with GA_ERR_STATE.
+ *
+ * ## ABI
+ * Status values and counter keys are pinned and only ever appended. New options get new setter
+ * functions, never new fields in a struct (there are no public structs), which keeps the ABI
+ * stable and the bindings for Fortran and ctypes trivial. SONAME: libgalpha.so.GA_VERSION_MAJOR.
+ */
+#ifndef GALPHA_H
+#define GALPHA_H
+
+#include <stddef.h>
+
+#if defined(_WIN32)
+#  if defined(GALPHA_BUILDING)
+#    define GA_API __declspec(dllexport)
+#  elif defined(GALPHA_SHARED)
+#    define GA_API __declspec(dllimport)
+#  else
+#    define GA_API
+#  endif
+#elif defined(__GNUC__) || defined(__clang__)
+#  define GA_API __attribute__((visibility("default")))
+#else
+#  define GA_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------------------------ */
+/** @name Versions
+ *  The macros give the version of this header, ga_version() and ga_version_number() the
+ *  version of the library actually loaded; a binding should compare them at load time. */
+/**@{*/
+#define GA_VERSION_MAJOR 0
+#define GA_VERSION_MINOR 1
+#define GA_VERSION_PATCH 0
+/** major * 10000 + minor * 100 + patch */
+#define GA_VERSION_NUMBER (GA_VERSION_MAJOR * 10000 + GA_VERSION_MINOR * 100 + GA_VERSION_PATCH)
+
+/** The library's version as "MAJOR.MINOR.PATCH" (static string). */
+GA_API const char *ga_version(void);
+/** The library's version as major * 10000 + minor * 100 + patch. */
+GA_API int ga_version_number(void);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
+/** Status codes. Values are pinned; new codes are only appended. */
+typedef enum ga_status {
+    GA_OK = 0,                  /**< success */
+    GA_ERR_ARG = -1,            /**< invalid argument (NULL pointer, bad size, h <= 0, NaN, ...) */
+    GA_ERR_STATE = -2,          /**< call out of order (e.g. ga_step before ga_init) or from a
+                                     callback of the same solver */
+    GA_ERR_NOMEM = -3,          /**< memory allocation failed */
+    GA_ERR_CALLBACK = -4,       /**< a callback returned a negative value (fatal) */
+    GA_ERR_CALLBACK_RETRY = -5, /**< a callback returned a positive value (recoverable: the step
+                                     was rejected; it may be retried, e.g. with a smaller h) */
+    GA_ERR_NONFINITE = -6,      /**< NaN or Inf in a callback output or in the Newton iteration */
+    GA_ERR_SINGULAR = -7,       /**< singular (or numerically singular) matrix */
+    GA_ERR_NEWTON = -8,         /**< Newton iteration did not converge in max_iter iterations */
+    GA_ERR_INCONSISTENT = -9,   /**< initial values violate the constraints and were not, or
+                                     could not be, projected onto them */
+    GA_ERR_INTERNAL = -10       /**< unexpected internal error, including a C++ exception thrown
+                                     by a user callback written in C++ */
+} ga_status;
+
+/** Fixed English name of a status, e.g. "invalid argument". Never NULL. */
+GA_API const char *ga_strerror(ga_status status);
+
+/* ------------------------------------------------------------------------------------------ */
+/** Opaque solver handle. */
+typedef struct ga_solver ga_solver;
+
+/** @name Callbacks
+ *  Each receives the time t, the input vectors (length n), an output buffer owned by the
+ *  library, and the `user` pointer given to ga_set_callbacks(). Outputs must be written
+ *  completely. Return 0 = ok, > 0 = recoverable failure, < 0 = fatal failure. Output buffers
+ *  are not zeroed before the call. */
+/**@{*/
+/** Mass matrix M(q): n x n, column-major, ld = n. */
+typedef int (*ga_mass_fn)(double t, const double *q, double *M, void *user);
+/** Applied forces f(q, v, t) (external, internal and complementary inertia forces): length n. */
+typedef int (*ga_force_fn)(double t, const double *q, const double *v, double *f, void *user);
+/** Constraints Phi(q, t): length m. */
+typedef int (*ga_constraint_fn)(double t, const double *q, double *phi, void *user);
+/** Constraint Jacobian Phi_q(q, t): m x n, column-major, ld = m. */
+typedef int (*ga_jacobian_fn)(double t, const double *q, double *Phi_q, void *user);
+/** Tangent stiffness K_t = d(M(q) qdd - f(q, v, t) + Phi_q(q, t)^T lambda)/dq at fixed qdd, v,
+ *  lambda: n x n, column-major, ld = n. Optional (finite differences otherwise). */
+typedef int (*ga_stiffness_fn)(double t, const double *q, const double *v, const double *qdd,
+                               const double *lambda, double *K, void *user);
+/** Tangent damping C_t = -df/dv: n x n, column-major, ld = n. Optional. */
+typedef int (*ga_damping_fn)(double t, const double *q, const double *v, double *C, void *user);
+/** Constraint acceleration term Phi_qq(v, v) + 2 Phi_qt v + Phi_tt, i.e.
+ *  d^2/dt^2 Phi(q(t), t) - Phi_q q'': length m. Optional (finite differences otherwise). */
+typedef int (*ga_constraint_accel_fn)(double t, const double *q, const double *v, double *out,
+                                      void *user);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
+/** @name Life cycle */
+/**@{*/
+/** Create a solver for n coordinates and m constraints (0 <= m <= n, n >= 1); sizes are fixed
+ *  for the life of the solver. On success *out holds the new solver; on failure *out is NULL.
+ *  Errors: GA_ERR_ARG (out NULL, n < 1, m < 0, m > n), GA_ERR_NOMEM. */
+GA_API ga_status ga_create(int n, int m, ga_solver **out);
+
+/** Free a solver and everything it owns. ga_free(NULL) does nothing. Must not be called from
+ *  one of the solver's own callbacks. */
+GA_API void ga_free(ga_solver *s);
+
+/** Set the model. mass is required; force may be NULL (f = 0); constraint and jacobian are
+ *  required when m > 0 and ignored when m = 0. `user` is passed unchanged to every callback
+ *  (also to the optional ones set later). May be called again, also after ga_init().
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE (from a callback). */
+GA_API ga_status ga_set_callbacks(ga_solver *s, ga_mass_fn mass, ga_force_fn force,
+                                  ga_constraint_fn constraint, ga_jacobian_fn jacobian,
+                                  void *user);
+
+/** Compute consistent initial values at t0 from q0 and v0 (both length n) and make the solver
+ *  ready to step:
+ *   1. positions: if |Phi(q0, t0)|_inf > init_tol, q0 is projected onto the constraint manifold
+ *      by the minimum-norm (Euclidean) Gauss-Newton correction (or refused, see
+ *      ga_set_init_mode());
+ *   2. velocities: if |Phi_q v0 + Phi_t|_inf > init_tol, v0 is replaced by its minimum-norm
+ *      correction onto Phi_q v + Phi_t = 0 (or refused);
+ *   3. accelerations and multipliers from the saddle-point system
+ *      [M Phi_q^T; Phi_q 0] [qdd0; lambda0] = [f; -(Phi_qq(v,v) + 2 Phi_qt v + Phi_tt)];
+ *   4. a0 = qdd0 (eq. 3 of the paper).
+ *  Allocates the solver's linear-algebra workspace (the last allocation before stepping).
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE (callbacks not set, or from a callback), GA_ERR_NOMEM,
+ *  GA_ERR_CALLBACK, GA_ERR_CALLBACK_RETRY, GA_ERR_NONFINITE, GA_ERR_SINGULAR,
+ *  GA_ERR_INCONSISTENT. On failure the solver is not initialized. */
+GA_API ga_status ga_init(ga_solver *s, double t0, const double *q0, const double *v0);
+
+/** Advance by exactly one step of size h > 0 (Algorithm 1). The step is transactional: unless
+ *  GA_OK is returned, t, q, v, qdd, lambda and a are bit-identical to the last accepted step
+ *  (work counters do count the failed attempt). After GA_ERR_CALLBACK_RETRY, GA_ERR_NEWTON,
+ *  GA_ERR_NONFINITE or GA_ERR_SINGULAR the caller may retry, typically with a smaller h.
+ *  Errors: GA_ERR_ARG (h <= 0, NaN, Inf, or t + h == t), GA_ERR_STATE (before ga_init, or from a
+ *  callback), GA_ERR_CALLBACK, GA_ERR_CALLBACK_RETRY, GA_ERR_NONFINITE, GA_ERR_SINGULAR,
+ *  GA_ERR_NEWTON, GA_ERR_INTERNAL. */
+GA_API ga_status ga_step(ga_solver *s, double h);
+
+/** Details of the last error on this solver (which callback, iteration, norm, ...), or "" when
+ *  the last call succeeded. The string belongs to the solver and stays valid until its next
+ *  call. ga_last_error(NULL) returns a fixed message. */
+GA_API const char *ga_last_error(const ga_solver *s);
+
+/** Sizes given to ga_create. Errors: GA_ERR_ARG. */
+GA_API ga_status ga_get_size(const ga_solver *s, int *n, int *m);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
+/** @name Method parameters
+ *  The default is rho_inf = 0.9. The parameters may be changed between steps. */
+/**@{*/
+/** Chung-Hulbert parameters from the spectral radius at infinity rho_inf in [0, 1] (eq. 24 with
+ *  gamma from eq. 20): alpha_m = (2 rho - 1)/(rho + 1), alpha_f = rho/(rho + 1),
+ *  gamma = 1/2 + alpha_f - alpha_m, beta = (gamma + 1/2)^2 / 4. rho_inf = 1 (no numerical
+ *  damping) is allowed; it is the limit where strict stability at infinity (eq. 23) is lost.
+ *  Errors: GA_ERR_ARG (outside [0, 1] or NaN), GA_ERR_STATE. */
+GA_API ga_status ga_set_rho_inf(ga_solver *s, double rho_inf);
+
+/** Explicit parameters. Refused with GA_ERR_ARG, and a message naming the broken condition,
+ *  unless all of: finite values; second order, gamma = 1/2 + alpha_f - alpha_m (eq. 20, to
+ *  1e-12); zero stability, alpha_m <= 1/2; strict stability at infinity (eq. 23),
+ *  alpha_m < alpha_f < 1/2 and beta > 1/4 + (alpha_f - alpha_m)/2. */
+GA_API ga_status ga_set_params(ga_solver *s, double alpha_m, double alpha_f, double beta,
+                               double gamma);
+
+/** Current parameters; any output pointer may be NULL. Errors: GA_ERR_ARG. */
+GA_API ga_status ga_get_params(const ga_solver *s, double *alpha_m, double *alpha_f, double *beta,
+                               double *gamma);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
+/** @name Newton iteration and linear algebra */
+/**@{*/
+/** Newton tolerance and iteration limit (defaults 1e-10 and 20).
+ *
+ *  The test is on the Newton increments, relative and per quantity: a step is converged when
+ *  the last increments satisfy |dq| <= tol |q|, |beta' dq| <= tol |qdd| and
+ *  |dlambda| <= tol |lambda| (max-norms), or when the iteration has stagnated at round-off
+ *  (|dq| within a few ulps of |q| and no more contraction). Why not the paper's absolute test
+ *  on the scaled residual: the residual of the dynamics is scaled by beta h^2, so once h is
+ *  small the test accepts unconverged accelerations and multipliers (at h = 1e-6 it accepts
+ *  the predictor with lambda = 0). An increment test in the units of each quantity keeps its
+ *  meaning for every h, and its round-off floor follows the 1/h^2 sensitivity of index-3
+ *  multipliers instead of failing on it. tol in (0, 1), max_iter >= 1.
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_newton(ga_solver *s, double tol, int max_iter);
+
+/** Tangent matrices in the iteration matrix S_t = [beta' M + gamma' C_t + K_t, Phi_q^T;
+ *  Phi_q, 0]. */
+typedef enum ga_tangent_mode {
+    GA_TANGENT_AUTO = 0,    /**< user callbacks where given, finite differences otherwise
+                                 (default): full Newton */
+    GA_TANGENT_FD = 1,      /**< finite differences even where callbacks are given */
+    GA_TANGENT_NEGLECT = 2  /**< K_t = C_t = 0: simplified Newton (cheaper iterations, linear
+                                 convergence; only for non-stiff problems, omega_max h <~ 2) */
+} ga_tangent_mode;
+
+/** Optional exact tangent callbacks (either may be NULL: finite differences for that one).
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_tangents(ga_solver *s, ga_stiffness_fn stiffness, ga_damping_fn damping);
+
+/** Choose how K_t and C_t enter the iteration matrix. Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_tangent_mode(ga_solver *s, ga_tangent_mode mode);
+
+/** Switch the scaling (10) of the iteration matrix, D_L = diag(beta h^2 I, I),
+ *  D_R = diag(I, I/(beta h^2)), on (1, default) or off (0). Off exists to show why it is on:
+ *  without it the condition number grows like h^-4. Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_scaling(ga_solver *s, int on);
+
+/** Newton predictor. Both converge to the same step solution (to the Newton tolerance). */
+typedef enum ga_predictor {
+    GA_PREDICTOR_CONSTANT_A = 0, /**< a_{n+1} = a_n, lambda_{n+1} = lambda_n (default): an O(h)
+                                      accurate start, so fewer iterations */
+    GA_PREDICTOR_ZERO = 1        /**< Algorithm 1 verbatim: qdd_{n+1} = 0, lambda_{n+1} = 0 */
+} ga_predictor;
+
+/** Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_predictor(ga_solver *s, ga_predictor predictor);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
+/** @name Consistent start */
+/**@{*/
+/** Optional callback for the constraint acceleration term (finite differences of Phi_q and Phi
+ *  otherwise). Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_constraint_accel(ga_solver *s, ga_constraint_accel_fn fn);
+
+typedef enum ga_init_mode {
+    GA_INIT_PROJECT = 0, /**< project inconsistent q0, v0 (minimum-norm correction; default) */
+    GA_INIT_REFUSE = 1   /**< refuse inconsistent q0, v0 with GA_ERR_INCONSISTENT */
+} ga_init_mode;
+
+/** What ga_init does with inconsistent q0, v0, and the tolerance init_tol (> 0, default 1e-10,
+ *  in the units of Phi and of Phi_q v) beyond which they count as inconsistent. Projection
+ *  iterates to round-off, well below init_tol. Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_init_mode(ga_solver *s, ga_init_mode mode, double init_tol);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
+/** @name State
+ *  Copies of the current (last accepted) state. Errors: GA_ERR_ARG (NULL), GA_ERR_STATE
+ *  (before ga_init, or from a callback). */
+/**@{*/
+GA_API ga_status ga_get_t(const ga_solver *s, double *t);
+GA_API ga_status ga_get_q(const ga_solver *s, double *q);           /**< length n */
+GA_API ga_status ga_get_v(const ga_solver *s, double *v);           /**< length n */
+GA_API ga_status ga_get_qdd(const ga_solver *s, double *qdd);       /**< length n */
+GA_API ga_status ga_get_lambda(const ga_solver *s, double *lambda); /**< length m */
+GA_API ga_status ga_get_a(const ga_solver *s, double *a); /**< auxiliary vector a, length n */
+/** Size of the last accepted step (0 before the first). */
+GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
+/**@}*/
+
+/** @name Checkpoint and restart
+ *  The full state (t, h_last, q, v, qdd, lambda, a) as a flat array of doubles, so a host
+ *  simulator can save, restore and restart: a run restarted from a checkpoint continues
+ *  bit-identically. The layout is [magic, layout version, n, m, t, h_last, q(n), v(n),
+ *  qdd(n), lambda(m), a(n)]; treat it as opaque. ga_set_state needs callbacks set, allocates
+ *  like ga_init (when the solver was not initialized) and makes the solver initialized. */
+/**@{*/
+/** Number of doubles in a checkpoint. Errors: GA_ERR_ARG. */
+GA_API ga_status ga_state_size(const ga_solver *s, size_t *len);
+/** Errors: GA_ERR_ARG (NULL, len too small), GA_ERR_STATE (before ga_init). */
+GA_API ga_status ga_get_state(const ga_solver *s, double *buf, size_t len);
+/** Errors: GA_ERR_ARG (NULL, wrong length, magic, version or sizes, non-finite values),
+ *  GA_ERR_STATE (callbacks not set), GA_ERR_NOMEM. */
+GA_API ga_status ga_set_state(ga_solver *s, const double *buf, size_t len);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
+/** @name Counters
+ *  Work done since creation (or ga_reset_counters), failed attempts included, so that
+ *  work-precision comparisons count honestly. Keys are pinned and only appended. */
+/**@{*/
+typedef enum ga_counter {
+    GA_COUNT_STEPS = 0,          /**< accepted steps */
+    GA_COUNT_FAILED_STEPS = 1,   /**< ga_step calls that failed after starting the step */
+    GA_COUNT_NEWTON_ITERS = 2,   /**< Newton iterations (linear solves in ga_step) */
+    GA_COUNT_FACTORIZATIONS = 3, /**< LU factorizations (including ga_init's) */
+    GA_COUNT_RESIDUALS = 4,      /**< evaluations of the residual (r^q, r^lambda) */
+    GA_COUNT_MASS_EVALS = 5,     /**< mass matrix callback calls (finite differences included) */
+    GA_COUNT_FORCE_EVALS = 6,    /**< force callback calls (finite differences included) */
+    GA_COUNT_CONSTRAINT_EVALS = 7, /**< constraint callback calls */
+    GA_COUNT_JACOBIAN_EVALS = 8, /**< constraint Jacobian callback calls */
+    GA_COUNT_STIFFNESS_EVALS = 9, /**< K_t evaluations (callback or finite differences) */
+    GA_COUNT_DAMPING_EVALS = 10, /**< C_t evaluations (callback or finite differences) */
+    GA_COUNT_ACCEL_EVALS = 11    /**< constraint acceleration term evaluations */
+} ga_counter;
+#define GA_COUNTER_COUNT 12
+
+/** Errors: GA_ERR_ARG (NULL or unknown key), GA_ERR_STATE. */
+GA_API ga_status ga_get_counter(const ga_solver *s, ga_counter key, long long *value);
+/** Set all counters to zero. Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_reset_counters(ga_solver *s);
+/**@}*/
+
+#ifdef __cplusplus
+} /* extern "C" */
+#endif
+
+#endif /* GALPHA_H */

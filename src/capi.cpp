@@ -1,0 +1,401 @@
+// The C ABI: argument checks, the re-entrancy guard, exceptions turned into statuses.
+// No mathematics here; it lives in the ga:: core.
+#include <climits>
+#include <cmath>
+#include <exception>
+#include <new>
+
+#include "galpha.h"
+#include "params.hpp"
+#include "solver.hpp"
+
+struct ga_solver {
+    ga_solver(int n, int m) : core(n, m) {}
+    ga::Solver core;
+    bool busy = false;  // true while a call on this solver runs (and so inside its callbacks)
+};
+
+namespace {
+
+// Runs `body` as one API call on `s`: refuses calls from inside the solver's own callbacks,
+// clears the last error, and converts every C++ exception into a status.
+template <class Body>
+ga_status guarded(ga_solver *s, Body &&body)
+{
+    if (!s)
+        return GA_ERR_ARG;
+    if (s->busy)
+        return GA_ERR_STATE;  // message left alone: the outer call owns it
+    s->busy = true;
+    s->core.diag.clear();
+    ga_status st;
+    try {
+        st = body(s->core);
+    } catch (const std::bad_alloc &) {
+        st = s->core.diag.fail(GA_ERR_NOMEM, "out of memory");
+    } catch (const std::exception &e) {
+        st = s->core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception: %s", e.what());
+    } catch (...) {
+        st = s->core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception of unknown type");
+    }
+    s->busy = false;
+    return st;
+}
+
+// Read-only calls: the same refusal from callbacks; they cannot throw and keep the message.
+template <class Body>
+ga_status reading(const ga_solver *s, Body &&body)
+{
+    if (!s)
+        return GA_ERR_ARG;
+    if (s->busy)
+        return GA_ERR_STATE;
+    return body(s->core);
+}
+
+ga_status copy_out(const ga::Solver &c, const ga::Vec &x, double *out)
+{
+    if (!out)
+        return GA_ERR_ARG;
+    if (!c.initialized())
+        return GA_ERR_STATE;
+    Eigen::Map<ga::Vec>(out, x.size()) = x;
+    return GA_OK;
+}
+
+}  // namespace
+
+extern "C" {
+
+GA_API const char *ga_version(void)
+{
+#define GA_STR2(x) #x
+#define GA_STR(x) GA_STR2(x)
+    return GA_STR(GA_VERSION_MAJOR) "." GA_STR(GA_VERSION_MINOR) "." GA_STR(GA_VERSION_PATCH);
+#undef GA_STR
+#undef GA_STR2
+}
+
+GA_API int ga_version_number(void) { return GA_VERSION_NUMBER; }
+
+GA_API const char *ga_strerror(ga_status status)
+{
+    switch (status) {
+    case GA_OK: return "success";
+    case GA_ERR_ARG: return "invalid argument";
+    case GA_ERR_STATE: return "call out of order or from inside a callback";
+    case GA_ERR_NOMEM: return "out of memory";
+    case GA_ERR_CALLBACK: return "callback failed (fatal)";
+    case GA_ERR_CALLBACK_RETRY: return "callback failed (recoverable): step rejected";
+    case GA_ERR_NONFINITE: return "NaN or Inf encountered";
+    case GA_ERR_SINGULAR: return "singular matrix";
+    case GA_ERR_NEWTON: return "Newton iteration did not converge";
+    case GA_ERR_INCONSISTENT: return "inconsistent initial values";
+    case GA_ERR_INTERNAL: return "internal error";
+    }
+    return "unknown status";
+}
+
+GA_API const char *ga_last_error(const ga_solver *s)
+{
+    if (!s)
+        return "NULL solver";
+    return s->core.diag.text();
+}
+
+GA_API ga_status ga_create(int n, int m, ga_solver **out)
+{
+    if (!out)
+        return GA_ERR_ARG;
+    *out = nullptr;
+    if (n < 1 || m < 0 || m > n || n > INT_MAX - m)
+        return GA_ERR_ARG;
+    try {
+        *out = new ga_solver(n, m);
+    } catch (const std::bad_alloc &) {
+        return GA_ERR_NOMEM;
+    } catch (...) {
+        return GA_ERR_INTERNAL;
+    }
+    return GA_OK;
+}
+
+GA_API void ga_free(ga_solver *s)
+{
+    if (!s || s->busy)  // freeing a solver from its own callback would pull the floor away
+        return;
+    delete s;
+}
+
+GA_API ga_status ga_get_size(const ga_solver *s, int *n, int *m)
+{
+    return reading(s, [&](const ga::Solver &c) {
+        if (!n || !m)
+            return GA_ERR_ARG;
+        *n = c.n();
+        *m = c.m();
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_callbacks(ga_solver *s, ga_mass_fn mass, ga_force_fn force,
+                                  ga_constraint_fn constraint, ga_jacobian_fn jacobian,
+                                  void *user)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!mass)
+            return c.diag.fail(GA_ERR_ARG, "the mass matrix callback is required");
+        if (c.m() > 0 && (!constraint || !jacobian))
+            return c.diag.fail(GA_ERR_ARG, "m = %d > 0: constraint and jacobian callbacks are "
+                               "required", c.m());
+        c.model.cb.mass = mass;
+        c.model.cb.force = force;
+        c.model.cb.constraint = c.m() > 0 ? constraint : nullptr;
+        c.model.cb.jacobian = c.m() > 0 ? jacobian : nullptr;
+        c.model.cb.user = user;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_tangents(ga_solver *s, ga_stiffness_fn stiffness, ga_damping_fn damping)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        c.model.cb.stiffness = stiffness;
+        c.model.cb.damping = damping;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_tangent_mode(ga_solver *s, ga_tangent_mode mode)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (mode != GA_TANGENT_AUTO && mode != GA_TANGENT_FD && mode != GA_TANGENT_NEGLECT)
+            return c.diag.fail(GA_ERR_ARG, "unknown tangent mode %d", static_cast<int>(mode));
+        c.model.tangent_mode = mode;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_constraint_accel(ga_solver *s, ga_constraint_accel_fn fn)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        c.model.cb.constraint_accel = fn;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_rho_inf(ga_solver *s, double rho_inf)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
+            return c.diag.fail(GA_ERR_ARG, "rho_inf = %g is outside [0, 1]", rho_inf);
+        c.params = ga::params_from_rho_inf(rho_inf);
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_params(ga_solver *s, double alpha_m, double alpha_f, double beta,
+                               double gamma)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        const ga::Params p{alpha_m, alpha_f, beta, gamma};
+        if (const char *why = ga::check_params(p))
+            return c.diag.fail(GA_ERR_ARG, "parameters refused: %s", why);
+        c.params = p;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_get_params(const ga_solver *s, double *alpha_m, double *alpha_f,
+                               double *beta, double *gamma)
+{
+    return reading(s, [&](const ga::Solver &c) {
+        if (alpha_m)
+            *alpha_m = c.params.alpha_m;
+        if (alpha_f)
+            *alpha_f = c.params.alpha_f;
+        if (beta)
+            *beta = c.params.beta;
+        if (gamma)
+            *gamma = c.params.gamma;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_newton(ga_solver *s, double tol, int max_iter)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!(tol > 0.0 && tol < 1.0))
+            return c.diag.fail(GA_ERR_ARG, "Newton tolerance %g is outside (0, 1)", tol);
+        if (max_iter < 1)
+            return c.diag.fail(GA_ERR_ARG, "max_iter = %d < 1", max_iter);
+        c.newton_tol = tol;
+        c.max_iter = max_iter;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_scaling(ga_solver *s, int on)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (on != 0 && on != 1)
+            return c.diag.fail(GA_ERR_ARG, "scaling must be 0 or 1, got %d", on);
+        c.scaling = on == 1;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_predictor(ga_solver *s, ga_predictor predictor)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (predictor != GA_PREDICTOR_CONSTANT_A && predictor != GA_PREDICTOR_ZERO)
+            return c.diag.fail(GA_ERR_ARG, "unknown predictor %d", static_cast<int>(predictor));
+        c.predictor = predictor;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_init_mode(ga_solver *s, ga_init_mode mode, double init_tol)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (mode != GA_INIT_PROJECT && mode != GA_INIT_REFUSE)
+            return c.diag.fail(GA_ERR_ARG, "unknown init mode %d", static_cast<int>(mode));
+        if (!(init_tol > 0.0 && std::isfinite(init_tol)))
+            return c.diag.fail(GA_ERR_ARG, "init_tol = %g must be positive and finite",
+                               init_tol);
+        c.init_mode = mode;
+        c.init_tol = init_tol;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_init(ga_solver *s, double t0, const double *q0, const double *v0)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!q0 || !v0)
+            return c.diag.fail(GA_ERR_ARG, "q0 and v0 must not be NULL");
+        if (!std::isfinite(t0))
+            return c.diag.fail(GA_ERR_ARG, "t0 = %g is not finite", t0);
+        if (!c.model.ready())
+            return c.diag.fail(GA_ERR_STATE, "ga_init before ga_set_callbacks");
+        return c.init(t0, q0, v0);
+    });
+}
+
+GA_API ga_status ga_step(ga_solver *s, double h)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!c.initialized())
+            return c.diag.fail(GA_ERR_STATE, "ga_step before ga_init");
+        if (!(h > 0.0) || !std::isfinite(h))
+            return c.diag.fail(GA_ERR_ARG, "step size h = %g must be positive and finite", h);
+        if (c.state().t + h == c.state().t)
+            return c.diag.fail(GA_ERR_ARG, "step size h = %g is too small to advance t = %.17g",
+                               h, c.state().t);
+        return c.step(h);
+    });
+}
+
+GA_API ga_status ga_get_t(const ga_solver *s, double *t)
+{
+    return reading(s, [&](const ga::Solver &c) {
+        if (!t)
+            return GA_ERR_ARG;
+        if (!c.initialized())
+            return GA_ERR_STATE;
+        *t = c.state().t;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_get_h_last(const ga_solver *s, double *h)
+{
+    return reading(s, [&](const ga::Solver &c) {
+        if (!h)
+            return GA_ERR_ARG;
+        if (!c.initialized())
+            return GA_ERR_STATE;
+        *h = c.state().h_last;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_get_q(const ga_solver *s, double *q)
+{
+    return reading(s, [&](const ga::Solver &c) { return copy_out(c, c.state().q, q); });
+}
+
+GA_API ga_status ga_get_v(const ga_solver *s, double *v)
+{
+    return reading(s, [&](const ga::Solver &c) { return copy_out(c, c.state().v, v); });
+}
+
+GA_API ga_status ga_get_qdd(const ga_solver *s, double *qdd)
+{
+    return reading(s, [&](const ga::Solver &c) { return copy_out(c, c.state().qdd, qdd); });
+}
+
+GA_API ga_status ga_get_lambda(const ga_solver *s, double *lambda)
+{
+    return reading(s, [&](const ga::Solver &c) {
+        if (c.m() == 0 && c.initialized())
+            return GA_OK;  // nothing to copy; lambda may be NULL
+        return copy_out(c, c.state().lambda, lambda);
+    });
+}
+
+GA_API ga_status ga_get_a(const ga_solver *s, double *a)
+{
+    return reading(s, [&](const ga::Solver &c) { return copy_out(c, c.state().a, a); });
+}
+
+GA_API ga_status ga_state_size(const ga_solver *s, size_t *len)
+{
+    return reading(s, [&](const ga::Solver &c) {
+        if (!len)
+            return GA_ERR_ARG;
+        *len = c.state_size();
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_get_state(const ga_solver *s, double *buf, size_t len)
+{
+    return reading(s, [&](const ga::Solver &c) {
+        if (!buf || len < c.state_size())
+            return GA_ERR_ARG;
+        if (!c.initialized())
+            return GA_ERR_STATE;
+        c.get_state(buf);
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_state(ga_solver *s, const double *buf, size_t len)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!buf)
+            return c.diag.fail(GA_ERR_ARG, "checkpoint buffer is NULL");
+        return c.set_state(buf, len);
+    });
+}
+
+GA_API ga_status ga_get_counter(const ga_solver *s, ga_counter key, long long *value)
+{
+    return reading(s, [&](const ga::Solver &c) {
+        if (!value || static_cast<int>(key) < 0 || static_cast<int>(key) >= GA_COUNTER_COUNT)
+            return GA_ERR_ARG;
+        *value = c.counters[key];
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_reset_counters(ga_solver *s)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        c.counters.fill(0);
+        return GA_OK;
+    });
+}
+
+}  // extern "C"
