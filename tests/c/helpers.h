@@ -1,0 +1,62 @@
+/* Shared by the cmocka suites: least-squares order fits and an independent reference
+ * solution of the pendulum (RK4 on the angle equation, not galpha). */
+#ifndef GALPHA_TEST_HELPERS_H
+#define GALPHA_TEST_HELPERS_H
+
+#include <math.h>
+#include <stdio.h>
+
+#include "scenes/pendulum.h"
+
+/* Slope of the least-squares line through (log h_i, log e_i). */
+static inline double fit_order(const double *h, const double *e, int k)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int i = 0; i < k; ++i) {
+        const double x = log(h[i]), y = log(e[i]);
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+    }
+    return (k * sxy - sx * sy) / (k * sxx - sx * sx);
+}
+
+/* Reference pendulum: theta'' = -(g/L) sin(theta), classical RK4 with `steps` steps to t_end.
+ * Returns the Cartesian q, v, qdd and lambda = m (|v|^2 - g y) / L^2 at t_end. */
+typedef struct pendulum_exact {
+    double q[2], v[2], qdd[2], lambda;
+} pendulum_exact;
+
+static inline pendulum_exact pendulum_reference(const pendulum *p, double theta0, double omega0,
+                                                double t_end, long steps)
+{
+    const double w2 = p->gravity / p->length, h = t_end / (double)steps;
+    double th = theta0, om = omega0;
+    for (long i = 0; i < steps; ++i) {
+        const double k1t = om, k1o = -w2 * sin(th);
+        const double k2t = om + 0.5 * h * k1o, k2o = -w2 * sin(th + 0.5 * h * k1t);
+        const double k3t = om + 0.5 * h * k2o, k3o = -w2 * sin(th + 0.5 * h * k2t);
+        const double k4t = om + h * k3o, k4o = -w2 * sin(th + h * k3t);
+        th += h / 6.0 * (k1t + 2 * k2t + 2 * k3t + k4t);
+        om += h / 6.0 * (k1o + 2 * k2o + 2 * k3o + k4o);
+    }
+    pendulum_exact r;
+    const double L = p->length, al = -w2 * sin(th); /* angular acceleration */
+    pendulum_state(p, th, om, r.q, r.v);
+    /* x = L sin th, y = -L cos th: differentiate twice */
+    r.qdd[0] = L * (al * cos(th) - om * om * sin(th));
+    r.qdd[1] = L * (al * sin(th) + om * om * cos(th));
+    r.lambda = p->mass * ((r.v[0] * r.v[0] + r.v[1] * r.v[1]) - p->gravity * r.q[1]) / (L * L);
+    return r;
+}
+
+static inline double max_abs_diff(const double *a, const double *b, int n)
+{
+    double d = 0.0;
+    for (int i = 0; i < n; ++i)
+        d = fmax(d, fabs(a[i] - b[i]));
+    return d;
+}
+
+#endif

@@ -1,0 +1,553 @@
+/* Every error path: bad arguments, calls out of order, callback failures (fatal and
+ * recoverable), NaN/Inf, singular matrices, Newton failure, inconsistent initial values,
+ * out of memory, and re-entrant calls. Each must return its specific status with a readable
+ * message, and a failed ga_step must leave the solver bit-identical to its last accepted
+ * state, so that the run can go on as if the failure had not happened. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <galpha.h>
+
+#include "helpers.h"
+
+/* The pendulum with switchable faults. */
+typedef enum fault_site { NONE, MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS } fault_site;
+typedef struct faulty {
+    pendulum p;
+    fault_site site;
+    int rc;          /* return code to inject (0: inject a value instead) */
+    double value;    /* value written into the output when rc == 0 */
+    int zero_jacobian;
+    ga_solver *self; /* for the re-entrancy test */
+    ga_status reentry_status;
+    int reentry_calls;
+} faulty;
+
+static int inject(faulty *f, fault_site site, double *out)
+{
+    if (f->site != site)
+        return 0;
+    if (f->rc != 0)
+        return f->rc;
+    out[0] = f->value;
+    return 0;
+}
+
+static int f_mass(double t, const double *q, double *M, void *u)
+{
+    faulty *f = u;
+    pendulum_mass(t, q, M, &f->p);
+    if (f->self) { /* calls back into its own solver: must be refused */
+        double tt;
+        f->reentry_status = ga_get_t(f->self, &tt);
+        if (f->reentry_status == GA_ERR_STATE)
+            f->reentry_status = ga_step(f->self, 0.1);
+        ++f->reentry_calls;
+    }
+    return inject(f, MASS, M);
+}
+static int f_force(double t, const double *q, const double *v, double *out, void *u)
+{
+    faulty *f = u;
+    pendulum_force(t, q, v, out, &f->p);
+    return inject(f, FORCE, out);
+}
+static int f_constraint(double t, const double *q, double *phi, void *u)
+{
+    faulty *f = u;
+    pendulum_constraint(t, q, phi, &f->p);
+    return inject(f, CONSTRAINT, phi);
+}
+static int f_jacobian(double t, const double *q, double *J, void *u)
+{
+    faulty *f = u;
+    pendulum_jacobian(t, q, J, &f->p);
+    if (f->zero_jacobian)
+        J[0] = J[1] = 0.0;
+    return inject(f, JACOBIAN, J);
+}
+static int f_stiffness(double t, const double *q, const double *v, const double *qdd,
+                       const double *lambda, double *K, void *u)
+{
+    faulty *f = u;
+    pendulum_stiffness(t, q, v, qdd, lambda, K, &f->p);
+    return inject(f, STIFFNESS, K);
+}
+
+typedef struct fixture {
+    faulty model;
+    ga_solver *s;
+} fixture;
+
+static int setup(void **state)
+{
+    fixture *x = calloc(1, sizeof *x);
+    double q[2], v[2];
+    x->model.p = (pendulum){1.0, 1.0, 9.81};
+    if (!x || ga_create(2, 1, &x->s) != GA_OK)
+        return -1;
+    pendulum_state(&x->model.p, 1.0, 0.5, q, v);
+    if (ga_set_callbacks(x->s, f_mass, f_force, f_constraint, f_jacobian, &x->model) ||
+        ga_set_tangents(x->s, f_stiffness, NULL) || ga_init(x->s, 0.0, q, v))
+        return -1;
+    for (int i = 0; i < 10; ++i)
+        if (ga_step(x->s, 0.01) != GA_OK)
+            return -1;
+    *state = x;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    fixture *x = *state;
+    ga_free(x->s);
+    free(x);
+    return 0;
+}
+
+enum { STATE_MAX = 64 };
+static size_t snapshot(ga_solver *s, double *buf)
+{
+    size_t len = 0;
+    assert_int_equal(ga_state_size(s, &len), GA_OK);
+    assert_true(len <= STATE_MAX);
+    assert_int_equal(ga_get_state(s, buf, len), GA_OK);
+    return len;
+}
+
+static void expect_message(ga_solver *s, const char *part)
+{
+    if (!strstr(ga_last_error(s), part))
+        fail_msg("message '%s' does not contain '%s'", ga_last_error(s), part);
+}
+
+/* Run a failing step; check status, message, bit-identical state, then clear the fault and
+ * check that the run continues exactly like an undisturbed solver. */
+static void failing_step(fixture *x, ga_status expected, const char *part)
+{
+    double before[STATE_MAX], after[STATE_MAX];
+    const size_t len = snapshot(x->s, before);
+    assert_int_equal(ga_step(x->s, 0.01), expected);
+    expect_message(x->s, part);
+    snapshot(x->s, after);
+    assert_memory_equal(before, after, len * sizeof(double));
+
+    /* recovery: the same step again, without the fault, equals the undisturbed run */
+    x->model.site = NONE;
+    x->model.zero_jacobian = 0;
+    ga_solver *ref = NULL;
+    assert_int_equal(ga_create(2, 1, &ref), GA_OK);
+    assert_int_equal(ga_set_callbacks(ref, f_mass, f_force, f_constraint, f_jacobian, &x->model),
+                     GA_OK);
+    assert_int_equal(ga_set_tangents(ref, f_stiffness, NULL), GA_OK);
+    assert_int_equal(ga_set_state(ref, before, len), GA_OK);
+    assert_int_equal(ga_step(x->s, 0.01), GA_OK);
+    assert_int_equal(ga_step(ref, 0.01), GA_OK);
+    snapshot(x->s, after);
+    snapshot(ref, before);
+    assert_memory_equal(before, after, len * sizeof(double));
+    ga_free(ref);
+}
+
+/* ---- arguments and order of calls ------------------------------------------------------- */
+
+static void create_rejects_bad_sizes(void **state)
+{
+    (void)state;
+    ga_solver *s = (ga_solver *)0x1;
+    assert_int_equal(ga_create(2, 1, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_create(0, 0, &s), GA_ERR_ARG);
+    assert_null(s);
+    assert_int_equal(ga_create(-3, 0, &s), GA_ERR_ARG);
+    assert_int_equal(ga_create(2, -1, &s), GA_ERR_ARG);
+    assert_int_equal(ga_create(2, 3, &s), GA_ERR_ARG);
+    assert_int_equal(ga_create(INT_MAX, INT_MAX, &s), GA_ERR_ARG);
+    assert_null(s);
+    ga_free(NULL); /* no-op */
+}
+
+static void null_pointers_are_refused(void **state)
+{
+    fixture *x = *state;
+    double d;
+    long long c;
+    int n, m;
+    size_t len;
+    assert_int_equal(ga_step(NULL, 0.1), GA_ERR_ARG);
+    assert_int_equal(ga_init(NULL, 0.0, &d, &d), GA_ERR_ARG);
+    assert_int_equal(ga_set_rho_inf(NULL, 0.5), GA_ERR_ARG);
+    assert_int_equal(ga_get_t(NULL, &d), GA_ERR_ARG);
+    assert_int_equal(ga_get_t(x->s, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_get_q(x->s, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_get_v(x->s, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_get_qdd(x->s, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_get_lambda(x->s, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_get_a(x->s, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_get_h_last(x->s, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_get_counter(x->s, GA_COUNT_STEPS, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_get_counter(x->s, (ga_counter)99, &c), GA_ERR_ARG);
+    assert_int_equal(ga_get_counter(x->s, (ga_counter)-1, &c), GA_ERR_ARG);
+    assert_int_equal(ga_get_size(x->s, NULL, &m), GA_ERR_ARG);
+    assert_int_equal(ga_get_size(x->s, &n, &m), GA_OK);
+    assert_int_equal(ga_state_size(x->s, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_state_size(x->s, &len), GA_OK);
+    assert_int_equal(ga_get_state(x->s, NULL, len), GA_ERR_ARG);
+    assert_int_equal(ga_set_state(x->s, NULL, len), GA_ERR_ARG);
+    assert_int_equal(ga_init(x->s, 0.0, NULL, &d), GA_ERR_ARG);
+    assert_string_equal(ga_last_error(NULL), "NULL solver");
+}
+
+static void bad_step_sizes_are_refused(void **state)
+{
+    fixture *x = *state;
+    double before[STATE_MAX], after[STATE_MAX];
+    const size_t len = snapshot(x->s, before);
+    const double bad[] = {0.0, -0.01, NAN, INFINITY, -INFINITY, 1e-30};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        assert_int_equal(ga_step(x->s, bad[i]), GA_ERR_ARG);
+        expect_message(x->s, "step size h");
+    }
+    snapshot(x->s, after);
+    assert_memory_equal(before, after, len * sizeof(double));
+}
+
+static void calls_out_of_order_are_refused(void **state)
+{
+    (void)state;
+    ga_solver *s = NULL;
+    double q[2] = {0.0, -1.0}, v[2] = {0.0, 0.0}, t, buf[STATE_MAX];
+    pendulum p = {1.0, 1.0, 9.81};
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_step(s, 0.01), GA_ERR_STATE);
+    expect_message(s, "before ga_init");
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_STATE);
+    expect_message(s, "before ga_set_callbacks");
+    assert_int_equal(ga_get_t(s, &t), GA_ERR_STATE);
+    assert_int_equal(ga_get_q(s, q), GA_ERR_STATE);
+    assert_int_equal(ga_get_state(s, buf, STATE_MAX), GA_ERR_STATE);
+    buf[0] = 26465.0; /* a well-formed checkpoint still needs callbacks */
+    buf[1] = 1.0;
+    buf[2] = 2.0;
+    buf[3] = 1.0;
+    for (int i = 4; i < 6 + 4 * 2 + 1; ++i)
+        buf[i] = 0.0;
+    assert_int_equal(ga_set_state(s, buf, 6 + 4 * 2 + 1), GA_ERR_STATE);
+    /* callbacks: mass required, constraint + jacobian required for m > 0 */
+    assert_int_equal(ga_set_callbacks(s, NULL, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &p),
+                     GA_ERR_ARG);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, NULL, pendulum_jacobian,
+                                      &p),
+                     GA_ERR_ARG);
+    expect_message(s, "constraint and jacobian callbacks are required");
+    ga_free(s);
+}
+
+static void bad_options_are_refused(void **state)
+{
+    fixture *x = *state;
+    assert_int_equal(ga_set_newton(x->s, 0.0, 10), GA_ERR_ARG);
+    assert_int_equal(ga_set_newton(x->s, 1.0, 10), GA_ERR_ARG);
+    assert_int_equal(ga_set_newton(x->s, NAN, 10), GA_ERR_ARG);
+    assert_int_equal(ga_set_newton(x->s, 1e-8, 0), GA_ERR_ARG);
+    assert_int_equal(ga_set_scaling(x->s, 2), GA_ERR_ARG);
+    assert_int_equal(ga_set_tangent_mode(x->s, (ga_tangent_mode)7), GA_ERR_ARG);
+    assert_int_equal(ga_set_predictor(x->s, (ga_predictor)7), GA_ERR_ARG);
+    assert_int_equal(ga_set_init_mode(x->s, (ga_init_mode)7, 1e-10), GA_ERR_ARG);
+    assert_int_equal(ga_set_init_mode(x->s, GA_INIT_PROJECT, 0.0), GA_ERR_ARG);
+    assert_int_equal(ga_set_init_mode(x->s, GA_INIT_PROJECT, INFINITY), GA_ERR_ARG);
+}
+
+static void bad_checkpoints_are_refused(void **state)
+{
+    fixture *x = *state;
+    double buf[STATE_MAX], before[STATE_MAX], after[STATE_MAX];
+    const size_t len = snapshot(x->s, before);
+    memcpy(buf, before, len * sizeof(double));
+    assert_int_equal(ga_set_state(x->s, buf, len - 1), GA_ERR_ARG);
+    expect_message(x->s, "doubles");
+    assert_int_equal(ga_get_state(x->s, buf, len - 1), GA_ERR_ARG);
+    buf[0] = 1.0;
+    assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
+    expect_message(x->s, "not a galpha checkpoint");
+    buf[0] = before[0];
+    buf[2] = 3.0;
+    assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
+    buf[2] = before[2];
+    buf[8] = NAN;
+    assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
+    expect_message(x->s, "not finite");
+    snapshot(x->s, after);
+    assert_memory_equal(before, after, len * sizeof(double));
+}
+
+/* ---- failures inside a step --------------------------------------------------------------- */
+
+static void fatal_callback_failure(void **state)
+{
+    fixture *x = *state;
+    const fault_site sites[] = {MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS};
+    const char *names[] = {"mass callback returned -7", "force callback returned -7",
+                           "constraint callback returned -7", "jacobian callback returned -7",
+                           "stiffness callback returned -7"};
+    for (int i = 0; i < 5; ++i) {
+        x->model.site = sites[i];
+        x->model.rc = -7;
+        failing_step(x, GA_ERR_CALLBACK, names[i]);
+    }
+}
+
+static void recoverable_callback_failure(void **state)
+{
+    fixture *x = *state;
+    x->model.site = FORCE;
+    x->model.rc = 3;
+    failing_step(x, GA_ERR_CALLBACK_RETRY, "force callback returned 3 (recoverable)");
+    long long failed = 0;
+    assert_int_equal(ga_get_counter(x->s, GA_COUNT_FAILED_STEPS, &failed), GA_OK);
+    assert_int_equal(failed, 1);
+}
+
+static void nan_and_inf_in_callback_outputs(void **state)
+{
+    fixture *x = *state;
+    const fault_site sites[] = {MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS};
+    const char *names[] = {"mass matrix M(0,0)", "force f[0]", "constraint Phi[0]",
+                           "constraint Jacobian Phi_q(0,0)", "tangent stiffness K_t(0,0)"};
+    for (int i = 0; i < 5; ++i) {
+        x->model.site = sites[i];
+        x->model.rc = 0;
+        x->model.value = (i % 2) ? INFINITY : NAN;
+        failing_step(x, GA_ERR_NONFINITE, names[i]);
+    }
+}
+
+static void singular_iteration_matrix(void **state)
+{
+    fixture *x = *state;
+    x->model.zero_jacobian = 1; /* Phi_q = 0: the saddle-point matrix is singular */
+    failing_step(x, GA_ERR_SINGULAR, "iteration matrix S_t (scaled, eq. 10) is singular");
+}
+
+static void newton_not_converged_in_max_iter(void **state)
+{
+    fixture *x = *state;
+    assert_int_equal(ga_set_newton(x->s, 1e-10, 1), GA_OK);
+    double before[STATE_MAX], after[STATE_MAX];
+    const size_t len = snapshot(x->s, before);
+    assert_int_equal(ga_step(x->s, 0.01), GA_ERR_NEWTON);
+    expect_message(x->s, "did not converge in 1 iterations");
+    snapshot(x->s, after);
+    assert_memory_equal(before, after, len * sizeof(double));
+    assert_int_equal(ga_set_newton(x->s, 1e-10, 20), GA_OK);
+    assert_int_equal(ga_step(x->s, 0.01), GA_OK);
+}
+
+/* A wrong tangent (as from a sign error in user code) makes Newton diverge: reported, not
+ * accepted, and the state is kept. */
+static int wrong_stiffness(double t, const double *q, const double *v, const double *qdd,
+                           const double *lambda, double *K, void *u)
+{
+    (void)t, (void)q, (void)v, (void)qdd, (void)lambda, (void)u;
+    K[0] = K[3] = -1.95e4; /* cancels most of beta' M at h = 0.01: a wildly wrong slope */
+    K[1] = K[2] = 0.0;
+    return 0;
+}
+
+static void newton_diverges_with_wrong_tangent(void **state)
+{
+    fixture *x = *state;
+    assert_int_equal(ga_set_tangents(x->s, wrong_stiffness, NULL), GA_OK);
+    double before[STATE_MAX], after[STATE_MAX];
+    const size_t len = snapshot(x->s, before);
+    const ga_status st = ga_step(x->s, 0.01);
+    assert_true(st == GA_ERR_NEWTON || st == GA_ERR_NONFINITE);
+    snapshot(x->s, after);
+    assert_memory_equal(before, after, len * sizeof(double));
+}
+
+/* ---- re-entrancy ------------------------------------------------------------------------ */
+
+static void callback_calling_its_own_solver_is_refused(void **state)
+{
+    fixture *x = *state;
+    x->model.self = x->s;
+    x->model.reentry_status = GA_OK;
+    assert_int_equal(ga_step(x->s, 0.01), GA_OK); /* the outer step is not disturbed */
+    assert_true(x->model.reentry_calls > 0);
+    assert_int_equal(x->model.reentry_status, GA_ERR_STATE);
+    x->model.self = NULL;
+}
+
+/* ---- initial values ---------------------------------------------------------------------- */
+
+static void inconsistent_start_refused_when_asked(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = NULL;
+    double q[2] = {0.3, -1.0}, v[2] = {0.0, 0.0};
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &p),
+                     GA_OK);
+    assert_int_equal(ga_set_init_mode(s, GA_INIT_REFUSE, 1e-10), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_INCONSISTENT);
+    expect_message(s, "q0 violates the constraints");
+    q[0] = 0.0; /* consistent position, inconsistent velocity */
+    v[1] = 0.2;
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_INCONSISTENT);
+    expect_message(s, "v0 violates the velocity constraints");
+    ga_free(s);
+}
+
+/* x^2 + y^2 = L^2 with L^2 < 0 has no solution: the projection must give up, not loop. */
+static int impossible_constraint(double t, const double *q, double *phi, void *u)
+{
+    (void)t, (void)u;
+    phi[0] = 0.5 * (q[0] * q[0] + q[1] * q[1] + 1.0);
+    return 0;
+}
+
+static void projection_that_cannot_converge(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = NULL;
+    double q[2] = {0.3, -1.0}, v[2] = {0.0, 0.0};
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, impossible_constraint,
+                                      pendulum_jacobian, &p),
+                     GA_OK);
+    const ga_status st = ga_init(s, 0.0, q, v);
+    assert_true(st == GA_ERR_INCONSISTENT || st == GA_ERR_SINGULAR);
+    printf("  impossible constraint: %s: %s\n", ga_strerror(st), ga_last_error(s));
+    ga_free(s);
+}
+
+static int redundant_constraints(double t, const double *q, double *phi, void *u)
+{
+    pendulum_constraint(t, q, phi, u);
+    phi[1] = phi[0];
+    return 0;
+}
+static int redundant_jacobian(double t, const double *q, double *J, void *u)
+{
+    (void)t, (void)u;
+    J[0] = J[1] = q[0]; /* 2 x 2 column-major: both rows (x, y) */
+    J[2] = J[3] = q[1];
+    return 0;
+}
+
+static void singular_saddle_point_matrix_at_init(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = NULL;
+    double q[2], v[2];
+    pendulum_state(&p, 0.4, 0.0, q, v);
+    assert_int_equal(ga_create(2, 2, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, redundant_constraints,
+                                      redundant_jacobian, &p),
+                     GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_SINGULAR);
+    expect_message(s, "saddle-point matrix [M Phi_q^T; Phi_q 0] is singular");
+    ga_free(s);
+}
+
+static void nan_in_initial_values(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = NULL;
+    double q[2] = {0.0, -1.0}, v[2] = {NAN, 0.0};
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &p),
+                     GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_ARG);
+    assert_int_equal(ga_init(s, NAN, q, q), GA_ERR_ARG);
+    ga_free(s);
+}
+
+/* ---- memory ------------------------------------------------------------------------------ */
+
+static int overcommit_always(void)
+{
+    FILE *f = fopen("/proc/sys/vm/overcommit_memory", "r");
+    int mode = 0;
+    if (f) {
+        if (fscanf(f, "%d", &mode) != 1)
+            mode = 0;
+        fclose(f);
+    }
+    return mode == 1;
+}
+
+static void out_of_memory_is_reported(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = NULL;
+    /* Dense workspace for n = 400 000: 1.28e12 bytes per n x n matrix, beyond any RAM here
+     * (and beyond ASan's allocation limit): malloc fails, and so must ga_init, cleanly. */
+    if (overcommit_always()) {
+        printf("  skipped: vm.overcommit_memory = 1 would let the allocation succeed lazily\n");
+        skip();
+    }
+    assert_int_equal(ga_create(400000, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, NULL, NULL, NULL, &p), GA_OK);
+    double x = 0.0;
+    assert_int_equal(ga_init(s, 0.0, &x, &x), GA_ERR_NOMEM);
+    expect_message(s, "out of memory");
+    ga_free(s);
+    /* sizes whose dense workspace would not even fit in the address space */
+    assert_int_equal(ga_create(INT_MAX / 2, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, NULL, NULL, NULL, &p), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, &x, &x), GA_ERR_NOMEM);
+    ga_free(s);
+}
+
+static void strerror_names_every_status(void **state)
+{
+    (void)state;
+    for (int st = GA_OK; st >= GA_ERR_INTERNAL; --st)
+        assert_string_not_equal(ga_strerror((ga_status)st), "unknown status");
+    assert_string_equal(ga_strerror((ga_status)-99), "unknown status");
+    assert_string_equal(ga_strerror(GA_ERR_NEWTON), "Newton iteration did not converge");
+}
+
+#define T(f) cmocka_unit_test_setup_teardown(f, setup, teardown)
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(create_rejects_bad_sizes),
+        T(null_pointers_are_refused),
+        T(bad_step_sizes_are_refused),
+        cmocka_unit_test(calls_out_of_order_are_refused),
+        T(bad_options_are_refused),
+        T(bad_checkpoints_are_refused),
+        T(fatal_callback_failure),
+        T(recoverable_callback_failure),
+        T(nan_and_inf_in_callback_outputs),
+        T(singular_iteration_matrix),
+        T(newton_not_converged_in_max_iter),
+        T(newton_diverges_with_wrong_tangent),
+        T(callback_calling_its_own_solver_is_refused),
+        cmocka_unit_test(inconsistent_start_refused_when_asked),
+        cmocka_unit_test(projection_that_cannot_converge),
+        cmocka_unit_test(singular_saddle_point_matrix_at_init),
+        cmocka_unit_test(nan_in_initial_values),
+        cmocka_unit_test(out_of_memory_is_reported),
+        cmocka_unit_test(strerror_names_every_status),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
