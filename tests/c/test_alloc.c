@@ -1,0 +1,151 @@
+/* No heap allocation inside ga_step after ga_init: every allocation in the process is counted
+ * while ga_step runs (successful steps, steps with finite-difference tangents, and failing
+ * steps). Without sanitizers, malloc and friends are interposed here; under AddressSanitizer,
+ * its allocation hooks count instead. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <string.h>
+
+#include <galpha.h>
+
+#include "helpers.h"
+
+static volatile int armed = 0;
+static volatile long allocations = 0;
+
+#if defined(__SANITIZE_ADDRESS__)
+#include <sanitizer/allocator_interface.h>
+static void on_malloc(const volatile void *p, size_t n)
+{
+    (void)p, (void)n;
+    if (armed)
+        ++allocations;
+}
+static void on_free(const volatile void *p) { (void)p; }
+static void install(void) { __sanitizer_install_malloc_and_free_hooks(on_malloc, on_free); }
+#else
+extern void *__libc_malloc(size_t);
+extern void *__libc_calloc(size_t, size_t);
+extern void *__libc_realloc(void *, size_t);
+extern void *__libc_memalign(size_t, size_t);
+extern void __libc_free(void *);
+void *malloc(size_t n)
+{
+    if (armed)
+        ++allocations;
+    return __libc_malloc(n);
+}
+void *calloc(size_t k, size_t n)
+{
+    if (armed)
+        ++allocations;
+    return __libc_calloc(k, n);
+}
+void *realloc(void *p, size_t n)
+{
+    if (armed)
+        ++allocations;
+    return __libc_realloc(p, n);
+}
+void *memalign(size_t a, size_t n)
+{
+    if (armed)
+        ++allocations;
+    return __libc_memalign(a, n);
+}
+void *aligned_alloc(size_t a, size_t n) { return memalign(a, n); }
+int posix_memalign(void **out, size_t a, size_t n)
+{
+    *out = memalign(a, n);
+    return *out ? 0 : 12;
+}
+void free(void *p) { __libc_free(p); }
+static void install(void) {}
+#endif
+
+static int fail_force = 0;
+static int force_maybe_failing(double t, const double *q, const double *v, double *f, void *u)
+{
+    pendulum_force(t, q, v, f, u);
+    return fail_force;
+}
+
+static long count_step_allocations(ga_tangent_mode mode, int with_failures)
+{
+    pendulum p = {1.0, 1.0, 9.81};
+    double q[2], v[2];
+    ga_solver *s = NULL;
+    pendulum_state(&p, 1.0, 0.5, q, v);
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, force_maybe_failing, pendulum_constraint,
+                                      pendulum_jacobian, &p),
+                     GA_OK);
+    assert_int_equal(ga_set_tangent_mode(s, mode), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    allocations = 0;
+    armed = 1;
+    long ok = 0;
+    for (int i = 0; i < 200; ++i) {
+        fail_force = with_failures && i % 7 == 3 ? (i % 2 ? -1 : 1) : 0;
+        ok += ga_step(s, 1e-3) == GA_OK;
+    }
+    armed = 0;
+    fail_force = 0;
+    assert_true(ok >= (with_failures ? 170 : 200));
+    ga_free(s);
+    return allocations;
+}
+
+static void counting_works(void **state)
+{
+    (void)state;
+    allocations = 0;
+    armed = 1;
+    void *volatile p = malloc(16); /* the counter must see this one */
+    armed = 0;
+    free(p);
+    assert_int_equal(allocations, 1);
+    /* and it sees the library's own allocations (through operator new and Eigen) */
+    pendulum pd = {1.0, 1.0, 9.81};
+    double q[2] = {0.0, -1.0}, v[2] = {0.0, 0.0};
+    ga_solver *s = NULL;
+    allocations = 0;
+    armed = 1;
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &pd),
+                     GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    armed = 0;
+    printf("  allocations in ga_create + ga_init: %ld\n", allocations);
+    assert_true(allocations > 10);
+    ga_free(s);
+}
+
+static void no_allocation_in_step(void **state)
+{
+    (void)state;
+    assert_int_equal(count_step_allocations(GA_TANGENT_AUTO, 0), 0);
+    assert_int_equal(count_step_allocations(GA_TANGENT_FD, 0), 0);
+    assert_int_equal(count_step_allocations(GA_TANGENT_NEGLECT, 0), 0);
+}
+
+static void no_allocation_in_failing_step(void **state)
+{
+    (void)state;
+    assert_int_equal(count_step_allocations(GA_TANGENT_AUTO, 1), 0);
+}
+
+int main(void)
+{
+    install();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(counting_works),
+        cmocka_unit_test(no_allocation_in_step),
+        cmocka_unit_test(no_allocation_in_failing_step),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

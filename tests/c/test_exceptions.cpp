@@ -1,0 +1,71 @@
+// No C++ exception crosses the C ABI: a callback written in C++ that throws makes the call
+// fail with a status (GA_ERR_INTERNAL, or GA_ERR_NOMEM for std::bad_alloc), the message
+// carries what(), the state is kept, and the solver stays usable.
+#include <cstdarg>
+#include <cstddef>
+#include <cstdint>
+#include <csetjmp>
+extern "C" {
+#include <cmocka.h>
+}
+#include <cstring>
+#include <new>
+#include <stdexcept>
+
+#include <galpha.h>
+
+#include "scenes/pendulum.h"
+
+namespace {
+
+int throw_kind = 0;  // 0: none, 1: std::runtime_error, 2: int, 3: std::bad_alloc
+
+int throwing_force(double t, const double *q, const double *v, double *f, void *user)
+{
+    switch (throw_kind) {
+    case 1: throw std::runtime_error("model exploded");
+    case 2: throw 42;
+    case 3: throw std::bad_alloc();
+    default: return pendulum_force(t, q, v, f, user);
+    }
+}
+
+void exceptions_become_statuses(void **)
+{
+    pendulum p{1.0, 1.0, 9.81};
+    double q[2], v[2];
+    ga_solver *s = nullptr;
+    pendulum_state(&p, 0.5, 0.0, q, v);
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, throwing_force, pendulum_constraint,
+                                      pendulum_jacobian, &p),
+                     GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    assert_int_equal(ga_step(s, 0.01), GA_OK);
+    double before[15], after[15];
+    assert_int_equal(ga_get_state(s, before, 15), GA_OK);
+
+    const ga_status expected[] = {GA_ERR_INTERNAL, GA_ERR_INTERNAL, GA_ERR_NOMEM};
+    const char *message[] = {"model exploded", "unknown type", "out of memory"};
+    for (int k = 1; k <= 3; ++k) {
+        throw_kind = k;
+        assert_int_equal(ga_step(s, 0.01), expected[k - 1]);
+        assert_non_null(std::strstr(ga_last_error(s), message[k - 1]));
+        assert_int_equal(ga_get_state(s, after, 15), GA_OK);
+        assert_memory_equal(before, after, sizeof before);
+    }
+    // an exception during ga_init is caught as well, and the solver is still usable after
+    throw_kind = 1;
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_INTERNAL);
+    throw_kind = 0;
+    assert_int_equal(ga_step(s, 0.01), GA_OK);
+    ga_free(s);
+}
+
+}  // namespace
+
+int main()
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(exceptions_become_statuses)};
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}

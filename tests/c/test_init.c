@@ -1,0 +1,191 @@
+/* Consistent start (ga_init): qdd0 and lambda0 from the saddle-point system, projection of
+ * inconsistent q0 and v0 onto the constraints (minimum-norm corrections), and the finite-
+ * difference constraint acceleration term, including a time-dependent (rheonomic) constraint.
+ * Oracles: closed-form pendulum relations and the geometry of the circle. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <string.h>
+
+#include <galpha.h>
+
+#include "helpers.h"
+
+static ga_solver *make(pendulum *p, int with_accel_callback)
+{
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, p),
+                     GA_OK);
+    if (with_accel_callback)
+        assert_int_equal(ga_set_constraint_accel(s, pendulum_constraint_accel), GA_OK);
+    return s;
+}
+
+/* At theta with rate omega: lambda = m (L^2 omega^2 - g y) / L^2 and the tangential
+ * acceleration -g sin(theta), i.e. the qdd of pendulum_reference at t = 0. */
+static void accelerations_and_multiplier_are_consistent(void **state)
+{
+    (void)state;
+    pendulum p = {2.0, 1.5, 9.81};
+    for (int cb = 0; cb < 2; ++cb) {
+        ga_solver *s = make(&p, cb);
+        double q[2], v[2], qdd[2], lambda, a[2];
+        pendulum_state(&p, 0.8, -1.3, q, v);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        const pendulum_exact ex = pendulum_reference(&p, 0.8, -1.3, 0.0, 1);
+        ga_get_qdd(s, qdd);
+        ga_get_lambda(s, &lambda);
+        ga_get_a(s, a);
+        const double tol = cb ? 1e-12 : 1e-7; /* finite differences: O(eps^(2/3)) */
+        assert_true(max_abs_diff(qdd, ex.qdd, 2) < tol * 10.0);
+        assert_true(fabs(lambda - ex.lambda) < tol * fabs(ex.lambda));
+        assert_memory_equal(a, qdd, sizeof a); /* eq. (3): a_0 = qdd_0 */
+        long long accel = 0;
+        ga_get_counter(s, GA_COUNT_ACCEL_EVALS, &accel);
+        assert_int_equal(accel, 1);
+        ga_free(s);
+    }
+}
+
+/* Minimum-norm projection onto the circle x^2 + y^2 = L^2 is radial: q0 L / |q0|. The
+ * velocity correction removes the radial component of v0. */
+static void inconsistent_positions_and_velocities_are_projected(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = make(&p, 1);
+    double q0[2] = {0.9, -0.7}, v0[2] = {0.4, 0.5}, q[2], v[2];
+    assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+    ga_get_q(s, q);
+    ga_get_v(s, v);
+    const double r = hypot(q0[0], q0[1]);
+    const double expected_q[2] = {q0[0] / r, q0[1] / r};
+    assert_true(max_abs_diff(q, expected_q, 2) < 1e-15);
+    const double vr = v0[0] * expected_q[0] + v0[1] * expected_q[1];
+    const double expected_v[2] = {v0[0] - vr * expected_q[0], v0[1] - vr * expected_q[1]};
+    assert_true(max_abs_diff(v, expected_v, 2) < 1e-15);
+    ga_free(s);
+}
+
+/* Within init_tol the given values are kept as they are, bit for bit. */
+static void consistent_values_are_kept(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = make(&p, 1);
+    double q0[2], v0[2], q[2], v[2];
+    pendulum_state(&p, 0.3, 0.2, q0, v0);
+    assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+    ga_get_q(s, q);
+    ga_get_v(s, v);
+    assert_memory_equal(q, q0, sizeof q);
+    assert_memory_equal(v, v0, sizeof v);
+    ga_free(s);
+}
+
+/* A failed re-initialization keeps the previous state. */
+static void failed_init_keeps_previous_state(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = make(&p, 1);
+    double q0[2], v0[2], q[2], t;
+    pendulum_state(&p, 0.3, 0.2, q0, v0);
+    assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+    assert_int_equal(ga_step(s, 0.01), GA_OK);
+    assert_int_equal(ga_set_init_mode(s, GA_INIT_REFUSE, 1e-10), GA_OK);
+    double bad[2] = {3.0, 0.0};
+    assert_int_equal(ga_init(s, 5.0, bad, v0), GA_ERR_INCONSISTENT);
+    ga_get_t(s, &t);
+    ga_get_q(s, q);
+    assert_true(t == 0.01);
+    assert_true(fabs(q[0] * q[0] + q[1] * q[1] - 1.0) < 1e-14);
+    ga_free(s);
+}
+
+/* Rheonomic pendulum: the rod length follows L(t) = L0 + A sin(w t).
+ * Phi = (x^2 + y^2 - L(t)^2)/2, Phi_t = -L L', Phi_tt = -(L'^2 + L L''), Phi_qt = 0. */
+typedef struct rheonomic {
+    pendulum p;
+    double L0, A, w;
+} rheonomic;
+
+static double rl(const rheonomic *r, double t, int d)
+{
+    const double s = sin(r->w * t), c = cos(r->w * t);
+    return d == 0 ? r->L0 + r->A * s : d == 1 ? r->A * r->w * c : -r->A * r->w * r->w * s;
+}
+static int rh_constraint(double t, const double *q, double *phi, void *u)
+{
+    const rheonomic *r = u;
+    const double L = rl(r, t, 0);
+    phi[0] = 0.5 * (q[0] * q[0] + q[1] * q[1] - L * L);
+    return 0;
+}
+static int rh_jacobian(double t, const double *q, double *J, void *u)
+{
+    return pendulum_jacobian(t, q, J, u);
+}
+static int rh_mass(double t, const double *q, double *M, void *u)
+{
+    return pendulum_mass(t, q, M, &((rheonomic *)u)->p);
+}
+static int rh_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    return pendulum_force(t, q, v, f, &((rheonomic *)u)->p);
+}
+static int rh_accel(double t, const double *q, const double *v, double *out, void *u)
+{
+    const rheonomic *r = u;
+    (void)q;
+    const double L = rl(r, t, 0), Ld = rl(r, t, 1), Ldd = rl(r, t, 2);
+    out[0] = v[0] * v[0] + v[1] * v[1] - (Ld * Ld + L * Ldd);
+    return 0;
+}
+
+static void time_dependent_constraint_start(void **state)
+{
+    (void)state;
+    rheonomic r = {{1.0, 1.0, 9.81}, 1.0, 0.2, 3.0};
+    const double t0 = 0.4;
+    double results[2][5];
+    for (int cb = 0; cb < 2; ++cb) {
+        ga_solver *s = NULL;
+        assert_int_equal(ga_create(2, 1, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, rh_mass, rh_force, rh_constraint, rh_jacobian, &r),
+                         GA_OK);
+        if (cb)
+            assert_int_equal(ga_set_constraint_accel(s, rh_accel), GA_OK);
+        /* position on the circle of radius L(t0), velocity purely tangential: the projection
+         * must add the radial rate L'(t0) (that is what Phi_t brings in) */
+        const double L = rl(&r, t0, 0), th = 0.5;
+        double q[2] = {L * sin(th), -L * cos(th)}, v[2] = {cos(th), sin(th)};
+        assert_int_equal(ga_init(s, t0, q, v), GA_OK);
+        ga_get_v(s, v);
+        const double radial = (v[0] * q[0] + v[1] * q[1]) / L;
+        assert_true(fabs(radial - rl(&r, t0, 1)) < 1e-8);
+        ga_get_qdd(s, results[cb]);
+        ga_get_lambda(s, results[cb] + 2);
+        ga_free(s);
+    }
+    /* finite-difference term (nested differences in t) against the analytic callback */
+    assert_true(fabs(results[0][2] - results[1][2]) < 1e-6 * fabs(results[1][2]));
+    assert_true(max_abs_diff(results[0], results[1], 2) < 1e-5);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(accelerations_and_multiplier_are_consistent),
+        cmocka_unit_test(inconsistent_positions_and_velocities_are_projected),
+        cmocka_unit_test(consistent_values_are_kept),
+        cmocka_unit_test(failed_init_keeps_previous_state),
+        cmocka_unit_test(time_dependent_constraint_start),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
