@@ -49,7 +49,10 @@
  * ## ABI
  * Status values and counter keys are pinned and only ever appended. New options get new setter
  * functions, never new fields in a struct (there are no public structs), which keeps the ABI
- * stable and the bindings for Fortran and ctypes trivial. SONAME: libgalpha.so.GA_VERSION_MAJOR.
+ * stable and the bindings for Fortran and ctypes trivial. Parameters that take one of the enum
+ * values below are declared `int`: a C caller may pass any integer, and an out-of-range value
+ * must be a GA_ERR_ARG, not undefined behaviour in the C++ implementation.
+ * SONAME: libgalpha.so.GA_VERSION_MAJOR.
  */
 #ifndef GALPHA_H
 #define GALPHA_H
@@ -111,8 +114,9 @@ typedef enum ga_status {
                                      by a user callback written in C++ */
 } ga_status;
 
-/** Fixed English name of a status, e.g. "invalid argument". Never NULL. */
-GA_API const char *ga_strerror(ga_status status);
+/** Fixed English name of a status (a ::ga_status value), e.g. "invalid argument"; "unknown
+ *  status" for other values. Never NULL. */
+GA_API const char *ga_strerror(int status);
 
 /* ------------------------------------------------------------------------------------------ */
 /** Opaque solver handle. */
@@ -252,8 +256,9 @@ typedef enum ga_tangent_mode {
  *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
 GA_API ga_status ga_set_tangents(ga_solver *s, ga_stiffness_fn stiffness, ga_damping_fn damping);
 
-/** Choose how K_t and C_t enter the iteration matrix. Errors: GA_ERR_ARG, GA_ERR_STATE. */
-GA_API ga_status ga_set_tangent_mode(ga_solver *s, ga_tangent_mode mode);
+/** Choose how K_t and C_t enter the iteration matrix: mode is a ::ga_tangent_mode.
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_tangent_mode(ga_solver *s, int mode);
 
 /** Switch the scaling (10) of the iteration matrix, D_L = diag(beta h^2 I, I),
  *  D_R = diag(I, I/(beta h^2)), on (1, default) or off (0). Off exists to show why it is on:
@@ -267,8 +272,8 @@ typedef enum ga_predictor {
     GA_PREDICTOR_ZERO = 1        /**< Algorithm 1 verbatim: qdd_{n+1} = 0, lambda_{n+1} = 0 */
 } ga_predictor;
 
-/** Errors: GA_ERR_ARG, GA_ERR_STATE. */
-GA_API ga_status ga_set_predictor(ga_solver *s, ga_predictor predictor);
+/** predictor is a ::ga_predictor. Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_predictor(ga_solver *s, int predictor);
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */
@@ -283,10 +288,10 @@ typedef enum ga_init_mode {
     GA_INIT_REFUSE = 1   /**< refuse inconsistent q0, v0 with GA_ERR_INCONSISTENT */
 } ga_init_mode;
 
-/** What ga_init does with inconsistent q0, v0, and the tolerance init_tol (> 0, default 1e-10,
+/** What ga_init does with inconsistent q0, v0 (mode is a ::ga_init_mode), and the tolerance init_tol (> 0, default 1e-10,
  *  in the units of Phi and of Phi_q v) beyond which they count as inconsistent. Projection
  *  iterates to round-off, well below init_tol. Errors: GA_ERR_ARG, GA_ERR_STATE. */
-GA_API ga_status ga_set_init_mode(ga_solver *s, ga_init_mode mode, double init_tol);
+GA_API ga_status ga_set_init_mode(ga_solver *s, int mode, double init_tol);
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */
@@ -341,8 +346,9 @@ typedef enum ga_counter {
 } ga_counter;
 #define GA_COUNTER_COUNT 12
 
-/** Errors: GA_ERR_ARG (NULL or unknown key), GA_ERR_STATE. */
-GA_API ga_status ga_get_counter(const ga_solver *s, ga_counter key, long long *value);
+/** Value of the counter `key` (a ::ga_counter). Errors: GA_ERR_ARG (NULL or unknown key),
+ *  GA_ERR_STATE. */
+GA_API ga_status ga_get_counter(const ga_solver *s, int key, long long *value);
 /** Set all counters to zero. Errors: GA_ERR_ARG, GA_ERR_STATE. */
 GA_API ga_status ga_reset_counters(ga_solver *s);
 /**@}*/

@@ -78,7 +78,7 @@ GA_API const char *ga_version(void)
 
 GA_API int ga_version_number(void) { return GA_VERSION_NUMBER; }
 
-GA_API const char *ga_strerror(ga_status status)
+GA_API const char *ga_strerror(int status)
 {
     switch (status) {
     case GA_OK: return "success";
@@ -166,12 +166,12 @@ GA_API ga_status ga_set_tangents(ga_solver *s, ga_stiffness_fn stiffness, ga_dam
     });
 }
 
-GA_API ga_status ga_set_tangent_mode(ga_solver *s, ga_tangent_mode mode)
+GA_API ga_status ga_set_tangent_mode(ga_solver *s, int mode)
 {
     return guarded(s, [&](ga::Solver &c) {
         if (mode != GA_TANGENT_AUTO && mode != GA_TANGENT_FD && mode != GA_TANGENT_NEGLECT)
-            return c.diag.fail(GA_ERR_ARG, "unknown tangent mode %d", static_cast<int>(mode));
-        c.model.tangent_mode = mode;
+            return c.diag.fail(GA_ERR_ARG, "unknown tangent mode %d", mode);
+        c.model.tangent_mode = static_cast<ga_tangent_mode>(mode);
         return GA_OK;
     });
 }
@@ -245,25 +245,25 @@ GA_API ga_status ga_set_scaling(ga_solver *s, int on)
     });
 }
 
-GA_API ga_status ga_set_predictor(ga_solver *s, ga_predictor predictor)
+GA_API ga_status ga_set_predictor(ga_solver *s, int predictor)
 {
     return guarded(s, [&](ga::Solver &c) {
         if (predictor != GA_PREDICTOR_CONSTANT_A && predictor != GA_PREDICTOR_ZERO)
-            return c.diag.fail(GA_ERR_ARG, "unknown predictor %d", static_cast<int>(predictor));
-        c.predictor = predictor;
+            return c.diag.fail(GA_ERR_ARG, "unknown predictor %d", predictor);
+        c.predictor = static_cast<ga_predictor>(predictor);
         return GA_OK;
     });
 }
 
-GA_API ga_status ga_set_init_mode(ga_solver *s, ga_init_mode mode, double init_tol)
+GA_API ga_status ga_set_init_mode(ga_solver *s, int mode, double init_tol)
 {
     return guarded(s, [&](ga::Solver &c) {
         if (mode != GA_INIT_PROJECT && mode != GA_INIT_REFUSE)
-            return c.diag.fail(GA_ERR_ARG, "unknown init mode %d", static_cast<int>(mode));
+            return c.diag.fail(GA_ERR_ARG, "unknown init mode %d", mode);
         if (!(init_tol > 0.0 && std::isfinite(init_tol)))
             return c.diag.fail(GA_ERR_ARG, "init_tol = %g must be positive and finite",
                                init_tol);
-        c.init_mode = mode;
+        c.init_mode = static_cast<ga_init_mode>(mode);
         c.init_tol = init_tol;
         return GA_OK;
     });
@@ -380,10 +380,10 @@ GA_API ga_status ga_set_state(ga_solver *s, const double *buf, size_t len)
     });
 }
 
-GA_API ga_status ga_get_counter(const ga_solver *s, ga_counter key, long long *value)
+GA_API ga_status ga_get_counter(const ga_solver *s, int key, long long *value)
 {
     return reading(s, [&](const ga::Solver &c) {
-        if (!value || static_cast<int>(key) < 0 || static_cast<int>(key) >= GA_COUNTER_COUNT)
+        if (!value || key < 0 || key >= GA_COUNTER_COUNT)
             return GA_ERR_ARG;
         *value = c.counters[key];
         return GA_OK;

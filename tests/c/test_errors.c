@@ -193,8 +193,8 @@ static void null_pointers_are_refused(void **state)
     assert_int_equal(ga_get_a(x->s, NULL), GA_ERR_ARG);
     assert_int_equal(ga_get_h_last(x->s, NULL), GA_ERR_ARG);
     assert_int_equal(ga_get_counter(x->s, GA_COUNT_STEPS, NULL), GA_ERR_ARG);
-    assert_int_equal(ga_get_counter(x->s, (ga_counter)99, &c), GA_ERR_ARG);
-    assert_int_equal(ga_get_counter(x->s, (ga_counter)-1, &c), GA_ERR_ARG);
+    assert_int_equal(ga_get_counter(x->s, 99, &c), GA_ERR_ARG);
+    assert_int_equal(ga_get_counter(x->s, -1, &c), GA_ERR_ARG);
     assert_int_equal(ga_get_size(x->s, NULL, &m), GA_ERR_ARG);
     assert_int_equal(ga_get_size(x->s, &n, &m), GA_OK);
     assert_int_equal(ga_state_size(x->s, NULL), GA_ERR_ARG);
@@ -259,9 +259,9 @@ static void bad_options_are_refused(void **state)
     assert_int_equal(ga_set_newton(x->s, NAN, 10), GA_ERR_ARG);
     assert_int_equal(ga_set_newton(x->s, 1e-8, 0), GA_ERR_ARG);
     assert_int_equal(ga_set_scaling(x->s, 2), GA_ERR_ARG);
-    assert_int_equal(ga_set_tangent_mode(x->s, (ga_tangent_mode)7), GA_ERR_ARG);
-    assert_int_equal(ga_set_predictor(x->s, (ga_predictor)7), GA_ERR_ARG);
-    assert_int_equal(ga_set_init_mode(x->s, (ga_init_mode)7, 1e-10), GA_ERR_ARG);
+    assert_int_equal(ga_set_tangent_mode(x->s, 7), GA_ERR_ARG);
+    assert_int_equal(ga_set_predictor(x->s, 7), GA_ERR_ARG);
+    assert_int_equal(ga_set_init_mode(x->s, 7, 1e-10), GA_ERR_ARG);
     assert_int_equal(ga_set_init_mode(x->s, GA_INIT_PROJECT, 0.0), GA_ERR_ARG);
     assert_int_equal(ga_set_init_mode(x->s, GA_INIT_PROJECT, INFINITY), GA_ERR_ARG);
 }
@@ -509,19 +509,14 @@ static void out_of_memory_is_reported(void **state)
     assert_int_equal(ga_init(s, 0.0, &x, &x), GA_ERR_NOMEM);
     expect_message(s, "out of memory");
     ga_free(s);
-    /* sizes whose dense workspace would not even fit in the address space */
-    assert_int_equal(ga_create(INT_MAX / 2, 0, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, pendulum_mass, NULL, NULL, NULL, &p), GA_OK);
-    assert_int_equal(ga_init(s, 0.0, &x, &x), GA_ERR_NOMEM);
-    ga_free(s);
 }
 
 static void strerror_names_every_status(void **state)
 {
     (void)state;
     for (int st = GA_OK; st >= GA_ERR_INTERNAL; --st)
-        assert_string_not_equal(ga_strerror((ga_status)st), "unknown status");
-    assert_string_equal(ga_strerror((ga_status)-99), "unknown status");
+        assert_string_not_equal(ga_strerror(st), "unknown status");
+    assert_string_equal(ga_strerror(-99), "unknown status");
     assert_string_equal(ga_strerror(GA_ERR_NEWTON), "Newton iteration did not converge");
 }
 

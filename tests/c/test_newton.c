@@ -53,7 +53,7 @@ static void reference_step(const step_data *n, double h, const double prm[4], lo
     }
 }
 
-static ga_solver *start(ga_predictor pred, step_data *n)
+static ga_solver *start(int pred, step_data *n)
 {
     ga_solver *s = NULL;
     double buf[6 + 4 * 2 + 1];
@@ -104,7 +104,7 @@ static void step_solution_is_converged_for_every_h(void **state)
             step_data n;
             double prm[4], qdd[2], lambda;
             long long it0, it1;
-            ga_solver *s = start((ga_predictor)pred, &n);
+            ga_solver *s = start(pred, &n);
             ga_get_params(s, &prm[0], &prm[1], &prm[2], &prm[3]);
             ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &it0);
             assert_int_equal(ga_step(s, h), GA_OK);

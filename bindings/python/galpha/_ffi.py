@@ -1,0 +1,136 @@
+"""Low-level ctypes declarations of libgalpha: one Python name per C function, same arguments.
+
+The library is looked for, in order, at
+  1. the path in the environment variable GALPHA_LIBRARY,
+  2. the installed library (pkg-config's libdir for galpha, then ctypes.util.find_library),
+  3. the build tree next to this source tree (build*/libgalpha.so*).
+"""
+import ctypes
+import ctypes.util
+import glob
+import os
+import subprocess
+
+c_double_p = ctypes.POINTER(ctypes.c_double)
+
+# Must match GA_VERSION_MAJOR of the header these declarations were written for.
+ABI_MAJOR = 0
+
+
+def _candidates():
+    env = os.environ.get("GALPHA_LIBRARY")
+    if env:
+        yield "environment variable GALPHA_LIBRARY", env
+        return
+    try:
+        libdir = subprocess.run(["pkg-config", "--variable=libdir", "galpha"], check=True,
+                                capture_output=True, text=True).stdout.strip()
+        if libdir:
+            yield "pkg-config libdir", os.path.join(libdir, "libgalpha.so.%d" % ABI_MAJOR)
+    except (OSError, subprocess.CalledProcessError):
+        pass
+    found = ctypes.util.find_library("galpha")
+    if found:
+        yield "ctypes.util.find_library", found
+    here = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.normpath(os.path.join(here, "..", "..", ".."))
+    for path in sorted(glob.glob(os.path.join(root, "build*", "libgalpha.so.%d" % ABI_MAJOR))):
+        yield "build tree", path
+
+
+def load():
+    tried = []
+    for where, path in _candidates():
+        try:
+            return ctypes.CDLL(path), path
+        except OSError as e:
+            tried.append("%s: %s (%s)" % (where, path, e))
+    raise OSError("libgalpha not found; looked at:\n  " + "\n  ".join(tried or ["nothing"]) +
+                  "\nSet GALPHA_LIBRARY to the full path of libgalpha.so.%d." % ABI_MAJOR)
+
+
+lib, path = load()
+
+# Callback types (void *user last; ctypes passes it through untouched).
+MASS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, ctypes.c_void_p)
+FORCE_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
+                            ctypes.c_void_p)
+CONSTRAINT_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p,
+                                 ctypes.c_void_p)
+JACOBIAN_FN = CONSTRAINT_FN
+STIFFNESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
+                                c_double_p, c_double_p, ctypes.c_void_p)
+DAMPING_FN = FORCE_FN
+CONSTRAINT_ACCEL_FN = FORCE_FN
+
+# Status codes (pinned in galpha.h).
+GA_OK = 0
+GA_ERR_ARG = -1
+GA_ERR_STATE = -2
+GA_ERR_NOMEM = -3
+GA_ERR_CALLBACK = -4
+GA_ERR_CALLBACK_RETRY = -5
+GA_ERR_NONFINITE = -6
+GA_ERR_SINGULAR = -7
+GA_ERR_NEWTON = -8
+GA_ERR_INCONSISTENT = -9
+GA_ERR_INTERNAL = -10
+
+# Enumerations.
+GA_TANGENT_AUTO, GA_TANGENT_FD, GA_TANGENT_NEGLECT = 0, 1, 2
+GA_PREDICTOR_CONSTANT_A, GA_PREDICTOR_ZERO = 0, 1
+GA_INIT_PROJECT, GA_INIT_REFUSE = 0, 1
+COUNTERS = ("steps", "failed_steps", "newton_iters", "factorizations", "residuals",
+            "mass_evals", "force_evals", "constraint_evals", "jacobian_evals",
+            "stiffness_evals", "damping_evals", "accel_evals")
+
+_S = ctypes.c_void_p  # ga_solver *
+_I = ctypes.c_int
+_D = ctypes.c_double
+_P = ctypes.POINTER
+
+_SIGNATURES = {
+    "ga_version": (ctypes.c_char_p, []),
+    "ga_version_number": (_I, []),
+    "ga_strerror": (ctypes.c_char_p, [_I]),
+    "ga_last_error": (ctypes.c_char_p, [_S]),
+    "ga_create": (_I, [_I, _I, _P(_S)]),
+    "ga_free": (None, [_S]),
+    "ga_get_size": (_I, [_S, _P(_I), _P(_I)]),
+    "ga_set_callbacks": (_I, [_S, MASS_FN, FORCE_FN, CONSTRAINT_FN, JACOBIAN_FN, ctypes.c_void_p]),
+    "ga_set_tangents": (_I, [_S, STIFFNESS_FN, DAMPING_FN]),
+    "ga_set_tangent_mode": (_I, [_S, _I]),
+    "ga_set_constraint_accel": (_I, [_S, CONSTRAINT_ACCEL_FN]),
+    "ga_set_rho_inf": (_I, [_S, _D]),
+    "ga_set_params": (_I, [_S, _D, _D, _D, _D]),
+    "ga_get_params": (_I, [_S, _P(_D), _P(_D), _P(_D), _P(_D)]),
+    "ga_set_newton": (_I, [_S, _D, _I]),
+    "ga_set_scaling": (_I, [_S, _I]),
+    "ga_set_predictor": (_I, [_S, _I]),
+    "ga_set_init_mode": (_I, [_S, _I, _D]),
+    "ga_init": (_I, [_S, _D, c_double_p, c_double_p]),
+    "ga_step": (_I, [_S, _D]),
+    "ga_get_t": (_I, [_S, _P(_D)]),
+    "ga_get_h_last": (_I, [_S, _P(_D)]),
+    "ga_get_q": (_I, [_S, c_double_p]),
+    "ga_get_v": (_I, [_S, c_double_p]),
+    "ga_get_qdd": (_I, [_S, c_double_p]),
+    "ga_get_lambda": (_I, [_S, c_double_p]),
+    "ga_get_a": (_I, [_S, c_double_p]),
+    "ga_state_size": (_I, [_S, _P(ctypes.c_size_t)]),
+    "ga_get_state": (_I, [_S, c_double_p, ctypes.c_size_t]),
+    "ga_set_state": (_I, [_S, c_double_p, ctypes.c_size_t]),
+    "ga_get_counter": (_I, [_S, _I, _P(ctypes.c_longlong)]),
+    "ga_reset_counters": (_I, [_S]),
+}
+
+for _name, (_restype, _argtypes) in _SIGNATURES.items():
+    _f = getattr(lib, _name)
+    _f.restype = _restype
+    _f.argtypes = _argtypes
+    globals()[_name] = _f
+
+_major = lib.ga_version_number() // 10000
+if _major != ABI_MAJOR:
+    raise ImportError("%s is galpha %s; these bindings need ABI major %d"
+                      % (path, lib.ga_version().decode(), ABI_MAJOR))
