@@ -193,9 +193,11 @@ GA_API ga_status ga_init(ga_solver *s, double t0, const double *q0, const double
  *  GA_ERR_NEWTON, GA_ERR_INTERNAL. */
 GA_API ga_status ga_step(ga_solver *s, double h);
 
-/** Details of the last error on this solver (which callback, iteration, norm, ...), or "" when
- *  the last call succeeded. The string belongs to the solver and stays valid until its next
- *  call. ga_last_error(NULL) returns a fixed message. */
+/** Details of the last error on this solver: which callback, which Newton iteration of which
+ *  step, which norm. Every call that can change the solver (ga_init, ga_step, ga_set_*,
+ *  ga_reset_counters) clears it when it starts; read-only calls (ga_get_*) leave it, so it can
+ *  be read after inspecting the state. "" when there is nothing to report. The string belongs
+ *  to the solver. ga_last_error(NULL) returns a fixed message. */
 GA_API const char *ga_last_error(const ga_solver *s);
 
 /** Sizes given to ga_create. Errors: GA_ERR_ARG. */

@@ -1,0 +1,24 @@
+# Sourced by the README's commands: installs the Debian packages that are missing (as root),
+# or says which command would (as another user).
+ensure_packages() {
+    local missing=()
+    for p in "$@"; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" ||
+            missing+=("$p")
+    done
+    [ ${#missing[@]} -eq 0 ] && return 0
+    if [ "$(id -u)" -eq 0 ]; then
+        echo "installing: ${missing[*]}"
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+            "${missing[@]}" >/dev/null
+    else
+        echo "missing Debian packages: ${missing[*]}" >&2
+        echo "run: sudo apt-get install -y ${missing[*]}" >&2
+        exit 1
+    fi
+}
+
+BUILD_PACKAGES=(build-essential cmake pkg-config libeigen3-dev liblapack-dev)
+TEST_PACKAGES=(libcmocka-dev python3 python3-numpy python3-pytest binutils)
+JOBS=$(nproc 2>/dev/null || echo 2)
