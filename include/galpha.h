@@ -355,6 +355,24 @@ GA_API ga_status ga_get_counter(const ga_solver *s, int key, long long *value);
 GA_API ga_status ga_reset_counters(ga_solver *s);
 /**@}*/
 
+/** @name Diagnostics of the last step
+ *  Double-valued facts about the most recent Newton solve, for studies and tuning. */
+/**@{*/
+typedef enum ga_info {
+    GA_INFO_RCOND = 0,        /**< reciprocal condition number (LAPACK 1-norm estimate) of the
+                                   iteration matrix factorized last, as solved: scaled by
+                                   eq. (10) or not; 1/value is its condition number */
+    GA_INFO_NEWTON_ITERS = 1, /**< Newton iterations of the last ga_step (accepted or not) */
+    GA_INFO_NEWTON_RATIO = 2  /**< last increment / tolerance ratio of that step's stopping
+                                   test (<= 1 means converged by the relative test) */
+} ga_info;
+#define GA_INFO_COUNT 3
+
+/** Value of the diagnostic `key` (a ::ga_info); 0 before anything was computed.
+ *  Errors: GA_ERR_ARG (NULL or unknown key), GA_ERR_STATE (from a callback). */
+GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value);
+/**@}*/
+
 #ifdef __cplusplus
 } /* extern "C" */
 #endif

@@ -390,6 +390,20 @@ GA_API ga_status ga_get_counter(const ga_solver *s, int key, long long *value)
     });
 }
 
+GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value)
+{
+    return reading(s, [&](const ga::Solver &c) {
+        if (!value)
+            return GA_ERR_ARG;
+        switch (key) {
+        case GA_INFO_RCOND: *value = c.last_rcond(); return GA_OK;
+        case GA_INFO_NEWTON_ITERS: *value = c.last_newton_iters(); return GA_OK;
+        case GA_INFO_NEWTON_RATIO: *value = c.last_newton_ratio(); return GA_OK;
+        default: return GA_ERR_ARG;
+        }
+    });
+}
+
 GA_API ga_status ga_reset_counters(ga_solver *s)
 {
     return guarded(s, [&](ga::Solver &c) {

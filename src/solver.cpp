@@ -112,10 +112,11 @@ ga_status Solver::attempt_step(double h)
 
     const bool tangents = model.uses_tangents();
     convergence_.reset();
+    last_newton_iters_ = 0;
     bool converged = false;
     int iter = 0;
     while (!converged && iter < max_iter) {
-        ++iter;
+        last_newton_iters_ = ++iter;
         ga_status st = model.mass(t1, x.q, M_);
         if (!st)
             st = model.force(t1, x.q, x.v, f_);

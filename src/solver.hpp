@@ -47,6 +47,10 @@ public:
     ga_status init(double t0, const double *q0, const double *v0);  // init.cpp
     ga_status step(double h);
 
+    double last_rcond() const { return S_.rcond(); }
+    int last_newton_iters() const { return last_newton_iters_; }
+    double last_newton_ratio() const { return convergence_.ratio(); }
+
     // Checkpoint: [magic, version, n, m, t, h_last, q, v, qdd, lambda, a].
     std::size_t state_size() const;
     void get_state(double *buf) const;
@@ -61,6 +65,7 @@ private:
     int n_, m_;
     bool initialized_ = false;
     bool workspace_ready_ = false;
+    int last_newton_iters_ = 0;
 
     State accepted_;  // the last accepted step: never touched by a step that fails
     State trial_;     // the step being computed

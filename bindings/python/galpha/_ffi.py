@@ -80,6 +80,7 @@ GA_ERR_INTERNAL = -10
 GA_TANGENT_AUTO, GA_TANGENT_FD, GA_TANGENT_NEGLECT = 0, 1, 2
 GA_PREDICTOR_CONSTANT_A, GA_PREDICTOR_ZERO = 0, 1
 GA_INIT_PROJECT, GA_INIT_REFUSE = 0, 1
+GA_INFO_RCOND, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO = 0, 1, 2
 COUNTERS = ("steps", "failed_steps", "newton_iters", "factorizations", "residuals",
             "mass_evals", "force_evals", "constraint_evals", "jacobian_evals",
             "stiffness_evals", "damping_evals", "accel_evals")
@@ -122,6 +123,7 @@ _SIGNATURES = {
     "ga_set_state": (_I, [_S, c_double_p, ctypes.c_size_t]),
     "ga_get_counter": (_I, [_S, _I, _P(ctypes.c_longlong)]),
     "ga_reset_counters": (_I, [_S]),
+    "ga_get_info": (_I, [_S, _I, _P(_D)]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():
