@@ -26,7 +26,7 @@ int main(void)
     const demo_scene a7 = {"Andrews' mechanism, 7 relative angles (Test Set formulation)",
                            AN7_N, AN7_M, an7_mass, an7_force, an7_constraint, an7_jacobian,
                            NULL, an7_constraint_accel, NULL, andrews_q0, v7, 0.7, h,
-                           andrews_t_end, names7, show7};
+                           andrews_t_end, names7, show7, 0};
     if (demo_run(&a7, q, lam))
         return 1;
     printf("  relative 2-norm error of the 7 angles vs the published reference: %.3e; "
@@ -39,7 +39,7 @@ int main(void)
     const demo_scene a31 = {"Andrews' mechanism, 31 absolute coordinates (paper sec. 5.2)",
                             AN31_N, AN31_M, an31_mass, an31_force, an31_constraint,
                             an31_jacobian, an31_stiffness, an31_constraint_accel, NULL, q31, v31,
-                            0.7, h, andrews_t_end, names31, show31};
+                            0.7, h, andrews_t_end, names31, show31, 0};
     if (demo_run(&a31, q, lam))
         return 1;
     an31_to_angles(q, ang);

@@ -61,6 +61,15 @@ int demo_run(const demo_scene *d, double *q_end, double *lambda_end)
            "residuals %lld, time %.2f ms (%.2f us per step)\n",
            n_steps, iters, (double)iters / (double)n_steps, facts, res, 1e3 * elapsed,
            1e6 * elapsed / (double)n_steps);
+    if (d->full_precision) {
+        printf("final q =");
+        for (int i = 0; i < d->n; ++i)
+            printf(" %.17e", q[i]);
+        printf("\nfinal lambda =");
+        for (int i = 0; i < d->m; ++i)
+            printf(" %.17e", lam[i]);
+        printf("\n");
+    }
     if (q_end)
         for (int i = 0; i < d->n; ++i)
             q_end[i] = q[i];

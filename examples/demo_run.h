@@ -19,6 +19,7 @@ typedef struct demo_scene {
     double rho_inf, h, t_end;
     const char *const *names;       /* names of the coordinates to print (NULL: first ones) */
     const int *show;                /* indices of the coordinates to print, -1 terminated */
+    int full_precision;             /* also print all of q and lambda with 17 digits */
 } demo_scene;
 
 /* Runs the scene; on success copies the final q (n) and lambda (m) out (either may be NULL)

@@ -54,6 +54,7 @@ int main(void)
     printf("  |Phi(q)| = %.2e  steps = %lld  Newton iterations = %lld (%.2f per step)  "
            "CPU = %.3f ms\n",
            fabs(phi[0]), steps, iters, (double)iters / (double)steps, 1e3 * cpu);
+    printf("final q = %.17e %.17e\nfinal lambda = %.17e\n", q[0], q[1], lambda[0]);
     ga_free(s);
     return 0;
 }

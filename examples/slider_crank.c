@@ -15,6 +15,6 @@ int main(void)
     const demo_scene d = {"Slider-crank with spring and mass (Arnold & Bruls 2007, sec. 5.1)",
                           SC_N, SC_M, sc_mass, sc_force, sc_constraint, sc_jacobian,
                           sc_stiffness, sc_constraint_accel, &p, q0, v0, 0.7, 5e-3, 1.0, names,
-                          show};
+                          show, 1};
     return demo_run(&d, NULL, NULL);
 }

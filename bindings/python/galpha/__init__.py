@@ -1,4 +1,23 @@
-"""galpha: the generalized-alpha method for constrained mechanical systems (ctypes bindings)."""
-from . import _ffi  # noqa: F401  (loads the library and checks its version)
+"""galpha: the generalized-alpha method of Arnold & Bruls for constrained mechanical systems
+M(q) q'' = f(q, q', t) - Phi_q^T lambda, Phi(q, t) = 0 -- Python bindings over ctypes.
+
+    import galpha
+    with galpha.Solver(n, m, mass, force, constraint, jacobian, rho_inf=0.9) as s:
+        s.init(0.0, q0, v0)
+        s.step(1e-3)
+        print(s.t, s.q, s.lam, s.stats)
+
+or, for time histories, galpha.integrate(...). The low-level mirror of the C API is
+galpha._ffi (one function per C function)."""
+from . import _ffi
+from ._ffi import (GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_RCOND,  # noqa: F401
+                   GA_INIT_PROJECT, GA_INIT_REFUSE, GA_PREDICTOR_CONSTANT_A, GA_PREDICTOR_ZERO,
+                   GA_TANGENT_AUTO, GA_TANGENT_FD, GA_TANGENT_NEGLECT)
+from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceError,  # noqa: F401
+                     GalphaError, InconsistentError, InternalError, NonFiniteError,
+                     OutOfMemoryError, RecoverableError, SingularMatrixError, StateError)
+from .integrate import IntegrateResult, integrate  # noqa: F401
+from .solver import Solver  # noqa: F401
 
 __version__ = _ffi.lib.ga_version().decode()
+library_path = _ffi.path

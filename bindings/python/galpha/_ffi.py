@@ -2,8 +2,9 @@
 
 The library is looked for, in order, at
   1. the path in the environment variable GALPHA_LIBRARY,
-  2. the installed library (pkg-config's libdir for galpha, then ctypes.util.find_library),
-  3. the build tree next to this source tree (build*/libgalpha.so*).
+  2. the library installed with this package by `cmake --install` (galpha/_install.py),
+  3. the installed library (pkg-config's libdir for galpha, then ctypes.util.find_library),
+  4. the build tree next to this source tree (build*/libgalpha.so*).
 """
 import ctypes
 import ctypes.util
@@ -22,6 +23,13 @@ def _candidates():
     if env:
         yield "environment variable GALPHA_LIBRARY", env
         return
+    here = os.path.dirname(os.path.abspath(__file__))
+    try:  # written by `cmake --install` next to this file: where the library went
+        from ._install import LIBDIR_FROM_PACKAGE
+        yield "install tree", os.path.normpath(os.path.join(
+            here, LIBDIR_FROM_PACKAGE, "libgalpha.so.%d" % ABI_MAJOR))
+    except ImportError:
+        pass
     try:
         libdir = subprocess.run(["pkg-config", "--variable=libdir", "galpha"], check=True,
                                 capture_output=True, text=True).stdout.strip()
@@ -32,7 +40,6 @@ def _candidates():
     found = ctypes.util.find_library("galpha")
     if found:
         yield "ctypes.util.find_library", found
-    here = os.path.dirname(os.path.abspath(__file__))
     root = os.path.normpath(os.path.join(here, "..", "..", ".."))
     for path in sorted(glob.glob(os.path.join(root, "build*", "libgalpha.so.%d" % ABI_MAJOR))):
         yield "build tree", path

@@ -1,0 +1,476 @@
+! galpha for Fortran: module `galpha`.
+!
+! Two layers in one module:
+!  1. bind(C) interfaces to every function of galpha.h, under the C names (ga_create, ga_step,
+!     ...), with the status, counter and option constants;
+!  2. a thin Fortran layer: type(galpha_solver) with type-bound procedures that take
+!     assumed-shape arrays and check their sizes, and galpha_message / galpha_strerror that
+!     return Fortran strings.
+! Callbacks are Fortran procedures with bind(C) and the interfaces ga_mass_fn, ... below
+! (scalars by value, arrays as explicit-shape or assumed-size, `user` as type(c_ptr), value);
+! matrices are column-major, which is Fortran's own order: M(n, n), Phi_q(m, n).
+!
+! Build: gfortran prog.f90 $(pkg-config --cflags --libs galpha)
+module galpha
+  use, intrinsic :: iso_c_binding
+  implicit none
+  private
+
+  ! ---- status codes (ga_status), pinned -------------------------------------------------
+  integer(c_int), parameter, public :: GA_OK = 0, GA_ERR_ARG = -1, GA_ERR_STATE = -2, &
+       GA_ERR_NOMEM = -3, GA_ERR_CALLBACK = -4, GA_ERR_CALLBACK_RETRY = -5, &
+       GA_ERR_NONFINITE = -6, GA_ERR_SINGULAR = -7, GA_ERR_NEWTON = -8, &
+       GA_ERR_INCONSISTENT = -9, GA_ERR_INTERNAL = -10
+  ! ---- options ----------------------------------------------------------------------------
+  integer(c_int), parameter, public :: GA_TANGENT_AUTO = 0, GA_TANGENT_FD = 1, &
+       GA_TANGENT_NEGLECT = 2
+  integer(c_int), parameter, public :: GA_PREDICTOR_CONSTANT_A = 0, GA_PREDICTOR_ZERO = 1
+  integer(c_int), parameter, public :: GA_INIT_PROJECT = 0, GA_INIT_REFUSE = 1
+  integer(c_int), parameter, public :: GA_COUNT_STEPS = 0, GA_COUNT_FAILED_STEPS = 1, &
+       GA_COUNT_NEWTON_ITERS = 2, GA_COUNT_FACTORIZATIONS = 3, GA_COUNT_RESIDUALS = 4, &
+       GA_COUNT_MASS_EVALS = 5, GA_COUNT_FORCE_EVALS = 6, GA_COUNT_CONSTRAINT_EVALS = 7, &
+       GA_COUNT_JACOBIAN_EVALS = 8, GA_COUNT_STIFFNESS_EVALS = 9, &
+       GA_COUNT_DAMPING_EVALS = 10, GA_COUNT_ACCEL_EVALS = 11
+  integer(c_int), parameter, public :: GA_INFO_RCOND = 0, GA_INFO_NEWTON_ITERS = 1, &
+       GA_INFO_NEWTON_RATIO = 2
+
+  ! ---- callback interfaces ----------------------------------------------------------------
+  abstract interface
+     integer(c_int) function ga_mass_fn(t, q, M, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*)
+       real(c_double), intent(out) :: M(*)
+       type(c_ptr), value :: user
+     end function ga_mass_fn
+     integer(c_int) function ga_force_fn(t, q, v, f, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*), v(*)
+       real(c_double), intent(out) :: f(*)
+       type(c_ptr), value :: user
+     end function ga_force_fn
+     integer(c_int) function ga_constraint_fn(t, q, phi, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*)
+       real(c_double), intent(out) :: phi(*)
+       type(c_ptr), value :: user
+     end function ga_constraint_fn
+     integer(c_int) function ga_stiffness_fn(t, q, v, qdd, lambda, K, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*), v(*), qdd(*), lambda(*)
+       real(c_double), intent(out) :: K(*)
+       type(c_ptr), value :: user
+     end function ga_stiffness_fn
+  end interface
+  public :: ga_mass_fn, ga_force_fn, ga_constraint_fn, ga_stiffness_fn
+
+  ! ---- the C API, one to one ----------------------------------------------------------------
+  interface
+     type(c_ptr) function ga_version() bind(C, name="ga_version")
+       import :: c_ptr
+     end function ga_version
+     integer(c_int) function ga_version_number() bind(C, name="ga_version_number")
+       import :: c_int
+     end function ga_version_number
+     type(c_ptr) function ga_strerror(status) bind(C, name="ga_strerror")
+       import :: c_ptr, c_int
+       integer(c_int), value :: status
+     end function ga_strerror
+     type(c_ptr) function ga_last_error(s) bind(C, name="ga_last_error")
+       import :: c_ptr
+       type(c_ptr), value :: s
+     end function ga_last_error
+     integer(c_int) function ga_create(n, m, out) bind(C, name="ga_create")
+       import :: c_int, c_ptr
+       integer(c_int), value :: n, m
+       type(c_ptr), intent(out) :: out
+     end function ga_create
+     subroutine ga_free(s) bind(C, name="ga_free")
+       import :: c_ptr
+       type(c_ptr), value :: s
+     end subroutine ga_free
+     integer(c_int) function ga_get_size(s, n, m) bind(C, name="ga_get_size")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), intent(out) :: n, m
+     end function ga_get_size
+     integer(c_int) function ga_set_callbacks(s, mass, force, constraint, jacobian, user) &
+          bind(C, name="ga_set_callbacks")
+       import :: c_int, c_ptr, c_funptr
+       type(c_ptr), value :: s
+       type(c_funptr), value :: mass, force, constraint, jacobian
+       type(c_ptr), value :: user
+     end function ga_set_callbacks
+     integer(c_int) function ga_set_tangents(s, stiffness, damping) &
+          bind(C, name="ga_set_tangents")
+       import :: c_int, c_ptr, c_funptr
+       type(c_ptr), value :: s
+       type(c_funptr), value :: stiffness, damping
+     end function ga_set_tangents
+     integer(c_int) function ga_set_tangent_mode(s, mode) bind(C, name="ga_set_tangent_mode")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: mode
+     end function ga_set_tangent_mode
+     integer(c_int) function ga_set_constraint_accel(s, fn) &
+          bind(C, name="ga_set_constraint_accel")
+       import :: c_int, c_ptr, c_funptr
+       type(c_ptr), value :: s
+       type(c_funptr), value :: fn
+     end function ga_set_constraint_accel
+     integer(c_int) function ga_set_rho_inf(s, rho_inf) bind(C, name="ga_set_rho_inf")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: rho_inf
+     end function ga_set_rho_inf
+     integer(c_int) function ga_set_params(s, alpha_m, alpha_f, beta, gamma) &
+          bind(C, name="ga_set_params")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: alpha_m, alpha_f, beta, gamma
+     end function ga_set_params
+     integer(c_int) function ga_get_params(s, alpha_m, alpha_f, beta, gamma) &
+          bind(C, name="ga_get_params")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), intent(out) :: alpha_m, alpha_f, beta, gamma
+     end function ga_get_params
+     integer(c_int) function ga_set_newton(s, tol, max_iter) bind(C, name="ga_set_newton")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: tol
+       integer(c_int), value :: max_iter
+     end function ga_set_newton
+     integer(c_int) function ga_set_scaling(s, on) bind(C, name="ga_set_scaling")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: on
+     end function ga_set_scaling
+     integer(c_int) function ga_set_predictor(s, predictor) bind(C, name="ga_set_predictor")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: predictor
+     end function ga_set_predictor
+     integer(c_int) function ga_set_init_mode(s, mode, init_tol) &
+          bind(C, name="ga_set_init_mode")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       integer(c_int), value :: mode
+       real(c_double), value :: init_tol
+     end function ga_set_init_mode
+     integer(c_int) function ga_init(s, t0, q0, v0) bind(C, name="ga_init")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: t0
+       real(c_double), intent(in) :: q0(*), v0(*)
+     end function ga_init
+     integer(c_int) function ga_step(s, h) bind(C, name="ga_step")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: h
+     end function ga_step
+     integer(c_int) function ga_get_t(s, t) bind(C, name="ga_get_t")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), intent(out) :: t
+     end function ga_get_t
+     integer(c_int) function ga_get_h_last(s, h) bind(C, name="ga_get_h_last")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), intent(out) :: h
+     end function ga_get_h_last
+     integer(c_int) function ga_get_q(s, x) bind(C, name="ga_get_q")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), intent(out) :: x(*)
+     end function ga_get_q
+     integer(c_int) function ga_get_v(s, x) bind(C, name="ga_get_v")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), intent(out) :: x(*)
+     end function ga_get_v
+     integer(c_int) function ga_get_qdd(s, x) bind(C, name="ga_get_qdd")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), intent(out) :: x(*)
+     end function ga_get_qdd
+     integer(c_int) function ga_get_lambda(s, x) bind(C, name="ga_get_lambda")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), intent(out) :: x(*)
+     end function ga_get_lambda
+     integer(c_int) function ga_get_a(s, x) bind(C, name="ga_get_a")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), intent(out) :: x(*)
+     end function ga_get_a
+     integer(c_int) function ga_state_size(s, len) bind(C, name="ga_state_size")
+       import :: c_int, c_ptr, c_size_t
+       type(c_ptr), value :: s
+       integer(c_size_t), intent(out) :: len
+     end function ga_state_size
+     integer(c_int) function ga_get_state(s, buf, len) bind(C, name="ga_get_state")
+       import :: c_int, c_ptr, c_double, c_size_t
+       type(c_ptr), value :: s
+       real(c_double), intent(out) :: buf(*)
+       integer(c_size_t), value :: len
+     end function ga_get_state
+     integer(c_int) function ga_set_state(s, buf, len) bind(C, name="ga_set_state")
+       import :: c_int, c_ptr, c_double, c_size_t
+       type(c_ptr), value :: s
+       real(c_double), intent(in) :: buf(*)
+       integer(c_size_t), value :: len
+     end function ga_set_state
+     integer(c_int) function ga_get_counter(s, key, value) bind(C, name="ga_get_counter")
+       import :: c_int, c_ptr, c_long_long
+       type(c_ptr), value :: s
+       integer(c_int), value :: key
+       integer(c_long_long), intent(out) :: value
+     end function ga_get_counter
+     integer(c_int) function ga_reset_counters(s) bind(C, name="ga_reset_counters")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+     end function ga_reset_counters
+     integer(c_int) function ga_get_info(s, key, value) bind(C, name="ga_get_info")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       integer(c_int), value :: key
+       real(c_double), intent(out) :: value
+     end function ga_get_info
+     function c_strlen(p) bind(C, name="strlen")
+       import :: c_ptr, c_size_t
+       type(c_ptr), value :: p
+       integer(c_size_t) :: c_strlen
+     end function c_strlen
+  end interface
+  public :: ga_version, ga_version_number, ga_strerror, ga_last_error, ga_create, ga_free, &
+       ga_get_size, ga_set_callbacks, ga_set_tangents, ga_set_tangent_mode, &
+       ga_set_constraint_accel, ga_set_rho_inf, ga_set_params, ga_get_params, ga_set_newton, &
+       ga_set_scaling, ga_set_predictor, ga_set_init_mode, ga_init, ga_step, ga_get_t, &
+       ga_get_h_last, ga_get_q, ga_get_v, ga_get_qdd, ga_get_lambda, ga_get_a, &
+       ga_state_size, ga_get_state, ga_set_state, ga_get_counter, ga_reset_counters, ga_get_info
+
+  ! ---- the Fortran layer --------------------------------------------------------------------
+  type, public :: galpha_solver
+     type(c_ptr) :: handle = c_null_ptr
+     integer :: n = 0, m = 0
+   contains
+     procedure :: create => solver_create
+     procedure :: free => solver_free
+     procedure, private :: solver_set_callbacks, solver_set_callbacks_funptr
+     !> set_callbacks(mass, force, constraint, jacobian, user): either Fortran procedures with
+     !> exactly the interfaces ga_mass_fn, ... (arrays as assumed-size (*)), or c_funloc() of
+     !> any bind(C) procedures -- the latter lets the model use explicit-shape arrays such as
+     !> M(n, n) and J(m, n).
+     generic :: set_callbacks => solver_set_callbacks, solver_set_callbacks_funptr
+     procedure :: set_tangents => solver_set_tangents
+     procedure :: set_constraint_accel => solver_set_constraint_accel
+     procedure :: set_rho_inf => solver_set_rho_inf
+     procedure :: set_newton => solver_set_newton
+     procedure :: init => solver_init
+     procedure :: step => solver_step
+     procedure :: t => solver_t
+     procedure :: get_q => solver_get_q
+     procedure :: get_v => solver_get_v
+     procedure :: get_qdd => solver_get_qdd
+     procedure :: get_lambda => solver_get_lambda
+     procedure :: counter => solver_counter
+     procedure :: message => solver_message
+  end type galpha_solver
+  public :: galpha_strerror, galpha_version
+
+contains
+
+  ! Fortran string from a NUL-terminated C string.
+  function c_to_f(p) result(s)
+    type(c_ptr), intent(in) :: p
+    character(len=:), allocatable :: s
+    character(kind=c_char), pointer :: chars(:)
+    integer :: i, n
+    if (.not. c_associated(p)) then
+       s = ""
+       return
+    end if
+    n = int(c_strlen(p))
+    call c_f_pointer(p, chars, [n])
+    allocate (character(len=n) :: s)
+    do i = 1, n
+       s(i:i) = chars(i)
+    end do
+  end function c_to_f
+
+  function galpha_strerror(status) result(s)
+    integer(c_int), intent(in) :: status
+    character(len=:), allocatable :: s
+    s = c_to_f(ga_strerror(status))
+  end function galpha_strerror
+
+  function galpha_version() result(s)
+    character(len=:), allocatable :: s
+    s = c_to_f(ga_version())
+  end function galpha_version
+
+  integer(c_int) function solver_create(this, n, m) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer, intent(in) :: n, m
+    status = ga_create(int(n, c_int), int(m, c_int), this%handle)
+    if (status == GA_OK) then
+       this%n = n
+       this%m = m
+    end if
+  end function solver_create
+
+  subroutine solver_free(this)
+    class(galpha_solver), intent(inout) :: this
+    call ga_free(this%handle)
+    this%handle = c_null_ptr
+  end subroutine solver_free
+
+  integer(c_int) function solver_set_callbacks(this, mass, force, constraint, jacobian, user) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    procedure(ga_mass_fn) :: mass
+    procedure(ga_force_fn), optional :: force
+    procedure(ga_constraint_fn), optional :: constraint, jacobian
+    type(c_ptr), intent(in), optional :: user
+    type(c_funptr) :: f, c, j
+    type(c_ptr) :: u
+    f = c_null_funptr
+    c = c_null_funptr
+    j = c_null_funptr
+    u = c_null_ptr
+    if (present(force)) f = c_funloc(force)
+    if (present(constraint)) c = c_funloc(constraint)
+    if (present(jacobian)) j = c_funloc(jacobian)
+    if (present(user)) u = user
+    status = ga_set_callbacks(this%handle, c_funloc(mass), f, c, j, u)
+  end function solver_set_callbacks
+
+  integer(c_int) function solver_set_callbacks_funptr(this, mass, force, constraint, jacobian, &
+       user) result(status)
+    class(galpha_solver), intent(inout) :: this
+    type(c_funptr), intent(in) :: mass, force, constraint, jacobian
+    type(c_ptr), intent(in), optional :: user
+    type(c_ptr) :: u
+    u = c_null_ptr
+    if (present(user)) u = user
+    status = ga_set_callbacks(this%handle, mass, force, constraint, jacobian, u)
+  end function solver_set_callbacks_funptr
+
+  integer(c_int) function solver_set_tangents(this, stiffness, damping) result(status)
+    class(galpha_solver), intent(inout) :: this
+    procedure(ga_stiffness_fn), optional :: stiffness
+    procedure(ga_force_fn), optional :: damping
+    type(c_funptr) :: k, d
+    k = c_null_funptr
+    d = c_null_funptr
+    if (present(stiffness)) k = c_funloc(stiffness)
+    if (present(damping)) d = c_funloc(damping)
+    status = ga_set_tangents(this%handle, k, d)
+  end function solver_set_tangents
+
+  integer(c_int) function solver_set_constraint_accel(this, fn) result(status)
+    class(galpha_solver), intent(inout) :: this
+    procedure(ga_force_fn) :: fn
+    status = ga_set_constraint_accel(this%handle, c_funloc(fn))
+  end function solver_set_constraint_accel
+
+  integer(c_int) function solver_set_rho_inf(this, rho_inf) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: rho_inf
+    status = ga_set_rho_inf(this%handle, rho_inf)
+  end function solver_set_rho_inf
+
+  integer(c_int) function solver_set_newton(this, tol, max_iter) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: tol
+    integer, intent(in) :: max_iter
+    status = ga_set_newton(this%handle, tol, int(max_iter, c_int))
+  end function solver_set_newton
+
+  integer(c_int) function solver_init(this, t0, q0, v0) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t0, q0(:), v0(:)
+    if (size(q0) /= this%n .or. size(v0) /= this%n) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_init(this%handle, t0, q0, v0)
+  end function solver_init
+
+  integer(c_int) function solver_step(this, h) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: h
+    status = ga_step(this%handle, h)
+  end function solver_step
+
+  real(c_double) function solver_t(this) result(t)
+    class(galpha_solver), intent(in) :: this
+    integer(c_int) :: status
+    status = ga_get_t(this%handle, t)
+    if (status /= GA_OK) t = ieee_nan()
+  end function solver_t
+
+  real(c_double) function ieee_nan()
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+    ieee_nan = ieee_value(0.0_c_double, ieee_quiet_nan)
+  end function ieee_nan
+
+  integer(c_int) function copy_out(this, fn, x, expected) result(status)
+    class(galpha_solver), intent(in) :: this
+    interface
+       integer(c_int) function fn(s, x) bind(C)
+         import :: c_int, c_ptr, c_double
+         type(c_ptr), value :: s
+         real(c_double), intent(out) :: x(*)
+       end function fn
+    end interface
+    real(c_double), intent(out) :: x(:)
+    integer, intent(in) :: expected
+    if (size(x) /= expected) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = fn(this%handle, x)
+  end function copy_out
+
+  integer(c_int) function solver_get_q(this, q) result(status)
+    class(galpha_solver), intent(in) :: this
+    real(c_double), intent(out) :: q(:)
+    status = copy_out(this, ga_get_q, q, this%n)
+  end function solver_get_q
+
+  integer(c_int) function solver_get_v(this, v) result(status)
+    class(galpha_solver), intent(in) :: this
+    real(c_double), intent(out) :: v(:)
+    status = copy_out(this, ga_get_v, v, this%n)
+  end function solver_get_v
+
+  integer(c_int) function solver_get_qdd(this, qdd) result(status)
+    class(galpha_solver), intent(in) :: this
+    real(c_double), intent(out) :: qdd(:)
+    status = copy_out(this, ga_get_qdd, qdd, this%n)
+  end function solver_get_qdd
+
+  integer(c_int) function solver_get_lambda(this, lambda) result(status)
+    class(galpha_solver), intent(in) :: this
+    real(c_double), intent(out) :: lambda(:)
+    status = copy_out(this, ga_get_lambda, lambda, this%m)
+  end function solver_get_lambda
+
+  integer(c_long_long) function solver_counter(this, key) result(value)
+    class(galpha_solver), intent(in) :: this
+    integer(c_int), intent(in) :: key
+    if (ga_get_counter(this%handle, key, value) /= GA_OK) value = -1
+  end function solver_counter
+
+  function solver_message(this) result(s)
+    class(galpha_solver), intent(in) :: this
+    character(len=:), allocatable :: s
+    s = c_to_f(ga_last_error(this%handle))
+  end function solver_message
+
+end module galpha

@@ -1,0 +1,259 @@
+"""The Pythonic layer: a Solver object over one ga_solver, callbacks as Python functions on
+numpy arrays.
+
+Callbacks fill their output array in place and return None (or 0) on success, a positive int
+for a recoverable failure (the step is rejected) or a negative int for a fatal one. Their
+array arguments are numpy views of the library's own buffers -- no copies -- so inputs must be
+treated as read-only (they are flagged so) and outputs must not be kept after the call.
+Matrices are seen in their natural shape (M: n x n, Phi_q: m x n); storage underneath is
+column-major, as in the C API.
+
+A Python exception raised inside a callback makes the step fail cleanly (the solver stays at
+its last accepted state) and is re-raised, with its traceback, from the call that stepped.
+"""
+import ctypes
+
+import numpy as np
+
+from . import _ffi
+from .errors import error_for
+
+_vp = ctypes.c_void_p
+_i = ctypes.c_int
+_d = ctypes.c_double
+# Trampoline types: pointers arrive as plain addresses (cheaper than POINTER objects).
+_MASS = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp)
+_FORCE = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp)
+_CONSTRAINT = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp)
+_STIFFNESS = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp)
+
+
+def _cast(fn, ctype):
+    return ctypes.cast(fn, ctype) if fn is not None else ctype()
+
+
+class Solver:
+    """A galpha solver for n coordinates and m constraints.
+
+    Parameters
+    ----------
+    n, m : int
+        Sizes, fixed for the life of the solver.
+    mass(t, q, M), force(t, q, v, f), constraint(t, q, phi), jacobian(t, q, J) : callables
+        The model. `force` may be None (no applied forces); `constraint` and `jacobian` are
+        required when m > 0.
+    stiffness(t, q, v, qdd, lam, K), damping(t, q, v, C), constraint_accel(t, q, v, out)
+        Optional exact tangents and constraint acceleration term (finite differences
+        otherwise).
+    rho_inf, params, newton, tangent_mode, scaling, predictor, init_mode
+        Options, as the C setters (ga_set_rho_inf, ga_set_params((alpha_m, alpha_f, beta,
+        gamma)), ga_set_newton((tol, max_iter)), ...).
+
+    Use as a context manager, or call close(); the handle is also freed by the garbage
+    collector.
+    """
+
+    def __init__(self, n, m, mass, force=None, constraint=None, jacobian=None, *,
+                 stiffness=None, damping=None, constraint_accel=None, rho_inf=None,
+                 params=None, newton=None, tangent_mode=None, scaling=None, predictor=None,
+                 init_mode=None):
+        self._ptr = None
+        self._pending = None          # exception raised inside a callback
+        self._views = {}              # (address, shape, writeable) -> ndarray
+        self.n, self.m = int(n), int(m)
+        handle = ctypes.c_void_p()
+        self._check(_ffi.ga_create(self.n, self.m, ctypes.byref(handle)))
+        self._ptr = handle
+        self._lib = _ffi.lib          # keeps the library alive for __del__ at shutdown
+        self._free = _ffi.ga_free
+        n, m = self.n, self.m
+        v = self._view
+        self._user = {"mass": mass, "force": force, "constraint": constraint,
+                      "jacobian": jacobian, "stiffness": stiffness, "damping": damping,
+                      "constraint_accel": constraint_accel}
+
+        # Trampolines: views of the library's buffers, every exception caught and stored.
+        def call(fn, *args):
+            if self._pending is not None:
+                return -1
+            try:
+                rc = fn(*args)
+                return 0 if rc is None else int(rc)
+            except BaseException as e:  # re-raised by the call that stepped
+                self._pending = e
+                return -1
+
+        self._cbs = [
+            _MASS(lambda t, q, M, u: call(mass, t, v(q, (n,)), v(M, (n, n), True))),
+            _FORCE(lambda t, q, qd, f, u: call(force, t, v(q, (n,)), v(qd, (n,)),
+                                               v(f, (n,), True))) if force else None,
+            _CONSTRAINT(lambda t, q, p, u: call(constraint, t, v(q, (n,)),
+                                                v(p, (m,), True))) if m and constraint else None,
+            _CONSTRAINT(lambda t, q, J, u: call(jacobian, t, v(q, (n,)),
+                                                v(J, (m, n), True))) if m and jacobian else None,
+            _STIFFNESS(lambda t, q, qd, a, lam, K, u: call(
+                stiffness, t, v(q, (n,)), v(qd, (n,)), v(a, (n,)), v(lam, (m,)),
+                v(K, (n, n), True))) if stiffness else None,
+            _FORCE(lambda t, q, qd, C, u: call(damping, t, v(q, (n,)), v(qd, (n,)),
+                                               v(C, (n, n), True))) if damping else None,
+            _FORCE(lambda t, q, qd, o, u: call(constraint_accel, t, v(q, (n,)), v(qd, (n,)),
+                                               v(o, (m,), True))) if constraint_accel else None,
+        ]
+        mc, fc, cc, jc, kc, dc, ac = self._cbs
+        self._check(_ffi.ga_set_callbacks(self._ptr, _cast(mc, _ffi.MASS_FN),
+                                          _cast(fc, _ffi.FORCE_FN),
+                                          _cast(cc, _ffi.CONSTRAINT_FN),
+                                          _cast(jc, _ffi.JACOBIAN_FN), None))
+        if kc or dc:
+            self._check(_ffi.ga_set_tangents(self._ptr, _cast(kc, _ffi.STIFFNESS_FN),
+                                             _cast(dc, _ffi.DAMPING_FN)))
+        if ac:
+            self._check(_ffi.ga_set_constraint_accel(self._ptr,
+                                                     _cast(ac, _ffi.CONSTRAINT_ACCEL_FN)))
+        if rho_inf is not None:
+            self.set_rho_inf(rho_inf)
+        if params is not None:
+            self.set_params(*params)
+        if newton is not None:
+            self.set_newton(*newton)
+        if tangent_mode is not None:
+            self._check(_ffi.ga_set_tangent_mode(self._ptr, int(tangent_mode)))
+        if scaling is not None:
+            self._check(_ffi.ga_set_scaling(self._ptr, int(bool(scaling))))
+        if predictor is not None:
+            self._check(_ffi.ga_set_predictor(self._ptr, int(predictor)))
+        if init_mode is not None:
+            self._check(_ffi.ga_set_init_mode(self._ptr, int(init_mode[0]), float(init_mode[1])))
+
+    # ---- plumbing ---------------------------------------------------------------------------
+    def _view(self, address, shape, writeable=False):
+        key = (address, shape, writeable)
+        arr = self._views.get(key)
+        if arr is None:
+            size = int(np.prod(shape))
+            buf = (ctypes.c_double * max(size, 1)).from_address(address)
+            flat = np.ctypeslib.as_array(buf)[:size]
+            # column-major storage seen with its natural (rows, cols) shape
+            arr = flat.reshape(shape[::-1]).T if len(shape) == 2 else flat
+            arr.flags.writeable = writeable
+            self._views[key] = arr
+        return arr
+
+    def _check(self, status):
+        pending, self._pending = self._pending, None
+        if pending is not None:
+            raise pending.with_traceback(pending.__traceback__)
+        if status != _ffi.GA_OK:
+            message = _ffi.ga_last_error(self._ptr).decode() if self._ptr else ""
+            raise error_for(status, message)
+
+    def _handle(self):
+        if self._ptr is None:
+            raise error_for(_ffi.GA_ERR_STATE, "solver is closed")
+        return self._ptr
+
+    @staticmethod
+    def _dp(a):
+        return a.ctypes.data_as(_ffi.c_double_p)
+
+    def _get(self, fn, size):
+        out = np.empty(max(size, 1))
+        self._check(fn(self._handle(), self._dp(out)))
+        return out[:size]
+
+    # ---- life cycle -------------------------------------------------------------------------
+    def close(self):
+        """Free the C solver (idempotent)."""
+        if self._ptr is not None:
+            self._free(self._ptr)
+            self._ptr = None
+        self._views.clear()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: modules may already be gone
+            pass
+
+    # ---- options ----------------------------------------------------------------------------
+    def set_rho_inf(self, rho_inf):
+        self._check(_ffi.ga_set_rho_inf(self._handle(), float(rho_inf)))
+
+    def set_params(self, alpha_m, alpha_f, beta, gamma):
+        self._check(_ffi.ga_set_params(self._handle(), alpha_m, alpha_f, beta, gamma))
+
+    def set_newton(self, tol, max_iter=20):
+        self._check(_ffi.ga_set_newton(self._handle(), float(tol), int(max_iter)))
+
+    @property
+    def params(self):
+        """(alpha_m, alpha_f, beta, gamma)"""
+        vals = [ctypes.c_double() for _ in range(4)]
+        self._check(_ffi.ga_get_params(self._handle(), *[ctypes.byref(x) for x in vals]))
+        return tuple(x.value for x in vals)
+
+    # ---- stepping ---------------------------------------------------------------------------
+    def init(self, t0, q0, v0):
+        """Consistent initial values at t0 (see ga_init)."""
+        q0 = np.ascontiguousarray(q0, dtype=float)
+        v0 = np.ascontiguousarray(v0, dtype=float)
+        if q0.shape != (self.n,) or v0.shape != (self.n,):
+            raise error_for(_ffi.GA_ERR_ARG, "q0 and v0 must have shape (%d,)" % self.n)
+        self._check(_ffi.ga_init(self._handle(), float(t0), self._dp(q0), self._dp(v0)))
+
+    def step(self, h):
+        """One step of size h. On failure raises; the state stays at the last accepted step."""
+        self._check(_ffi.ga_step(self._handle(), float(h)))
+
+    # ---- state ------------------------------------------------------------------------------
+    @property
+    def t(self):
+        x = ctypes.c_double()
+        self._check(_ffi.ga_get_t(self._handle(), ctypes.byref(x)))
+        return x.value
+
+    @property
+    def h_last(self):
+        x = ctypes.c_double()
+        self._check(_ffi.ga_get_h_last(self._handle(), ctypes.byref(x)))
+        return x.value
+
+    q = property(lambda self: self._get(_ffi.ga_get_q, self.n), doc="positions (copy)")
+    v = property(lambda self: self._get(_ffi.ga_get_v, self.n), doc="velocities (copy)")
+    qdd = property(lambda self: self._get(_ffi.ga_get_qdd, self.n), doc="accelerations (copy)")
+    lam = property(lambda self: self._get(_ffi.ga_get_lambda, self.m), doc="multipliers (copy)")
+    a = property(lambda self: self._get(_ffi.ga_get_a, self.n), doc="auxiliary vector a (copy)")
+
+    @property
+    def stats(self):
+        """Work counters as a dict (steps, failed_steps, newton_iters, factorizations, ...)."""
+        out = {}
+        for key, name in enumerate(_ffi.COUNTERS):
+            x = ctypes.c_longlong()
+            self._check(_ffi.ga_get_counter(self._handle(), key, ctypes.byref(x)))
+            out[name] = x.value
+        return out
+
+    def info(self, key):
+        x = ctypes.c_double()
+        self._check(_ffi.ga_get_info(self._handle(), int(key), ctypes.byref(x)))
+        return x.value
+
+    def get_state(self):
+        """Checkpoint: the full state as a flat float array (see ga_get_state)."""
+        size = ctypes.c_size_t()
+        self._check(_ffi.ga_state_size(self._handle(), ctypes.byref(size)))
+        out = np.empty(size.value)
+        self._check(_ffi.ga_get_state(self._handle(), self._dp(out), size.value))
+        return out
+
+    def set_state(self, state):
+        state = np.ascontiguousarray(state, dtype=float)
+        self._check(_ffi.ga_set_state(self._handle(), self._dp(state), state.size))

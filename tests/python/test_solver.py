@@ -1,0 +1,168 @@
+"""The Pythonic layer: Solver, integrate, exceptions, checkpoints."""
+import math
+import os
+import sys
+
+import numpy as np
+import pytest
+
+if "GALPHA_PYTHON_INSTALLED" not in os.environ:  # else: the package comes from PYTHONPATH
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "bindings", "python"))
+import galpha  # noqa: E402
+
+G = 9.81
+
+
+def mass(t, q, M):
+    M[:] = np.eye(2)
+
+
+def force(t, q, v, f):
+    f[:] = (0.0, -G)
+
+
+def constraint(t, q, phi):
+    phi[0] = 0.5 * (q @ q - 1.0)
+
+
+def jacobian(t, q, J):
+    J[0, :] = q
+
+
+def pendulum(**kw):
+    return galpha.Solver(2, 1, mass, force, constraint, jacobian, **kw)
+
+
+Q0 = np.array([math.sin(1.0), -math.cos(1.0)])
+V0 = np.zeros(2)
+
+
+def test_library_found_and_versioned():
+    assert galpha.__version__.count(".") == 2
+    assert os.path.exists(galpha.library_path) or "/" not in galpha.library_path
+
+
+def test_solver_steps_and_properties():
+    with pendulum(rho_inf=0.7, newton=(1e-12, 20)) as s:
+        assert s.params == pytest.approx((4 / 17, 7 / 17, 100 / 289, 23 / 34), rel=1e-14)
+        s.init(0.0, Q0, V0)
+        # consistent start: lambda0 = m (|v|^2 - g y)/L^2 at rest
+        assert s.lam[0] == pytest.approx(-G * Q0[1], rel=1e-12)
+        for _ in range(100):
+            s.step(1e-3)
+        assert s.t == pytest.approx(0.1)
+        assert abs(s.q @ s.q - 1.0) < 1e-14
+        st = s.stats
+        assert st["steps"] == 100 and st["newton_iters"] >= 100
+        assert s.h_last == 1e-3
+        assert s.info(galpha.GA_INFO_RCOND) > 0
+
+
+def test_callback_exception_is_reraised_and_solver_stays_usable():
+    def bad_force(t, q, v, f):
+        if t > 0.0045:
+            raise ZeroDivisionError("boom in the model")
+        f[:] = (0.0, -G)
+
+    with galpha.Solver(2, 1, mass, bad_force, constraint, jacobian) as s:
+        s.init(0.0, Q0, V0)
+        s.step(1e-3)
+        before = s.get_state()
+        with pytest.raises(ZeroDivisionError, match="boom in the model") as info:
+            for _ in range(10):
+                s.step(1e-3)
+        # the traceback reaches into the callback
+        assert any(tb.name == "bad_force" for tb in info.traceback)
+        after_failure = s.get_state()
+        assert after_failure[4] == pytest.approx(0.004)  # steps up to the failure were kept
+        assert after_failure[4] > before[4]
+        with pytest.raises(ZeroDivisionError):  # the same step fails again, cleanly
+            s.step(1e-3)
+        s.step(4e-4)  # usable after: a step that stays below the fault succeeds
+        assert s.stats["failed_steps"] == 2
+
+
+def test_status_maps_to_exception_classes():
+    def retry_force(t, q, v, f):
+        f[:] = (0.0, -G)
+        return 1 if t > 0 else 0  # recoverable failure in every step
+
+    with galpha.Solver(2, 1, mass, retry_force, constraint, jacobian) as s:
+        s.init(0.0, Q0, V0)
+        state = s.get_state()
+        with pytest.raises(galpha.CallbackRetry) as e:
+            s.step(1e-3)
+        assert isinstance(e.value, galpha.RecoverableError)
+        assert "force callback returned 1" in str(e.value)
+        assert np.array_equal(s.get_state(), state)
+    with pendulum() as s:
+        with pytest.raises(galpha.StateError):
+            s.step(1e-3)
+        with pytest.raises(galpha.ArgumentError, match="outside"):
+            s.set_rho_inf(2.0)
+        with pytest.raises(galpha.ArgumentError, match="zero-stable"):
+            s.set_params(0.6, 0.7, 0.5, 0.6)
+        s.init(0.0, Q0, V0)
+        s.set_newton(1e-10, 1)
+        with pytest.raises(galpha.ConvergenceError):
+            s.step(1e-2)
+    with pendulum(init_mode=(galpha.GA_INIT_REFUSE, 1e-10)) as s:
+        with pytest.raises(galpha.InconsistentError):
+            s.init(0.0, [0.3, -1.0], V0)
+    s = pendulum()
+    s.close()
+    with pytest.raises(galpha.StateError):
+        s.step(1e-3)
+    s.close()  # idempotent
+
+
+def test_input_views_are_read_only():
+    def sneaky_mass(t, q, M):
+        q[0] = 0.0
+
+    with galpha.Solver(2, 1, sneaky_mass, force, constraint, jacobian) as s:
+        with pytest.raises(ValueError, match="read-only"):
+            s.init(0.0, Q0, V0)
+
+
+def test_checkpoint_restart_is_bit_identical():
+    with pendulum() as a, pendulum() as b:
+        a.init(0.0, Q0, V0)
+        for _ in range(50):
+            a.step(2e-3)
+        ckpt = a.get_state()
+        for _ in range(50):
+            a.step(2e-3)
+        b.set_state(ckpt)
+        for _ in range(50):
+            b.step(2e-3)
+        assert np.array_equal(a.get_state(), b.get_state())
+
+
+def test_integrate_returns_histories():
+    sol = galpha.integrate(mass, force, constraint, jacobian, (0.0, 0.5), Q0, V0, 0.003, m=1,
+                           rho_inf=0.8)
+    assert sol.success and sol.status == 0
+    assert sol.t[0] == 0.0 and sol.t[-1] == pytest.approx(0.5, abs=1e-14)
+    assert sol.q.shape == (len(sol.t), 2) and sol.lam.shape == (len(sol.t), 1)
+    assert np.allclose(np.einsum("ij,ij->i", sol.q, sol.q), 1.0, atol=1e-13)
+    assert sol.stats["steps"] == len(sol.t) - 1
+
+
+def test_integrate_reports_method_failure():
+    sol = galpha.integrate(mass, force, constraint, jacobian, (0.0, 0.1), Q0, V0, 0.01, m=1,
+                           newton=(1e-10, 1))
+    assert not sol.success and sol.status == galpha._ffi.GA_ERR_NEWTON
+    assert "did not converge" in sol.message and len(sol.t) == 1
+
+
+def test_unconstrained_oscillator():
+    def m1(t, q, M):
+        M[0, 0] = 1.0
+
+    def f1(t, q, v, f):
+        f[0] = -q[0]
+
+    sol = galpha.integrate(m1, f1, None, None, (0.0, 1.0), [1.0], [0.0], 1e-3)
+    assert sol.q[-1, 0] == pytest.approx(math.cos(1.0), abs=1e-6)
+    assert sol.lam.shape == (len(sol.t), 0)
