@@ -5,8 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/deps.sh
 ensure_packages "${BUILD_PACKAGES[@]}" python3 python3-numpy python3-matplotlib
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j "$JOBS" --target paper_studies >/dev/null
+cmake -S . -B build-demo -DCMAKE_BUILD_TYPE=Release -DGALPHA_BUILD_TESTS=OFF >/dev/null
+cmake --build build-demo -j "$JOBS" --target paper_studies >/dev/null
 mkdir -p docs/paper
-./build/bench/paper_studies docs/paper "$@"
+./build-demo/bench/paper_studies docs/paper "$@"
 /usr/bin/python3 scripts/plot_studies.py docs/paper

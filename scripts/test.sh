@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # The README's test command: installs what is missing (as root), then builds galpha twice --
 # release with warnings as errors, and AddressSanitizer + UndefinedBehaviorSanitizer -- and
-# runs the whole ctest suite (C, Python, install/consumer, ABI) in both.
+# runs the whole ctest suite (C, Python, Fortran, install/consumers, ABI) in both.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/deps.sh
 ensure_packages "${BUILD_PACKAGES[@]}" "${TEST_PACKAGES[@]}"
 
-common=(-DGALPHA_WERROR=ON -DPython3_EXECUTABLE=/usr/bin/python3 -DGALPHA_REQUIRE_PYTHON=ON)
+common=(-DGALPHA_WERROR=ON -DPython3_EXECUTABLE=/usr/bin/python3 -DGALPHA_REQUIRE_PYTHON=ON
+        -DGALPHA_REQUIRE_FORTRAN=ON)
 run_suite() {
     local dir=$1; shift
     echo "=== $dir: $*"

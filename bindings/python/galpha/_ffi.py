@@ -41,8 +41,22 @@ def _candidates():
     if found:
         yield "ctypes.util.find_library", found
     root = os.path.normpath(os.path.join(here, "..", "..", ".."))
-    for path in sorted(glob.glob(os.path.join(root, "build*", "libgalpha.so.%d" % ABI_MAJOR))):
+    builds = sorted(glob.glob(os.path.join(root, "build*", "libgalpha.so.%d" % ABI_MAJOR)),
+                    key=lambda p: (os.path.basename(os.path.dirname(p)) != "build", p))
+    asan_loaded = "libasan" in os.environ.get("LD_PRELOAD", "")
+    for path in builds:
+        # a sanitizer build aborts a process that did not preload its runtime: skip it
+        if not asan_loaded and _needs_asan(path):
+            continue
         yield "build tree", path
+
+
+def _needs_asan(path):
+    try:
+        with open(path, "rb") as f:
+            return b"libasan.so" in f.read()
+    except OSError:
+        return False
 
 
 def load():

@@ -1,0 +1,40 @@
+"""The same scene in C, Fortran and Python gives the same numbers (to round-off).
+
+Usage: cross_language.py BIN_DIR PY_EXAMPLES_DIR  (ctest passes both)."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+bin_dir, py_dir = sys.argv[1], sys.argv[2]
+SCENES = {
+    "pendulum": [[os.path.join(bin_dir, "pendulum_demo")],
+                 [os.path.join(bin_dir, "pendulum_fortran")],
+                 [sys.executable, os.path.join(py_dir, "pendulum.py")]],
+    "slider_crank": [[os.path.join(bin_dir, "slider_crank_demo")],
+                     [os.path.join(bin_dir, "slider_crank_fortran")],
+                     [sys.executable, os.path.join(py_dir, "slider_crank.py")]],
+}
+LANGS = ("C", "Fortran", "Python")
+
+
+def final_state(cmd):
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    values = {}
+    for line in out.splitlines():
+        for key in ("final q =", "final lambda ="):
+            if line.startswith(key):
+                values[key] = np.array([float(x) for x in line[len(key):].split()])
+    return np.concatenate([values["final q ="], values["final lambda ="]])
+
+
+ok = True
+for scene, commands in SCENES.items():
+    results = [final_state(cmd) for cmd in commands]
+    for lang, r in zip(LANGS[1:], results[1:]):
+        diff = np.max(np.abs(r - results[0]) / np.maximum(np.abs(results[0]), 1e-300))
+        print("%-13s %-8s vs C: %d values, max relative difference %.1e" % (scene, lang, r.size,
+                                                                          diff))
+        ok = ok and r.size == results[0].size and diff <= 1e-12
+sys.exit(0 if ok else 1)
