@@ -301,12 +301,20 @@ GA_API ga_status ga_set_init_mode(ga_solver *s, int mode, double init_tol);
  *  Copies of the current (last accepted) state. Errors: GA_ERR_ARG (NULL), GA_ERR_STATE
  *  (before ga_init, or from a callback). */
 /**@{*/
+/** Time t of the last accepted step (t0 after ga_init). */
 GA_API ga_status ga_get_t(const ga_solver *s, double *t);
-GA_API ga_status ga_get_q(const ga_solver *s, double *q);           /**< length n */
-GA_API ga_status ga_get_v(const ga_solver *s, double *v);           /**< length n */
-GA_API ga_status ga_get_qdd(const ga_solver *s, double *qdd);       /**< length n */
-GA_API ga_status ga_get_lambda(const ga_solver *s, double *lambda); /**< length m */
-GA_API ga_status ga_get_a(const ga_solver *s, double *a); /**< auxiliary vector a, length n */
+/** Copy the positions q (n doubles, caller's buffer). */
+GA_API ga_status ga_get_q(const ga_solver *s, double *q);
+/** Copy the velocities q' (n doubles). */
+GA_API ga_status ga_get_v(const ga_solver *s, double *v);
+/** Copy the accelerations q'' (n doubles): second order accurate (the residual is not
+ *  weighted), unlike the auxiliary vector a. */
+GA_API ga_status ga_get_qdd(const ga_solver *s, double *qdd);
+/** Copy the Lagrange multipliers lambda (m doubles; with the sign convention
+ *  M q'' = f - Phi_q^T lambda). With m = 0, lambda may be NULL. */
+GA_API ga_status ga_get_lambda(const ga_solver *s, double *lambda);
+/** Copy the auxiliary acceleration-like vector a of eq. (3) (n doubles). */
+GA_API ga_status ga_get_a(const ga_solver *s, double *a);
 /** Size of the last accepted step (0 before the first). */
 GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
 /**@}*/
