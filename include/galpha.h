@@ -267,6 +267,26 @@ GA_API ga_status ga_set_tangent_mode(ga_solver *s, int mode);
  *  without it the condition number grows like h^-4. Errors: GA_ERR_ARG, GA_ERR_STATE. */
 GA_API ga_status ga_set_scaling(ga_solver *s, int on);
 
+/** Reuse of the factorized iteration matrix (and of the tangents in it). */
+typedef enum ga_reuse_mode {
+    GA_REUSE_AUTO = 0, /**< modified Newton (default): keep the factorization across iterations
+                            and steps; rebuild it when there is none yet, when h changed by more
+                            than the factor 5/3 in h^2 since it was built (IDA's band), when the
+                            iteration contracts slower than 0.5 per iteration, and after any
+                            failed step. A step that fails to converge with an old matrix is
+                            retried once with a fresh one before GA_ERR_NEWTON is reported. */
+    GA_REUSE_NEVER = 1 /**< full Newton as printed in Algorithm 1: tangents and factorization
+                            at every iteration */
+} ga_reuse_mode;
+
+/** mode is a ::ga_reuse_mode. Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_jacobian_reuse(ga_solver *s, int mode);
+
+/** Declare the mass matrix constant (1) or not (0, default): with 1, M is evaluated once (at
+ *  ga_init or ga_set_state, and after an option changes) and its derivative is dropped from
+ *  finite-difference tangents. Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_constant_mass(ga_solver *s, int on);
+
 /** Newton predictor. Both converge to the same step solution (to the Newton tolerance). */
 typedef enum ga_predictor {
     GA_PREDICTOR_CONSTANT_A = 0, /**< a_{n+1} = a_n, lambda_{n+1} = lambda_n (default): an O(h)
@@ -276,6 +296,51 @@ typedef enum ga_predictor {
 
 /** predictor is a ::ga_predictor. Errors: GA_ERR_ARG, GA_ERR_STATE. */
 GA_API ga_status ga_set_predictor(ga_solver *s, int predictor);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
+/** @name Large models: sparsity patterns and the linear solver
+ *
+ *  By default every matrix is dense and its callback fills it column-major. After
+ *  ga_set_pattern(s, which, nnz, rows, cols), the callback of that matrix instead writes nnz
+ *  values, one per declared entry, in the declared order (entries repeated in the pattern add
+ *  up). nnz = 0 declares the matrix identically zero: it is never evaluated (e.g. C_t when the
+ *  forces do not depend on the velocities). With patterns for M and Phi_q (and for K_t and C_t
+ *  unless neglected), the iteration matrix can be assembled and factorized as a sparse matrix
+ *  (SuiteSparse KLU): no dense n x n object exists then, and the cost per step grows linearly
+ *  with the size for mechanism-like sparsity. Finite-difference tangents with a declared pattern
+ *  perturb structurally independent columns together (Curtis-Powell-Reid).
+ *  Patterns are declared before ga_init / ga_set_state and copied; indices are 0-based. */
+/**@{*/
+typedef enum ga_matrix {
+    GA_MATRIX_MASS = 0,      /**< M, n x n */
+    GA_MATRIX_JACOBIAN = 1,  /**< Phi_q, m x n */
+    GA_MATRIX_STIFFNESS = 2, /**< K_t, n x n */
+    GA_MATRIX_DAMPING = 3    /**< C_t, n x n */
+} ga_matrix;
+
+/** Declare the pattern of matrix `which` (a ::ga_matrix): nnz >= 0 entries (rows[k], cols[k]).
+ *  Errors: GA_ERR_ARG (unknown matrix, NULL arrays with nnz > 0, index out of range, a
+ *  Jacobian pattern with m = 0), GA_ERR_STATE (after ga_init or ga_set_state). */
+GA_API ga_status ga_set_pattern(ga_solver *s, int which, int nnz, const int *rows,
+                                const int *cols);
+
+typedef enum ga_linear_solver {
+    GA_LINEAR_AUTO = 0,         /**< sparse when the patterns allow it and n + m >= 200,
+                                     dense otherwise (default) */
+    GA_LINEAR_DENSE = 1,        /**< dense LU, the faster implementation for the size */
+    GA_LINEAR_SPARSE = 2,       /**< sparse LU (KLU); needs the patterns */
+    GA_LINEAR_DENSE_LAPACK = 3, /**< dense LU by LAPACK dgetrf/dgetrs */
+    GA_LINEAR_DENSE_EIGEN = 4   /**< dense LU by Eigen's PartialPivLU */
+} ga_linear_solver;
+
+/** Choose the linear algebra (a ::ga_linear_solver) before ga_init / ga_set_state.
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_linear_solver(ga_solver *s, int solver);
+
+/** Name of the linear algebra in use ("dense Eigen LU", "dense LAPACK LU", "sparse KLU"), or
+ *  "none" before ga_init. Static string; never NULL. */
+GA_API const char *ga_linear_solver_name(const ga_solver *s);
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */

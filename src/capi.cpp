@@ -153,6 +153,7 @@ GA_API ga_status ga_set_callbacks(ga_solver *s, ga_mass_fn mass, ga_force_fn for
         c.model.cb.constraint = c.m() > 0 ? constraint : nullptr;
         c.model.cb.jacobian = c.m() > 0 ? jacobian : nullptr;
         c.model.cb.user = user;
+        c.invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -162,6 +163,7 @@ GA_API ga_status ga_set_tangents(ga_solver *s, ga_stiffness_fn stiffness, ga_dam
     return guarded(s, [&](ga::Solver &c) {
         c.model.cb.stiffness = stiffness;
         c.model.cb.damping = damping;
+        c.invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -172,6 +174,7 @@ GA_API ga_status ga_set_tangent_mode(ga_solver *s, int mode)
         if (mode != GA_TANGENT_AUTO && mode != GA_TANGENT_FD && mode != GA_TANGENT_NEGLECT)
             return c.diag.fail(GA_ERR_ARG, "unknown tangent mode %d", mode);
         c.model.tangent_mode = static_cast<ga_tangent_mode>(mode);
+        c.invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -190,6 +193,7 @@ GA_API ga_status ga_set_rho_inf(ga_solver *s, double rho_inf)
         if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
             return c.diag.fail(GA_ERR_ARG, "rho_inf = %g is outside [0, 1]", rho_inf);
         c.params = ga::params_from_rho_inf(rho_inf);
+        c.invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -202,6 +206,7 @@ GA_API ga_status ga_set_params(ga_solver *s, double alpha_m, double alpha_f, dou
         if (const char *why = ga::check_params(p))
             return c.diag.fail(GA_ERR_ARG, "parameters refused: %s", why);
         c.params = p;
+        c.invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -241,8 +246,72 @@ GA_API ga_status ga_set_scaling(ga_solver *s, int on)
         if (on != 0 && on != 1)
             return c.diag.fail(GA_ERR_ARG, "scaling must be 0 or 1, got %d", on);
         c.scaling = on == 1;
+        c.invalidate_jacobian();
         return GA_OK;
     });
+}
+
+GA_API ga_status ga_set_jacobian_reuse(ga_solver *s, int mode)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (mode != GA_REUSE_AUTO && mode != GA_REUSE_NEVER)
+            return c.diag.fail(GA_ERR_ARG, "unknown reuse mode %d", mode);
+        c.reuse = static_cast<ga_reuse_mode>(mode);
+        c.invalidate_jacobian();
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_constant_mass(ga_solver *s, int on)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (on != 0 && on != 1)
+            return c.diag.fail(GA_ERR_ARG, "constant mass must be 0 or 1, got %d", on);
+        c.model.constant_mass = on == 1;
+        c.invalidate_jacobian();
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_pattern(ga_solver *s, int which, int nnz, const int *rows,
+                                const int *cols)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (which < GA_MATRIX_MASS || which > GA_MATRIX_DAMPING)
+            return c.diag.fail(GA_ERR_ARG, "unknown matrix %d", which);
+        if (c.setup_done())
+            return c.diag.fail(GA_ERR_STATE, "patterns are declared before ga_init");
+        if (nnz < 0 || (nnz > 0 && (!rows || !cols)))
+            return c.diag.fail(GA_ERR_ARG, "pattern with nnz = %d needs rows and cols", nnz);
+        const int nr = which == GA_MATRIX_JACOBIAN ? c.m() : c.n(), nc = c.n();
+        if (which == GA_MATRIX_JACOBIAN && c.m() == 0)
+            return c.diag.fail(GA_ERR_ARG, "m = 0: there is no constraint Jacobian");
+        for (int k = 0; k < nnz; ++k)
+            if (rows[k] < 0 || rows[k] >= nr || cols[k] < 0 || cols[k] >= nc)
+                return c.diag.fail(GA_ERR_ARG, "pattern entry %d = (%d, %d) is outside the "
+                                   "%d x %d matrix", k, rows[k], cols[k], nr, nc);
+        c.matrix(static_cast<ga_matrix>(which)).set_pattern(nr, nc, rows, cols, nnz);
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_linear_solver(ga_solver *s, int solver)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (solver < GA_LINEAR_AUTO || solver > GA_LINEAR_DENSE_EIGEN)
+            return c.diag.fail(GA_ERR_ARG, "unknown linear solver %d", solver);
+        if (c.setup_done())
+            return c.diag.fail(GA_ERR_STATE, "the linear solver is chosen before ga_init");
+        c.linear_solver = static_cast<ga_linear_solver>(solver);
+        return GA_OK;
+    });
+}
+
+GA_API const char *ga_linear_solver_name(const ga_solver *s)
+{
+    if (!s)
+        return "none";
+    return s->core.linear_backend();
 }
 
 GA_API ga_status ga_set_predictor(ga_solver *s, int predictor)

@@ -13,6 +13,11 @@ namespace {
 constexpr int kMaxProjectionIterations = 50;
 const double kEps = std::numeric_limits<double>::epsilon();
 
+double max_abs(const ModelMatrix &A)
+{
+    return A.size() ? Eigen::Map<const Vec>(A.data(), A.size()).cwiseAbs().maxCoeff() : 0.0;
+}
+
 Eigen::Index argmax_abs(const Vec &x)
 {
     Eigen::Index i = 0;
@@ -24,7 +29,9 @@ Eigen::Index argmax_abs(const Vec &x)
 
 ga_status Solver::init(double t0, const double *q0, const double *v0)
 {
-    allocate_workspace();
+    if (auto st = setup())
+        return st;
+    invalidate_jacobian();
     State &x = trial_;
     x.t = t0;
     x.h_last = 0.0;
@@ -47,20 +54,20 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
     if (!st)
         st = model.force(t0, x.q, x.v, f_);
     if (!st)
-        st = model.jacobian(t0, x.q, Phi_q_);
+        st = model.jacobian(t0, x.q, J_);
     if (!st)
         st = model.constraint_accel(t0, x.q, x.v, c_);
     if (st) {
         diag.append(" (consistent initial accelerations at t0 = %.17g)", t0);
         return st;
     }
+    mass_valid_ = model.constant_mass;
     double sigma = 1.0;
-    const double mmax = M_.cwiseAbs().maxCoeff();
-    const double jmax = m_ > 0 ? Phi_q_.cwiseAbs().maxCoeff() : 0.0;
+    const double mmax = max_abs(M_), jmax = max_abs(J_);
     if (mmax > 0.0 && jmax > 0.0)
         sigma = jmax / mmax;
     count(counters, GA_COUNT_FACTORIZATIONS);
-    if (!S_.factorize_kkt(M_, sigma, Phi_q_))
+    if (!S_.factorize_kkt(M_, sigma, J_))
         return diag.fail(GA_ERR_SINGULAR,
                          "saddle-point matrix [M Phi_q^T; Phi_q 0] is singular at t0 = %.17g "
                          "(rcond = %.3g): redundant constraints, or M singular on the null "
@@ -96,10 +103,10 @@ ga_status Solver::project_positions(double t, Vec &q)
     const double norm0 = norm;
     rq_.setZero();
     for (int it = 0; it < kMaxProjectionIterations; ++it) {
-        if (auto st = model.jacobian(t, q, Phi_q_))
+        if (auto st = model.jacobian(t, q, J_))
             return st;
         count(counters, GA_COUNT_FACTORIZATIONS);
-        if (!S_.factorize_projection(Phi_q_))
+        if (!S_.factorize_projection(J_))
             return diag.fail(GA_ERR_SINGULAR,
                              "cannot project q0: Phi_q is rank deficient (rcond of "
                              "[I Phi_q^T; Phi_q 0] = %.3g) at projection iteration %d",
@@ -126,12 +133,12 @@ ga_status Solver::project_positions(double t, Vec &q)
 ga_status Solver::project_velocities(double t, const Vec &q, Vec &v)
 {
     // Velocity constraint w = Phi_q v + Phi_t.
-    if (auto st = model.jacobian(t, q, Phi_q_))
+    if (auto st = model.jacobian(t, q, J_))
         return st;
     if (auto st = model.constraint_dt(t, q, c_))
         return st;
-    phi_.noalias() = Phi_q_ * v;
-    phi_ += c_;
+    phi_ = c_;
+    J_.multiply_add(1.0, v, phi_);
     const double norm0 = phi_.lpNorm<Eigen::Infinity>();
     if (norm0 <= init_tol)
         return GA_OK;
@@ -143,7 +150,7 @@ ga_status Solver::project_velocities(double t, const Vec &q, Vec &v)
                          norm0, static_cast<long>(argmax_abs(phi_)), init_tol);
     // Linear: one minimum-norm correction, plus one pass of refinement for round-off.
     count(counters, GA_COUNT_FACTORIZATIONS);
-    if (!S_.factorize_projection(Phi_q_))
+    if (!S_.factorize_projection(J_))
         return diag.fail(GA_ERR_SINGULAR,
                          "cannot project v0: Phi_q is rank deficient (rcond of "
                          "[I Phi_q^T; Phi_q 0] = %.3g)",
@@ -152,8 +159,8 @@ ga_status Solver::project_velocities(double t, const Vec &q, Vec &v)
     for (int pass = 0; pass < 2; ++pass) {
         S_.solve(rq_, phi_, dq_, dlambda_);
         v += dq_;
-        phi_.noalias() = Phi_q_ * v;
-        phi_ += c_;
+        phi_ = c_;
+        J_.multiply_add(1.0, v, phi_);
     }
     const double norm = phi_.lpNorm<Eigen::Infinity>();
     if (!(norm <= init_tol))

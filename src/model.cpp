@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace ga {
 
@@ -20,23 +21,103 @@ double fd_increment(double x)
 }
 }  // namespace
 
+void ColumnGroups::build(const ModelMatrix &A)
+{
+    const int nrows = A.rows(), ncols = A.cols(), nnz = A.nnz();
+    const auto &ri = A.row_index();
+    const auto &ci = A.col_index();
+    // first occurrence of every (row, col) pair; duplicates must not receive the value twice
+    std::vector<int> order(nnz);
+    for (int k = 0; k < nnz; ++k)
+        order[k] = k;
+    std::sort(order.begin(), order.end(), [&](int a, int b) {
+        return std::make_pair(ci[a], ri[a]) < std::make_pair(ci[b], ri[b]) ||
+               (std::make_pair(ci[a], ri[a]) == std::make_pair(ci[b], ri[b]) && a < b);
+    });
+    std::vector<int> unique;
+    for (int k = 0; k < nnz; ++k)
+        if (k == 0 || ci[order[k]] != ci[order[k - 1]] || ri[order[k]] != ri[order[k - 1]])
+            unique.push_back(order[k]);
+    // column -> rows and row -> columns adjacency
+    std::vector<std::vector<int>> col_rows(ncols), row_cols(nrows);
+    for (int k : unique) {
+        col_rows[ci[k]].push_back(ri[k]);
+        row_cols[ri[k]].push_back(ci[k]);
+    }
+    // greedy colouring: a column takes the first group that none of its row-neighbours has
+    std::vector<int> color(ncols, -1), forbidden;
+    int groups = 0;
+    for (int j = 0; j < ncols; ++j) {
+        if (col_rows[j].empty())
+            continue;
+        for (int i : col_rows[j])
+            for (int jj : row_cols[i])
+                if (color[jj] >= 0)
+                    forbidden[color[jj]] = j;
+        int c = 0;
+        while (c < groups && forbidden[c] == j)
+            ++c;
+        if (c == groups) {
+            ++groups;
+            forbidden.push_back(-1);
+        }
+        color[j] = c;
+    }
+    start.assign(groups + 1, 0);
+    entry_start.assign(groups + 1, 0);
+    for (int j = 0; j < ncols; ++j)
+        if (color[j] >= 0)
+            ++start[color[j] + 1];
+    for (int k : unique)
+        ++entry_start[color[ci[k]] + 1];
+    for (int g = 0; g < groups; ++g) {
+        start[g + 1] += start[g];
+        entry_start[g + 1] += entry_start[g];
+    }
+    cols.assign(start[groups], 0);
+    entries.assign(entry_start[groups], 0);
+    std::vector<int> fill_c(start.begin(), start.end() - 1);
+    std::vector<int> fill_e(entry_start.begin(), entry_start.end() - 1);
+    for (int j = 0; j < ncols; ++j)
+        if (color[j] >= 0)
+            cols[fill_c[color[j]]++] = j;
+    for (int k : unique)
+        entries[fill_e[color[ci[k]]]++] = k;
+}
+
 Model::Model(int n, int m, Counters &counters, Diagnostics &diag)
     : n_(n), m_(m), counters_(counters), diag_(diag)
 {
 }
 
-void Model::allocate_workspace()
+void Model::allocate_workspace(const ModelMatrix &M, const ModelMatrix &J, const ModelMatrix &K,
+                               const ModelMatrix &C)
 {
     q_pert_.setZero(n_);
     v_pert_.setZero(n_);
     f_pert_.setZero(n_);
     r_pert_.setZero(n_);
+    step_.setZero(n_);
     phi_plus_.setZero(m_);
     phi_minus_.setZero(m_);
     g_plus_.setZero(m_);
     g_minus_.setZero(m_);
-    M_pert_.setZero(n_, n_);
-    J_pert_.setZero(m_, n_);
+    M_pert_.copy_layout(M);
+    J_pert_.copy_layout(J);
+    if (!K.dense())
+        k_groups_.build(K);
+    if (!C.dense())
+        c_groups_.build(C);
+}
+
+bool Model::stiffness_available(const ModelMatrix &K) const
+{
+    return !stiffness_needed(K) || K.dense() || cb.stiffness || !K.zero();
+}
+
+bool Model::damping_available(const ModelMatrix &C) const
+{
+    return !damping_needed(C) || C.dense() || cb.damping || !C.zero();
 }
 
 ga_status Model::callback_status(int rc, const char *name, double t)
@@ -50,13 +131,12 @@ ga_status Model::callback_status(int rc, const char *name, double t)
                       t);
 }
 
-ga_status Model::check_finite(const double *x, Eigen::Index rows, Eigen::Index cols,
+ga_status Model::check_finite(const double *x, Eigen::Index size, Eigen::Index rows,
                               const char *what, double t)
 {
-    const Eigen::Index size = rows * cols;
     for (Eigen::Index k = 0; k < size; ++k) {
         if (!std::isfinite(x[k])) {
-            if (cols == 1)
+            if (rows == 0)  // a vector, or the values of a declared pattern
                 return diag_.fail(GA_ERR_NONFINITE, "%s[%ld] = %g is not finite at t = %.17g",
                                   what, static_cast<long>(k), x[k], t);
             return diag_.fail(GA_ERR_NONFINITE, "%s(%ld,%ld) = %g is not finite at t = %.17g",
@@ -67,12 +147,17 @@ ga_status Model::check_finite(const double *x, Eigen::Index rows, Eigen::Index c
     return GA_OK;
 }
 
-ga_status Model::mass(double t, const Vec &q, Mat &M)
+// Where a value of a matrix sits, for messages: dense (row, col) or pattern entry k.
+static Eigen::Index message_rows(const ModelMatrix &A) { return A.dense() ? A.rows() : 0; }
+
+ga_status Model::mass(double t, const Vec &q, ModelMatrix &M)
 {
+    if (M.zero())
+        return GA_OK;
     count(counters_, GA_COUNT_MASS_EVALS);
     if (auto st = callback_status(cb.mass(t, q.data(), M.data(), cb.user), "mass", t))
         return st;
-    return check_finite(M.data(), n_, n_, "mass matrix M", t);
+    return check_finite(M.data(), M.size(), message_rows(M), "mass matrix M", t);
 }
 
 ga_status Model::force(double t, const Vec &q, const Vec &v, Vec &f)
@@ -85,7 +170,7 @@ ga_status Model::force(double t, const Vec &q, const Vec &v, Vec &f)
     if (auto st = callback_status(cb.force(t, q.data(), v.data(), f.data(), cb.user), "force",
                                   t))
         return st;
-    return check_finite(f.data(), n_, 1, "force f", t);
+    return check_finite(f.data(), n_, 0, "force f", t);
 }
 
 ga_status Model::constraint(double t, const Vec &q, Vec &phi)
@@ -96,31 +181,45 @@ ga_status Model::constraint(double t, const Vec &q, Vec &phi)
     if (auto st = callback_status(cb.constraint(t, q.data(), phi.data(), cb.user), "constraint",
                                   t))
         return st;
-    return check_finite(phi.data(), m_, 1, "constraint Phi", t);
+    return check_finite(phi.data(), m_, 0, "constraint Phi", t);
 }
 
-ga_status Model::jacobian(double t, const Vec &q, Mat &Phi_q)
+ga_status Model::jacobian(double t, const Vec &q, ModelMatrix &J)
 {
-    if (m_ == 0)
+    if (m_ == 0 || J.zero())
         return GA_OK;
     count(counters_, GA_COUNT_JACOBIAN_EVALS);
-    if (auto st = callback_status(cb.jacobian(t, q.data(), Phi_q.data(), cb.user), "jacobian",
-                                  t))
+    if (auto st = callback_status(cb.jacobian(t, q.data(), J.data(), cb.user), "jacobian", t))
         return st;
-    return check_finite(Phi_q.data(), m_, n_, "constraint Jacobian Phi_q", t);
+    return check_finite(J.data(), J.size(), message_rows(J), "constraint Jacobian Phi_q", t);
 }
 
-void Model::dynamics_residual(const Mat &M, const Vec &qdd, const Vec &f, const Mat &Phi_q,
-                              const Vec &lambda, Vec &rq)
+void Model::dynamics_residual(const ModelMatrix &M, const Vec &qdd, const Vec &f,
+                              const ModelMatrix &J, const Vec &lambda, Vec &rq)
 {
-    rq.noalias() = M * qdd;
-    rq -= f;
+    rq = -f;
+    M.multiply_add(1.0, qdd, rq);
     if (lambda.size() > 0)
-        rq.noalias() += Phi_q.transpose() * lambda;
+        J.multiply_transpose_add(1.0, lambda, rq);
+}
+
+// r^q at a perturbed position qp (v, qdd, lambda fixed), into r.
+ga_status Model::perturbed_residual(double t, const Vec &qp, const Vec &v, const Vec &qdd,
+                                    const Vec &lambda, const ModelMatrix &M, Vec &r)
+{
+    if (!constant_mass)
+        if (auto st = mass(t, qp, M_pert_))
+            return st;
+    if (auto st = force(t, qp, v, f_pert_))
+        return st;
+    if (auto st = jacobian(t, qp, J_pert_))
+        return st;
+    dynamics_residual(constant_mass ? M : M_pert_, qdd, f_pert_, J_pert_, lambda, r);
+    return GA_OK;
 }
 
 ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
-                           const Vec &lambda, const Vec &rq, Mat &K)
+                           const Vec &lambda, const Vec &rq, const ModelMatrix &M, ModelMatrix &K)
 {
     count(counters_, GA_COUNT_STIFFNESS_EVALS);
     if (cb.stiffness && tangent_mode == GA_TANGENT_AUTO) {
@@ -128,48 +227,87 @@ ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
                                                    lambda.data(), K.data(), cb.user),
                                       "stiffness", t))
             return st;
-        return check_finite(K.data(), n_, n_, "tangent stiffness K_t", t);
+        return check_finite(K.data(), K.size(), message_rows(K), "tangent stiffness K_t", t);
     }
-    // Column j of d r^q/dq by a forward difference; includes the derivatives of M(q) qdd and
-    // of Phi_q(q)^T lambda, which structural codes often drop.
+    // Forward differences of r^q; they include the derivatives of M(q) qdd and of
+    // Phi_q(q)^T lambda, which structural codes often drop.
     q_pert_ = q;
-    for (int j = 0; j < n_; ++j) {
-        const double e = fd_increment(q[j]);
-        q_pert_[j] = q[j] + e;
-        if (auto st = mass(t, q_pert_, M_pert_))
+    if (K.dense()) {
+        auto Kd = K.as_dense();
+        for (int j = 0; j < n_; ++j) {
+            const double e = fd_increment(q[j]);
+            q_pert_[j] = q[j] + e;
+            if (auto st = perturbed_residual(t, q_pert_, v, qdd, lambda, M, r_pert_))
+                return st;
+            Kd.col(j) = (r_pert_ - rq) / e;
+            q_pert_[j] = q[j];
+        }
+        return GA_OK;
+    }
+    K.set_zero();
+    const auto &ri = K.row_index();
+    const auto &ci = K.col_index();
+    for (int g = 0; g < k_groups_.count(); ++g) {
+        for (int p = k_groups_.start[g]; p < k_groups_.start[g + 1]; ++p) {
+            const int j = k_groups_.cols[p];
+            step_[j] = fd_increment(q[j]);
+            q_pert_[j] = q[j] + step_[j];
+        }
+        if (auto st = perturbed_residual(t, q_pert_, v, qdd, lambda, M, r_pert_))
             return st;
-        if (auto st = force(t, q_pert_, v, f_pert_))
-            return st;
-        if (auto st = jacobian(t, q_pert_, J_pert_))
-            return st;
-        dynamics_residual(M_pert_, qdd, f_pert_, J_pert_, lambda, r_pert_);
-        K.col(j) = (r_pert_ - rq) / e;
-        q_pert_[j] = q[j];
+        for (int p = k_groups_.entry_start[g]; p < k_groups_.entry_start[g + 1]; ++p) {
+            const int k = k_groups_.entries[p];
+            K.data()[k] = (r_pert_[ri[k]] - rq[ri[k]]) / step_[ci[k]];
+        }
+        for (int p = k_groups_.start[g]; p < k_groups_.start[g + 1]; ++p)
+            q_pert_[k_groups_.cols[p]] = q[k_groups_.cols[p]];
     }
     return GA_OK;
 }
 
-ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, Mat &C)
+ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, ModelMatrix &C)
 {
     count(counters_, GA_COUNT_DAMPING_EVALS);
     if (cb.damping && tangent_mode == GA_TANGENT_AUTO) {
         if (auto st = callback_status(cb.damping(t, q.data(), v.data(), C.data(), cb.user),
                                       "damping", t))
             return st;
-        return check_finite(C.data(), n_, n_, "tangent damping C_t", t);
+        return check_finite(C.data(), C.size(), message_rows(C), "tangent damping C_t", t);
     }
     if (!cb.force) {
-        C.setZero();
+        C.set_zero();
         return GA_OK;
     }
     v_pert_ = v;
-    for (int j = 0; j < n_; ++j) {
-        const double e = fd_increment(v[j]);
-        v_pert_[j] = v[j] + e;
+    if (C.dense()) {
+        auto Cd = C.as_dense();
+        for (int j = 0; j < n_; ++j) {
+            const double e = fd_increment(v[j]);
+            v_pert_[j] = v[j] + e;
+            if (auto st = force(t, q, v_pert_, f_pert_))
+                return st;
+            Cd.col(j) = -(f_pert_ - f) / e;
+            v_pert_[j] = v[j];
+        }
+        return GA_OK;
+    }
+    C.set_zero();
+    const auto &ri = C.row_index();
+    const auto &ci = C.col_index();
+    for (int g = 0; g < c_groups_.count(); ++g) {
+        for (int p = c_groups_.start[g]; p < c_groups_.start[g + 1]; ++p) {
+            const int j = c_groups_.cols[p];
+            step_[j] = fd_increment(v[j]);
+            v_pert_[j] = v[j] + step_[j];
+        }
         if (auto st = force(t, q, v_pert_, f_pert_))
             return st;
-        C.col(j) = -(f_pert_ - f) / e;
-        v_pert_[j] = v[j];
+        for (int p = c_groups_.entry_start[g]; p < c_groups_.entry_start[g + 1]; ++p) {
+            const int k = c_groups_.entries[p];
+            C.data()[k] = -(f_pert_[ri[k]] - f[ri[k]]) / step_[ci[k]];
+        }
+        for (int p = c_groups_.start[g]; p < c_groups_.start[g + 1]; ++p)
+            v_pert_[c_groups_.cols[p]] = v[c_groups_.cols[p]];
     }
     return GA_OK;
 }
@@ -199,7 +337,7 @@ ga_status Model::constraint_accel(double t, const Vec &q, const Vec &v, Vec &out
                                                           cb.user),
                                       "constraint_accel", t))
             return st;
-        return check_finite(out.data(), m_, 1, "constraint acceleration term", t);
+        return check_finite(out.data(), m_, 0, "constraint acceleration term", t);
     }
     // Along the path s -> (q + s v, t + s) the velocity constraint is
     // g(s) = Phi_q v + Phi_t, and g'(0) = Phi_qq(v, v) + 2 Phi_qt v + Phi_tt. Central
@@ -215,7 +353,7 @@ ga_status Model::constraint_accel(double t, const Vec &q, const Vec &v, Vec &out
             return st;
         if (auto st = constraint_dt(t + sig, q_pert_, g))
             return st;
-        g.noalias() += J_pert_ * v;
+        J_pert_.multiply_add(1.0, v, g);
     }
     out = (g_plus_ - g_minus_) / (2.0 * s);
     return GA_OK;

@@ -1,10 +1,15 @@
 // ga::Model: the user's callbacks behind one interface. Maps callback return codes to statuses,
 // rejects non-finite outputs, counts evaluations, and supplies finite-difference fallbacks for
 // the optional pieces (tangent stiffness, tangent damping, constraint acceleration term, Phi_t).
+// Finite differences of sparse tangents perturb groups of structurally independent columns
+// together (Curtis-Powell-Reid), so a banded or block-diagonal K_t costs a few evaluations,
+// not n.
 #pragma once
 
+#include <vector>
+
 #include "diagnostics.hpp"
-#include "types.hpp"
+#include "matrix.hpp"
 
 namespace ga {
 
@@ -19,49 +24,73 @@ struct Callbacks {
     void *user = nullptr;
 };
 
+// Columns of a sparse matrix grouped so that no two columns of a group share a row.
+struct ColumnGroups {
+    std::vector<int> start;    // group g holds columns cols[start[g] .. start[g+1])
+    std::vector<int> cols;
+    std::vector<int> entry_start;  // and pattern entries entries[entry_start[g] ..)
+    std::vector<int> entries;      // (first occurrence of each (row, col) only)
+    void build(const ModelMatrix &A);
+    int count() const { return start.empty() ? 0 : static_cast<int>(start.size()) - 1; }
+};
+
 class Model {
 public:
     Model(int n, int m, Counters &counters, Diagnostics &diag);
 
-    // Scratch for finite differences; sized once at setup, never in a step.
-    void allocate_workspace();
-
     Callbacks cb;
     ga_tangent_mode tangent_mode = GA_TANGENT_AUTO;
+    bool constant_mass = false;
+
+    // Scratch for finite differences, shaped like the solver's matrices (setup only).
+    void allocate_workspace(const ModelMatrix &M, const ModelMatrix &J, const ModelMatrix &K,
+                            const ModelMatrix &C);
 
     bool ready() const { return cb.mass != nullptr && (m_ == 0 || (cb.constraint && cb.jacobian)); }
     bool uses_tangents() const { return tangent_mode != GA_TANGENT_NEGLECT; }
+    bool stiffness_needed(const ModelMatrix &K) const { return uses_tangents() && !K.zero(); }
+    bool damping_needed(const ModelMatrix &C) const
+    {
+        return uses_tangents() && !C.zero() && (cb.force || cb.damping);
+    }
+    // Can K (or C) be obtained in this storage: by callback, or by finite differences?
+    bool stiffness_available(const ModelMatrix &K) const;
+    bool damping_available(const ModelMatrix &C) const;
 
-    ga_status mass(double t, const Vec &q, Mat &M);
+    ga_status mass(double t, const Vec &q, ModelMatrix &M);
     ga_status force(double t, const Vec &q, const Vec &v, Vec &f);
     ga_status constraint(double t, const Vec &q, Vec &phi);
-    ga_status jacobian(double t, const Vec &q, Mat &Phi_q);
+    ga_status jacobian(double t, const Vec &q, ModelMatrix &J);
 
-    // K_t = d r^q / dq at fixed v, qdd, lambda. rq is r^q at q (used by finite differences).
+    // K_t = d r^q / dq at fixed v, qdd, lambda. rq is r^q at q, M the mass matrix at q (both
+    // used by finite differences; with a constant mass M is not evaluated again).
     ga_status stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd, const Vec &lambda,
-                        const Vec &rq, Mat &K);
+                        const Vec &rq, const ModelMatrix &M, ModelMatrix &K);
     // C_t = -df/dv. f is f(q, v, t) (used by finite differences).
-    ga_status damping(double t, const Vec &q, const Vec &v, const Vec &f, Mat &C);
+    ga_status damping(double t, const Vec &q, const Vec &v, const Vec &f, ModelMatrix &C);
     // Phi_qq(v, v) + 2 Phi_qt v + Phi_tt.
     ga_status constraint_accel(double t, const Vec &q, const Vec &v, Vec &out);
     // Phi_t by central differences in t (exactly zero for time-independent constraints).
     ga_status constraint_dt(double t, const Vec &q, Vec &out);
 
     // r^q = M qdd - f + Phi_q^T lambda: the residual of eq. (1), not weighted.
-    static void dynamics_residual(const Mat &M, const Vec &qdd, const Vec &f, const Mat &Phi_q,
-                                  const Vec &lambda, Vec &rq);
+    static void dynamics_residual(const ModelMatrix &M, const Vec &qdd, const Vec &f,
+                                  const ModelMatrix &J, const Vec &lambda, Vec &rq);
 
 private:
     ga_status callback_status(int rc, const char *name, double t);
-    ga_status check_finite(const double *x, Eigen::Index rows, Eigen::Index cols,
+    ga_status check_finite(const double *x, Eigen::Index size, Eigen::Index rows,
                            const char *what, double t);
+    ga_status perturbed_residual(double t, const Vec &qp, const Vec &v, const Vec &qdd,
+                                 const Vec &lambda, const ModelMatrix &M, Vec &r);
 
     int n_, m_;
     Counters &counters_;
     Diagnostics &diag_;
     // finite-difference scratch
-    Vec q_pert_, v_pert_, f_pert_, r_pert_, phi_plus_, phi_minus_, g_plus_, g_minus_;
-    Mat M_pert_, J_pert_;
+    Vec q_pert_, v_pert_, f_pert_, r_pert_, phi_plus_, phi_minus_, g_plus_, g_minus_, step_;
+    ModelMatrix M_pert_, J_pert_;
+    ColumnGroups k_groups_, c_groups_;
 };
 
 }  // namespace ga

@@ -1,6 +1,7 @@
 #include "newton.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace ga {
@@ -16,23 +17,43 @@ double relative(double increment, double tol, double value)
         return std::numeric_limits<double>::infinity();
     return increment / denom;
 }
+
+// A rate measured in a previous step is trusted no further than this: quadratic convergence
+// seen once says little about a reused matrix.
+constexpr double kMinTrustedRate = 0.05;
+// Iterations one matrix is given to converge before it counts as too slow.
+constexpr int kIterationBudget = 4;
 }  // namespace
 
-bool ConvergenceTest::converged(double tol, const Vec &dq, double beta_prime,
-                                const Vec &dlambda, const Vec &q, const Vec &qdd,
-                                const Vec &lambda)
+ConvergenceTest::Verdict ConvergenceTest::check(double tol, const Vec &dq, double beta_prime,
+                                                const Vec &dlambda, const Vec &q, const Vec &qdd,
+                                                const Vec &lambda)
 {
     ++iteration_;
+    ++with_matrix_;
     const double dq_norm = dq.lpNorm<Eigen::Infinity>();
     const double q_norm = q.lpNorm<Eigen::Infinity>();
-    double r = std::max(relative(dq_norm, tol, q_norm),
-                        relative(beta_prime * dq_norm, tol, qdd.lpNorm<Eigen::Infinity>()));
+    double eta = std::max(relative(dq_norm, tol, q_norm),
+                          relative(beta_prime * dq_norm, tol, qdd.lpNorm<Eigen::Infinity>()));
     if (dlambda.size() > 0)
-        r = std::max(r, relative(dlambda.lpNorm<Eigen::Infinity>(), tol,
-                                 lambda.lpNorm<Eigen::Infinity>()));
-    ratio_ = r;
-    if (r <= 1.0)
-        return true;
+        eta = std::max(eta, relative(dlambda.lpNorm<Eigen::Infinity>(), tol,
+                                     lambda.lpNorm<Eigen::Infinity>()));
+    ratio_ = eta;
+
+    double theta = -1.0;
+    const bool measured = previous_ratio_ > 0.0;
+    if (measured) {
+        theta = eta / previous_ratio_;
+        rate_ = theta;
+    } else if (theta_prev_ >= 0.0) {
+        theta = std::max(theta_prev_, kMinTrustedRate);
+    }
+    previous_ratio_ = eta;
+
+    if (eta <= 1.0)
+        return Verdict::Converged;
+    if (theta >= 0.0 && theta < 1.0 && eta * theta / (1.0 - theta) <= 1.0)
+        return Verdict::Converged;
 
     // Round-off exit: positions no longer move. With q fixed the equations are linear in qdd
     // and lambda, so the iteration after the first such increment has already corrected them.
@@ -40,7 +61,19 @@ bool ConvergenceTest::converged(double tol, const Vec &dq, double beta_prime,
     const bool at_roundoff = dq_norm <= roundoff;
     const bool stop = at_roundoff && previous_dq_at_roundoff_;
     previous_dq_at_roundoff_ = at_roundoff;
-    return stop;
+    if (stop)
+        return Verdict::Converged;
+    if (!at_roundoff) {
+        if (with_matrix_ >= kIterationBudget)
+            return Verdict::Slow;
+        if (theta >= 1.0)
+            return Verdict::Slow;
+        // error predicted after the iterations left in the budget
+        if (theta > 0.0 &&
+            eta * std::pow(theta, kIterationBudget - with_matrix_) / (1.0 - theta) > 1.0)
+            return Verdict::Slow;
+    }
+    return Verdict::Continue;
 }
 
 }  // namespace ga

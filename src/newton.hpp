@@ -1,15 +1,24 @@
 // The Newton stopping test of galpha (ALGORITHMS.md sec. 4.6: increments, not residuals).
 //
 // After each Newton update, with dq the position increment (and beta' dq the acceleration
-// increment, eq. 7) and dlambda the multiplier increment, the step is converged when
+// increment, eq. 7) and dlambda the multiplier increment, the size of the update relative to
+// the tolerance is
 //
-//     ratio = max( |dq|/(tol |q|), |beta' dq|/(tol |qdd|), |dlambda|/(tol |lambda|) ) <= 1
+//     eta = max( |dq|/(tol |q|), |beta' dq|/(tol |qdd|), |dlambda|/(tol |lambda|) )
 //
-// (max-norms over the vectors), or when the iteration has reached round-off: two successive
-// position increments within a few ulps of |q|. Every quantity is measured in its own units,
-// so the test means the same for every h; the round-off exit is needed because index-3
-// accelerations and multipliers are only determined to ~eps |q| / (beta h^2) (paper, sec. 3.3),
-// which exceeds tol |lambda| once h is small enough.
+// (max-norms over the vectors): every quantity is measured in its own units, so the test means
+// the same for every h. The step is converged when
+//   - eta <= 1, or
+//   - the error left after the update, estimated from the contraction rate theta as
+//     eta theta / (1 - theta), is <= 1 (theta from the last two increments; in the first
+//     iteration with a reused matrix, from the previous step, as SUNDIALS IDA does), or
+//   - the iteration has reached round-off: two successive position increments within a few
+//     ulps of |q|. This exit is needed because index-3 accelerations and multipliers are only
+//     determined to ~eps |q| / (beta h^2) (paper, sec. 3.3), which exceeds tol |lambda| once h
+//     is small enough.
+// Verdict Slow: at the measured rate the iteration cannot reach the tolerance within a budget
+// of 4 iterations with one matrix (the criterion of SciPy's Radau, with IDA's maxcor), so a
+// reused matrix should be rebuilt now rather than iterated on.
 #pragma once
 
 #include "types.hpp"
@@ -18,24 +27,38 @@ namespace ga {
 
 class ConvergenceTest {
 public:
-    void reset()
+    enum class Verdict { Converged, Continue, Slow };
+
+    // theta_prev: contraction rate seen in the previous step with the same matrix (< 0: none).
+    void reset(double theta_prev)
     {
         iteration_ = 0;
         ratio_ = 0.0;
+        previous_ratio_ = -1.0;
+        theta_prev_ = theta_prev;
+        rate_ = -1.0;
         previous_dq_at_roundoff_ = false;
+        with_matrix_ = 0;
+    }
+    // The iteration matrix was rebuilt: rates across the change mean nothing.
+    void matrix_changed()
+    {
+        previous_ratio_ = -1.0;
+        theta_prev_ = -1.0;
+        with_matrix_ = 0;
     }
 
-    // Returns true when converged after the update with these increments (q, qdd, lambda
-    // already updated).
-    bool converged(double tol, const Vec &dq, double beta_prime, const Vec &dlambda,
-                   const Vec &q, const Vec &qdd, const Vec &lambda);
+    Verdict check(double tol, const Vec &dq, double beta_prime, const Vec &dlambda, const Vec &q,
+                  const Vec &qdd, const Vec &lambda);
 
-    double ratio() const { return ratio_; }  // last ratio, for messages
+    double ratio() const { return ratio_; }  // eta of the last update
+    double rate() const { return rate_; }    // last measured theta (< 0: none yet)
 
 private:
     int iteration_ = 0;
-    double ratio_ = 0.0;
+    double ratio_ = 0.0, previous_ratio_ = -1.0, theta_prev_ = -1.0, rate_ = -1.0;
     bool previous_dq_at_roundoff_ = false;
+    int with_matrix_ = 0;  // iterations with the current matrix in this step
 };
 
 }  // namespace ga

@@ -1,7 +1,6 @@
 #include "solver.hpp"
 
 #include <cmath>
-#include <cstdint>
 #include <limits>
 #include <new>
 
@@ -12,7 +11,19 @@ constexpr double kStateMagic = 26465.0;  // 0x6761, "ga"
 constexpr double kStateVersion = 1.0;
 constexpr std::size_t kStateHeader = 6;  // magic, version, n, m, t, h_last
 
-bool all_finite(const Vec &x) { return x.allFinite(); }
+// Reuse of the iteration matrix after a change of h. Scaled, S_t depends on h only through
+// gamma h C_t and beta h^2 K_t; the band is IDA's for its c_j (ALGORITHMS.md sec. 4.5):
+// refactor when (h_old / h_new)^2 leaves [0.6, 5/3].
+bool h_within_reuse_band(double h_matrix, double h)
+{
+    const double r = (h_matrix / h) * (h_matrix / h);
+    return r >= 0.6 && r <= 5.0 / 3.0;
+}
+
+// Automatic choices of the linear algebra, from bench/linear_algebra (docs/performance.md):
+// Eigen's LU beats reference LAPACK's at every size of the paper's scenes; the sparse path
+// wins once the saddle-point system has a few hundred unknowns and is sparse.
+constexpr int kSparseMinSize = 200;
 }  // namespace
 
 void State::allocate(int n, int m)
@@ -40,30 +51,84 @@ Solver::Solver(int n, int m)
 {
     accepted_.allocate(n, m);
     trial_.allocate(n, m);
+    M_.set_dense(n, n);
+    J_.set_dense(m, n);
+    K_.set_dense(n, n);
+    C_.set_dense(n, n);
 }
 
-void Solver::allocate_workspace()
+ModelMatrix &Solver::matrix(ga_matrix which)
+{
+    switch (which) {
+    case GA_MATRIX_MASS: return M_;
+    case GA_MATRIX_JACOBIAN: return J_;
+    case GA_MATRIX_STIFFNESS: return K_;
+    default: return C_;
+    }
+}
+
+ga_status Solver::setup()
 {
     if (workspace_ready_)
-        return;
-    // The dense iteration matrix has (n + m)^2 entries; refuse sizes whose byte count does
-    // not fit in the address space instead of letting the multiplication overflow.
-    const double N = static_cast<double>(n_) + static_cast<double>(m_);
-    if (N * N * sizeof(double) > static_cast<double>(std::numeric_limits<std::ptrdiff_t>::max()))
-        throw std::bad_alloc();
-    M_.setZero(n_, n_);
-    C_.setZero(n_, n_);
-    K_.setZero(n_, n_);
-    Phi_q_.setZero(m_, n_);
+        return GA_OK;
+    // Which linear algebra: sparse needs declared patterns of M and Phi_q, and K_t, C_t either
+    // declared (possibly empty), not needed, or neglected.
+    const bool sparse_possible = !M_.dense() && (m_ == 0 || !J_.dense()) &&
+                                 (!model.stiffness_needed(K_) || !K_.dense()) &&
+                                 (!model.damping_needed(C_) || !C_.dense());
+    bool sparse = false;
+    switch (linear_solver) {
+    case GA_LINEAR_SPARSE:
+        if (!sparse_possible)
+            return diag.fail(GA_ERR_ARG,
+                             "the sparse solver needs the patterns of M and Phi_q, and of K_t "
+                             "and C_t unless they are neglected (ga_set_pattern; an empty "
+                             "pattern declares a zero matrix)");
+        sparse = true;
+        break;
+    case GA_LINEAR_AUTO: sparse = sparse_possible && n_ + m_ >= kSparseMinSize; break;
+    default: sparse = false;
+    }
+    std::unique_ptr<LinearBackend> backend;
+    if (sparse) {
+        backend = make_sparse_backend();
+        if (!backend && linear_solver == GA_LINEAR_SPARSE)
+            return diag.fail(GA_ERR_ARG, "galpha was built without KLU: no sparse solver");
+    }
+    if (!backend) {
+        // The dense iteration matrix has (n + m)^2 entries; refuse sizes whose byte count
+        // does not fit in the address space instead of letting the multiplication overflow.
+        const double N = static_cast<double>(n_) + static_cast<double>(m_);
+        if (N * N * sizeof(double) >
+            static_cast<double>(std::numeric_limits<std::ptrdiff_t>::max()))
+            throw std::bad_alloc();
+        backend = make_dense_backend(linear_solver == GA_LINEAR_DENSE_LAPACK ? DenseKind::Lapack
+                                                                             : DenseKind::Eigen);
+    }
+    M_.allocate();
+    J_.allocate();
+    K_.allocate();
+    C_.allocate();
     f_.setZero(n_);
     phi_.setZero(m_);
     rq_.setZero(n_);
     dq_.setZero(n_);
     dlambda_.setZero(m_);
     c_.setZero(m_);
-    S_.allocate(n_, m_);
-    model.allocate_workspace();
+    model.allocate_workspace(M_, J_, K_, C_);
+    S_.setup(std::move(backend), n_, m_, M_, J_, K_, C_);
     workspace_ready_ = true;
+    return GA_OK;
+}
+
+ga_status Solver::evaluate_mass(double t, const Vec &q)
+{
+    if (model.constant_mass && mass_valid_)
+        return GA_OK;
+    if (auto st = model.mass(t, q, M_))
+        return st;
+    mass_valid_ = model.constant_mass;
+    return GA_OK;
 }
 
 ga_status Solver::step(double h)
@@ -79,8 +144,11 @@ ga_status Solver::step(double h)
         }
     } failed{counters};
     const ga_status st = attempt_step(h);
-    if (st != GA_OK)
+    if (st != GA_OK) {
+        // Whatever went wrong, the next attempt starts from a fresh iteration matrix.
+        invalidate_jacobian();
         return st;
+    }
     accepted_.swap(trial_);  // commit
     failed.committed = true;
     count(counters, GA_COUNT_STEPS);
@@ -90,8 +158,46 @@ ga_status Solver::step(double h)
 // One step of Algorithm 1 from accepted_ into trial_. accepted_ is only read.
 ga_status Solver::attempt_step(double h)
 {
+    bool refresh = reuse == GA_REUSE_NEVER || !jacobian_valid_ ||
+                   !h_within_reuse_band(jacobian_h_, h);
+    bool converged = false, used_stale = false;
+    last_newton_iters_ = 0;
+    if (auto st = newton(h, refresh, converged, used_stale))
+        return st;
+    if (!converged && used_stale) {
+        // Modified Newton failed with an old matrix: the same step again, from the predictor,
+        // with a matrix evaluated now (as IDA and Chrono do) before giving up.
+        if (auto st = newton(h, true, converged, used_stale))
+            return st;
+    }
+    if (!converged)
+        return diag.fail(GA_ERR_NEWTON,
+                         "Newton iteration did not converge in %d iterations in the step from "
+                         "t = %.17g with h = %g (last increment / tolerance = %.3g)",
+                         max_iter, accepted_.t, h, convergence_.ratio());
+    const State &s = accepted_;
+    State &x = trial_;
+    if (!x.q.allFinite() || !x.v.allFinite() || !x.qdd.allFinite() || !x.lambda.allFinite())
+        return diag.fail(GA_ERR_NONFINITE, "step from t = %.17g with h = %g produced a "
+                         "non-finite state", s.t, h);
+    const Params &p = params;
+    // Algorithm 1, last line: a_{n+1} from eq. (3) with the converged qdd_{n+1}.
+    x.a = (p.alpha_f * s.qdd - p.alpha_m * s.a + (1.0 - p.alpha_f) * x.qdd) / (1.0 - p.alpha_m);
+    x.t = s.t + h;
+    x.h_last = h;
+    if (convergence_.rate() >= 0.0)
+        theta_prev_ = convergence_.rate();
+    return GA_OK;
+}
+
+// Predictor and Newton iteration of Algorithm 1. With `refresh` the iteration matrix is
+// rebuilt before the first solve; otherwise the factorization of an earlier step is reused
+// (modified Newton) and rebuilt only if the iteration contracts too slowly.
+ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_stale)
+{
     const Params &p = params;
     const NewtonCoefficients c = newton_coefficients(p, h);  // eq. (6)
+    const double row_scale = step_row_scale(p, h, scaling);
     const State &s = accepted_;
     State &x = trial_;
     const double t1 = s.t + h;
@@ -110,47 +216,57 @@ ga_status Solver::attempt_step(double h)
     x.q = s.q + h * s.v + (h * h) * ((0.5 - p.beta) * s.a + p.beta * x.a);  // eq. (4)
     x.v = s.v + h * ((1.0 - p.gamma) * s.a + p.gamma * x.a);               // eq. (5)
 
-    const bool tangents = model.uses_tangents();
-    convergence_.reset();
-    last_newton_iters_ = 0;
-    bool converged = false;
-    int iter = 0;
-    while (!converged && iter < max_iter) {
-        last_newton_iters_ = ++iter;
-        ga_status st = model.mass(t1, x.q, M_);
+    const bool tangents_K = model.stiffness_needed(K_);
+    const bool tangents_C = model.damping_needed(C_);
+    convergence_.reset(refresh ? -1.0 : theta_prev_);
+    converged = false;
+    used_stale = false;
+    for (int iter = 1; iter <= max_iter && !converged; ++iter) {
+        last_newton_iters_ = iter;
+        ga_status st = evaluate_mass(t1, x.q);
         if (!st)
             st = model.force(t1, x.q, x.v, f_);
         if (!st)
             st = model.constraint(t1, x.q, phi_);
         if (!st)
-            st = model.jacobian(t1, x.q, Phi_q_);
+            st = model.jacobian(t1, x.q, J_);
         if (!st) {
             // Residuals r^q (eq. 1, not weighted) and r^lambda = Phi (eq. 2).
-            Model::dynamics_residual(M_, x.qdd, f_, Phi_q_, x.lambda, rq_);
+            Model::dynamics_residual(M_, x.qdd, f_, J_, x.lambda, rq_);
             count(counters, GA_COUNT_RESIDUALS);
         }
-        if (!st && tangents)
-            st = model.stiffness(t1, x.q, x.v, x.qdd, x.lambda, rq_, K_);
-        if (!st && tangents)
+        if (!st && refresh && tangents_K)
+            st = model.stiffness(t1, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_);
+        if (!st && refresh && tangents_C)
             st = model.damping(t1, x.q, x.v, f_, C_);
         if (st) {
             diag.append(" (Newton iteration %d of the step from t = %.17g with h = %g)", iter,
                         s.t, h);
             return st;
         }
-
-        // [dq; dlambda] = -S_t^{-1} [r^q; r^lambda], solved in the scaled form (9)-(10).
-        count(counters, GA_COUNT_FACTORIZATIONS);
-        if (!S_.factorize_step(M_, tangents ? &C_ : nullptr, tangents ? &K_ : nullptr, Phi_q_, p,
-                               h, scaling))
-            return diag.fail(GA_ERR_SINGULAR,
-                             "iteration matrix S_t%s is singular (rcond = %.3g) in Newton "
-                             "iteration %d of the step from t = %.17g with h = %g",
-                             scaling ? " (scaled, eq. 10)" : " (unscaled)", S_.rcond(), iter,
-                             s.t, h);
-        S_.solve(rq_, phi_, dq_, dlambda_);
+        if (refresh) {
+            // S_t at the current iterate, in the scaled form (9)-(10).
+            count(counters, GA_COUNT_FACTORIZATIONS);
+            jacobian_valid_ = false;
+            if (!S_.factorize_step(M_, tangents_C ? &C_ : nullptr, tangents_K ? &K_ : nullptr,
+                                   J_, p, h, scaling))
+                return diag.fail(GA_ERR_SINGULAR,
+                                 "iteration matrix S_t%s is singular (rcond = %.3g) in Newton "
+                                 "iteration %d of the step from t = %.17g with h = %g",
+                                 scaling ? " (scaled, eq. 10)" : " (unscaled)", S_.rcond(), iter,
+                                 s.t, h);
+            jacobian_valid_ = true;
+            jacobian_h_ = h;
+            theta_prev_ = -1.0;
+            convergence_.matrix_changed();
+            refresh = false;
+        } else {
+            used_stale = true;
+        }
+        // [dq; dlambda] = -S_t^{-1} [r^q; r^lambda]
+        S_.solve(rq_, phi_, dq_, dlambda_, row_scale);
         count(counters, GA_COUNT_NEWTON_ITERS);
-        if (!all_finite(dq_) || !all_finite(dlambda_))
+        if (!dq_.allFinite() || !dlambda_.allFinite())
             return diag.fail(GA_ERR_NONFINITE,
                              "Newton increment is not finite in iteration %d of the step from "
                              "t = %.17g with h = %g",
@@ -162,22 +278,14 @@ ga_status Solver::attempt_step(double h)
         x.v += c.gamma_prime * dq_;
         x.qdd += c.beta_prime * dq_;
         x.lambda += dlambda_;
-        converged = convergence_.converged(newton_tol, dq_, c.beta_prime, dlambda_, x.q, x.qdd,
-                                           x.lambda);
+        const auto verdict = convergence_.check(newton_tol, dq_, c.beta_prime, dlambda_, x.q,
+                                                x.qdd, x.lambda);
+        converged = verdict == ConvergenceTest::Verdict::Converged;
+        // Too slow with an old matrix: rebuild it at the current iterate. Full Newton
+        // (GA_REUSE_NEVER, Algorithm 1 as printed) rebuilds at every iteration.
+        if (reuse == GA_REUSE_NEVER || (verdict == ConvergenceTest::Verdict::Slow && used_stale))
+            refresh = true;
     }
-    if (!converged)
-        return diag.fail(GA_ERR_NEWTON,
-                         "Newton iteration did not converge in %d iterations in the step from "
-                         "t = %.17g with h = %g (last increment / tolerance = %.3g)",
-                         max_iter, s.t, h, convergence_.ratio());
-    if (!all_finite(x.q) || !all_finite(x.v) || !all_finite(x.qdd) || !all_finite(x.lambda))
-        return diag.fail(GA_ERR_NONFINITE, "step from t = %.17g with h = %g produced a "
-                         "non-finite state", s.t, h);
-
-    // Algorithm 1, last line: a_{n+1} from eq. (3) with the converged qdd_{n+1}.
-    x.a = (p.alpha_f * s.qdd - p.alpha_m * s.a + (1.0 - p.alpha_f) * x.qdd) / (1.0 - p.alpha_m);
-    x.t = t1;
-    x.h_last = h;
     return GA_OK;
 }
 
@@ -200,6 +308,7 @@ void Solver::get_state(double *buf) const
         Eigen::Map<Vec>(p, x->size()) = *x;
         p += x->size();
     }
+    invalidate_jacobian();
 }
 
 ga_status Solver::set_state(const double *buf, std::size_t len)
@@ -218,7 +327,8 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
             return diag.fail(GA_ERR_ARG, "checkpoint entry %zu is not finite", k);
     if (!model.ready())
         return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
-    allocate_workspace();
+    if (auto st = setup())
+        return st;
     State &s = accepted_;
     s.t = buf[4];
     s.h_last = buf[5];
@@ -227,6 +337,7 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
         *x = Eigen::Map<const Vec>(p, x->size());
         p += x->size();
     }
+    invalidate_jacobian();
     initialized_ = true;
     return GA_OK;
 }

@@ -1,5 +1,6 @@
 // ga::Solver: the state (t, q, v, qdd, lambda, a), the options, and one step of Algorithm 1
-// with commit/rollback. The consistent start lives in init.cpp.
+// with commit/rollback and the reuse of the iteration matrix. The consistent start lives in
+// init.cpp.
 #pragma once
 
 #include <cstddef>
@@ -36,10 +37,17 @@ public:
     ga_predictor predictor = GA_PREDICTOR_CONSTANT_A;
     ga_init_mode init_mode = GA_INIT_PROJECT;
     double init_tol = 1e-10;
+    ga_reuse_mode reuse = GA_REUSE_AUTO;
+    ga_linear_solver linear_solver = GA_LINEAR_AUTO;
 
     Counters counters{};
     Diagnostics diag;
     Model model;
+
+    // Layout of the user's matrices (dense unless a pattern was declared); fixed at setup.
+    ModelMatrix &matrix(ga_matrix which);
+    bool setup_done() const { return workspace_ready_; }
+    const char *linear_backend() const { return S_.backend_name(); }
 
     bool initialized() const { return initialized_; }
     const State &state() const { return accepted_; }
@@ -47,18 +55,30 @@ public:
     ga_status init(double t0, const double *q0, const double *v0);  // init.cpp
     ga_status step(double h);
 
+    // Anything that changes the iteration matrix (options, callbacks) calls this.
+    void invalidate_jacobian() const
+    {
+        jacobian_valid_ = false;
+        theta_prev_ = -1.0;
+        mass_valid_ = false;
+    }
+
     double last_rcond() const { return S_.rcond(); }
     int last_newton_iters() const { return last_newton_iters_; }
     double last_newton_ratio() const { return convergence_.ratio(); }
 
-    // Checkpoint: [magic, version, n, m, t, h_last, q, v, qdd, lambda, a].
+    // Checkpoint: [magic, version, n, m, t, h_last, q, v, qdd, lambda, a]. Taking one also
+    // drops the reusable iteration matrix, so that the run continues exactly as a restart
+    // from the checkpoint does (the matrix is not part of the state).
     std::size_t state_size() const;
     void get_state(double *buf) const;
     ga_status set_state(const double *buf, std::size_t len);
 
 private:
-    void allocate_workspace();  // throws std::bad_alloc
+    ga_status setup();  // chooses the backend and allocates everything; throws std::bad_alloc
     ga_status attempt_step(double h);
+    ga_status newton(double h, bool refresh, bool &converged, bool &used_stale);
+    ga_status evaluate_mass(double t, const Vec &q);
     ga_status project_positions(double t, Vec &q);                  // init.cpp
     ga_status project_velocities(double t, const Vec &q, Vec &v);   // init.cpp
 
@@ -70,8 +90,14 @@ private:
     State accepted_;  // the last accepted step: never touched by a step that fails
     State trial_;     // the step being computed
 
+    // Reuse of the factorized iteration matrix across iterations and steps.
+    mutable bool jacobian_valid_ = false;
+    mutable double theta_prev_ = -1.0;  // contraction rate seen with the current matrix
+    mutable bool mass_valid_ = false;   // constant mass: M evaluated
+    double jacobian_h_ = 0.0;
+
     // Step workspace, sized once.
-    Mat M_, C_, K_, Phi_q_;
+    ModelMatrix M_, J_, K_, C_;
     Vec f_, phi_, rq_, dq_, dlambda_, c_;
     IterationMatrix S_;
     ConvergenceTest convergence_;

@@ -1,0 +1,46 @@
+// Linear algebra behind the iteration matrix: one interface, a dense and a sparse backend.
+//
+// Every matrix galpha factorizes has the saddle-point form
+//     S = [ cM M + cC C + cK K   Phi_q^T ]      (or I in the top-left block: projections)
+//         [ Phi_q                0       ]
+// The backend knows the layout of the blocks once (setup), assembles S in place from them
+// (factorize) and solves with the factors (solve). Neither allocates after setup.
+#pragma once
+
+#include <memory>
+
+#include "../matrix.hpp"
+
+namespace ga {
+
+struct SaddleBlocks {
+    const ModelMatrix *M = nullptr;  // null: identity in the top-left block
+    double cM = 1.0;
+    const ModelMatrix *C = nullptr;  // null: neglected
+    double cC = 0.0;
+    const ModelMatrix *K = nullptr;  // null: neglected
+    double cK = 0.0;
+    const ModelMatrix *J = nullptr;
+};
+
+class LinearBackend {
+public:
+    virtual ~LinearBackend() = default;
+    // Layouts of the blocks (patterns for the sparse backend); allocates everything.
+    virtual void setup(int n, int m, const ModelMatrix &M, const ModelMatrix &J,
+                       const ModelMatrix &K, const ModelMatrix &C) = 0;
+    // Assemble and factorize; false if singular or numerically singular.
+    virtual bool factorize(const SaddleBlocks &b) = 0;
+    virtual void solve(Vec &rhs) = 0;  // in place, length n + m
+    // Reciprocal condition estimate of the last factorization (dense: LAPACK dgecon, 1-norm;
+    // sparse: KLU's min |U_ii| / max |U_ii|).
+    virtual double rcond() const = 0;
+    virtual const char *name() const = 0;
+};
+
+enum class DenseKind { Lapack, Eigen };
+std::unique_ptr<LinearBackend> make_dense_backend(DenseKind kind);
+// nullptr when galpha was built without KLU.
+std::unique_ptr<LinearBackend> make_sparse_backend();
+
+}  // namespace ga

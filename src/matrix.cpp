@@ -1,0 +1,63 @@
+#include "matrix.hpp"
+
+namespace ga {
+
+void ModelMatrix::set_dense(int rows, int cols)
+{
+    rows_ = rows;
+    cols_ = cols;
+    dense_ = true;
+    row_.clear();
+    col_.clear();
+}
+
+void ModelMatrix::set_pattern(int rows, int cols, const int *row, const int *col, int nnz)
+{
+    rows_ = rows;
+    cols_ = cols;
+    dense_ = false;
+    row_.assign(row, row + nnz);
+    col_.assign(col, col + nnz);
+}
+
+void ModelMatrix::allocate()
+{
+    const Eigen::Index size = dense_ ? Eigen::Index(rows_) * cols_ : Eigen::Index(row_.size());
+    values_.setZero(size);
+}
+
+void ModelMatrix::copy_layout(const ModelMatrix &other)
+{
+    rows_ = other.rows_;
+    cols_ = other.cols_;
+    dense_ = other.dense_;
+    row_ = other.row_;
+    col_ = other.col_;
+    allocate();
+}
+
+void ModelMatrix::multiply_add(double alpha, const Vec &x, Vec &y) const
+{
+    if (dense_) {
+        if (rows_ > 0 && cols_ > 0)
+            y.noalias() += alpha * (as_dense() * x);
+        return;
+    }
+    const double *v = values_.data();
+    for (std::size_t k = 0; k < row_.size(); ++k)
+        y[row_[k]] += alpha * v[k] * x[col_[k]];
+}
+
+void ModelMatrix::multiply_transpose_add(double alpha, const Vec &x, Vec &y) const
+{
+    if (dense_) {
+        if (rows_ > 0 && cols_ > 0)
+            y.noalias() += alpha * (as_dense().transpose() * x);
+        return;
+    }
+    const double *v = values_.data();
+    for (std::size_t k = 0; k < row_.size(); ++k)
+        y[col_[k]] += alpha * v[k] * x[row_[k]];
+}
+
+}  // namespace ga
