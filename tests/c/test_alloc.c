@@ -13,6 +13,7 @@
 #include <galpha.h>
 
 #include "helpers.h"
+#include "scenes/chain.h"
 
 static volatile int armed = 0;
 static volatile long allocations = 0;
@@ -136,6 +137,44 @@ static void no_allocation_in_step(void **state)
     assert_int_equal(count_step_allocations(GA_TANGENT_NEGLECT, 0), 0);
 }
 
+/* The sparse path (KLU refactorization, grouped finite differences): no allocation either. */
+static long count_sparse_step_allocations(int exact_tangent)
+{
+    chain c = chain_make(300);
+    const int n = 3 * c.links, m = 2 * c.links;
+    double *q = malloc(sizeof(double) * n), *v = malloc(sizeof(double) * n);
+    ga_solver *s = NULL;
+    chain_initial(&c, q, v);
+    assert_int_equal(ga_create(n, m, &s), GA_OK);
+    assert_int_equal(chain_declare_patterns(&c, s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
+                                      chain_jacobian, &c),
+                     GA_OK);
+    if (exact_tangent)
+        assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
+    assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    allocations = 0;
+    armed = 1;
+    for (int i = 0; i < 30; ++i)
+        assert_int_equal(ga_step(s, 1e-3), GA_OK);
+    armed = 0;
+    long long factorizations = 0;
+    ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &factorizations);
+    assert_true(factorizations > 1); /* refactorizations did happen inside ga_step */
+    ga_free(s);
+    free(q);
+    free(v);
+    return allocations;
+}
+
+static void no_allocation_in_sparse_step(void **state)
+{
+    (void)state;
+    assert_int_equal(count_sparse_step_allocations(1), 0);
+    assert_int_equal(count_sparse_step_allocations(0), 0);
+}
+
 static void no_allocation_in_failing_step(void **state)
 {
     (void)state;
@@ -149,6 +188,7 @@ int main(void)
         cmocka_unit_test(counting_works),
         cmocka_unit_test(no_allocation_in_step),
         cmocka_unit_test(no_allocation_in_failing_step),
+        cmocka_unit_test(no_allocation_in_sparse_step),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,159 @@
+/* The sparse path on the N-link chain: the sparse (KLU) and dense solvers give the same steps,
+ * grouped finite differences reproduce the exact tangent at a few evaluations per matrix,
+ * and the energy of the chain is kept to the order of the integration error. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "helpers.h"
+#include "scenes/chain.h"
+
+typedef struct chain_run {
+    double *q, *lambda;
+    double energy_drift;
+    long long stiffness_evals, jacobian_evals, factorizations, steps;
+    char backend[32];
+} chain_run;
+
+static double energy(const chain *c, const double *q, const double *v)
+{
+    double e = 0.0;
+    for (int i = 0; i < c->links; ++i)
+        e += 0.5 * c->mass * (v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1]) +
+             0.5 * c->inertia * v[3 * i + 2] * v[3 * i + 2] + c->mass * c->gravity * q[3 * i + 1];
+    return e;
+}
+
+static chain_run run(int links, int solver, int exact_tangent, double h, int steps)
+{
+    chain c = chain_make(links);
+    const int n = 3 * links, m = 2 * links;
+    chain_run r;
+    double *q = malloc(sizeof(double) * n), *v = malloc(sizeof(double) * n);
+    ga_solver *s = NULL;
+    memset(&r, 0, sizeof r);
+    r.q = malloc(sizeof(double) * n);
+    r.lambda = malloc(sizeof(double) * m);
+    chain_initial(&c, q, v);
+    assert_int_equal(ga_create(n, m, &s), GA_OK);
+    assert_int_equal(chain_declare_patterns(&c, s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
+                                      chain_jacobian, &c),
+                     GA_OK);
+    if (exact_tangent)
+        assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
+    assert_int_equal(ga_set_constraint_accel(s, chain_constraint_accel), GA_OK);
+    assert_int_equal(ga_set_constant_mass(s, 1), GA_OK);
+    assert_int_equal(ga_set_linear_solver(s, solver), GA_OK);
+    assert_int_equal(ga_set_newton(s, 1e-10, 20), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    snprintf(r.backend, sizeof r.backend, "%s", ga_linear_solver_name(s));
+    const double e0 = energy(&c, q, v);
+    for (int k = 0; k < steps; ++k) {
+        const ga_status st = ga_step(s, h);
+        if (st)
+            fail_msg("step %d: %s", k, ga_last_error(s));
+        ga_get_q(s, q);
+        ga_get_v(s, v);
+        r.energy_drift = fmax(r.energy_drift, fabs(energy(&c, q, v) - e0));
+    }
+    ga_get_q(s, r.q);
+    ga_get_lambda(s, r.lambda);
+    ga_get_counter(s, GA_COUNT_STIFFNESS_EVALS, &r.stiffness_evals);
+    ga_get_counter(s, GA_COUNT_JACOBIAN_EVALS, &r.jacobian_evals);
+    ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &r.factorizations);
+    ga_get_counter(s, GA_COUNT_STEPS, &r.steps);
+    ga_free(s);
+    free(q);
+    free(v);
+    return r;
+}
+
+static void release(chain_run *r)
+{
+    free(r->q);
+    free(r->lambda);
+}
+
+static void sparse_and_dense_solvers_agree(void **state)
+{
+    (void)state;
+    const int links = 12;
+    chain_run sp = run(links, GA_LINEAR_SPARSE, 1, 2e-3, 100);
+    chain_run de = run(links, GA_LINEAR_DENSE_EIGEN, 1, 2e-3, 100);
+    chain_run la = run(links, GA_LINEAR_DENSE_LAPACK, 1, 2e-3, 100);
+    assert_string_equal(sp.backend, "sparse KLU");
+    assert_string_equal(de.backend, "dense Eigen LU");
+    assert_string_equal(la.backend, "dense LAPACK LU");
+    const double dq = max_abs_diff(sp.q, de.q, 3 * links);
+    const double dl = max_abs_diff(sp.lambda, de.lambda, 2 * links);
+    printf("  KLU vs Eigen LU: |dq| = %.1e, |dlambda| = %.1e; LAPACK vs Eigen |dq| = %.1e\n", dq,
+           dl, max_abs_diff(la.q, de.q, 3 * links));
+    assert_true(dq < 1e-9);
+    assert_true(dl < 1e-6);
+    assert_true(max_abs_diff(la.q, de.q, 3 * links) < 1e-9);
+    release(&sp);
+    release(&de);
+    release(&la);
+}
+
+static void grouped_finite_differences_match_exact_tangent(void **state)
+{
+    (void)state;
+    const int links = 40;
+    chain_run ex = run(links, GA_LINEAR_SPARSE, 1, 2e-3, 50);
+    chain_run fd = run(links, GA_LINEAR_SPARSE, 0, 2e-3, 50);
+    printf("  exact vs grouped FD tangent: |dq| = %.1e; FD: %lld Jacobian evaluations for %lld "
+           "stiffness matrices of a %d-link chain\n",
+           max_abs_diff(ex.q, fd.q, 3 * links), fd.jacobian_evals, fd.stiffness_evals, links);
+    assert_true(max_abs_diff(ex.q, fd.q, 3 * links) < 1e-9);
+    /* the stiffness pattern is diagonal: one group, so one extra Jacobian per K_t instead of
+     * 3N = 120 */
+    assert_true(fd.jacobian_evals - ex.jacobian_evals <= fd.stiffness_evals);
+    release(&ex);
+    release(&fd);
+}
+
+static void auto_choice_is_sparse_for_large_chains(void **state)
+{
+    (void)state;
+    chain_run big = run(200, GA_LINEAR_AUTO, 1, 1e-3, 5);
+    chain_run small = run(10, GA_LINEAR_AUTO, 1, 1e-3, 5);
+    assert_string_equal(big.backend, "sparse KLU");
+    assert_string_equal(small.backend, "dense Eigen LU");
+    release(&big);
+    release(&small);
+}
+
+static void energy_is_kept_to_integration_error(void **state)
+{
+    (void)state;
+    double hs[3], de[3];
+    for (int k = 0; k < 3; ++k) {
+        hs[k] = 4e-3 / (1 << k);
+        chain_run r = run(8, GA_LINEAR_SPARSE, 1, hs[k], (int)lround(0.4 / hs[k]));
+        de[k] = r.energy_drift;
+        release(&r);
+    }
+    const double o = fit_order(hs, de, 3);
+    printf("  8-link chain, max energy drift over 0.4 s: %.2e, %.2e, %.2e (order %.2f)\n", de[0],
+           de[1], de[2], o);
+    assert_true(o > 1.7);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(sparse_and_dense_solvers_agree),
+        cmocka_unit_test(grouped_finite_differences_match_exact_tangent),
+        cmocka_unit_test(auto_choice_is_sparse_for_large_chains),
+        cmocka_unit_test(energy_is_kept_to_integration_error),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
