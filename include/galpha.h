@@ -291,7 +291,10 @@ GA_API ga_status ga_set_constant_mass(ga_solver *s, int on);
 typedef enum ga_predictor {
     GA_PREDICTOR_CONSTANT_A = 0, /**< a_{n+1} = a_n, lambda_{n+1} = lambda_n (default): an O(h)
                                       accurate start, so fewer iterations */
-    GA_PREDICTOR_ZERO = 1        /**< Algorithm 1 verbatim: qdd_{n+1} = 0, lambda_{n+1} = 0 */
+    GA_PREDICTOR_ZERO = 1,       /**< Algorithm 1 verbatim: qdd_{n+1} = 0, lambda_{n+1} = 0 */
+    GA_PREDICTOR_EXTRAPOLATE = 2 /**< qdd_{n+1} extrapolated linearly with the third derivative
+                                      that a_n - qdd_n carries (= delta_alpha h q''' + O(h^2)),
+                                      lambda_{n+1} = lambda_n: an O(h^2) accurate start */
 } ga_predictor;
 
 /** predictor is a ::ga_predictor. Errors: GA_ERR_ARG, GA_ERR_STATE. */

@@ -9,11 +9,7 @@
 #include "params.hpp"
 #include "solver.hpp"
 
-struct ga_solver {
-    ga_solver(int n, int m) : core(n, m) {}
-    ga::Solver core;
-    bool busy = false;  // true while a call on this solver runs (and so inside its callbacks)
-};
+#include "capi_internal.hpp"
 
 namespace {
 
@@ -317,7 +313,8 @@ GA_API const char *ga_linear_solver_name(const ga_solver *s)
 GA_API ga_status ga_set_predictor(ga_solver *s, int predictor)
 {
     return guarded(s, [&](ga::Solver &c) {
-        if (predictor != GA_PREDICTOR_CONSTANT_A && predictor != GA_PREDICTOR_ZERO)
+        if (predictor != GA_PREDICTOR_CONSTANT_A && predictor != GA_PREDICTOR_ZERO &&
+            predictor != GA_PREDICTOR_EXTRAPOLATE)
             return c.diag.fail(GA_ERR_ARG, "unknown predictor %d", predictor);
         c.predictor = static_cast<ga_predictor>(predictor);
         return GA_OK;

@@ -158,7 +158,8 @@ ga_status Solver::step(double h)
 // One step of Algorithm 1 from accepted_ into trial_. accepted_ is only read.
 ga_status Solver::attempt_step(double h)
 {
-    bool refresh = reuse == GA_REUSE_NEVER || !jacobian_valid_ ||
+    // A matrix that was too slow in the last step would only waste an iteration here.
+    bool refresh = reuse == GA_REUSE_NEVER || !jacobian_valid_ || stale_was_slow_ ||
                    !h_within_reuse_band(jacobian_h_, h);
     bool converged = false, used_stale = false;
     last_newton_iters_ = 0;
@@ -205,9 +206,15 @@ ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_sta
     // Predictor (Algorithm 1, lines 1-7). The paper starts from qdd_{n+1} = 0, lambda = 0;
     // the default starts from a_{n+1} = a_n, lambda_{n+1} = lambda_n, i.e. the qdd_{n+1} that
     // eq. (3) maps to a_{n+1} = a_n. Both iterate to the same solution.
+    const double delta_alpha = p.alpha_m - p.alpha_f;
     if (predictor == GA_PREDICTOR_ZERO) {
         x.qdd.setZero();
         x.lambda.setZero();
+    } else if (predictor == GA_PREDICTOR_EXTRAPOLATE && delta_alpha != 0.0 && s.h_last > 0.0) {
+        // a_n - qdd_n = delta_alpha h_last qddd + O(h^2) (ALGORITHMS.md sec. 0), hence
+        // qdd(t_n + h) = qdd_n + (h / h_last) (a_n - qdd_n) / delta_alpha + O(h^2).
+        x.qdd = s.qdd + (h / (s.h_last * delta_alpha)) * (s.a - s.qdd);
+        x.lambda = s.lambda;
     } else {
         x.qdd = (s.a - p.alpha_f * s.qdd) / (1.0 - p.alpha_f);
         x.lambda = s.lambda;
@@ -221,6 +228,7 @@ ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_sta
     convergence_.reset(refresh ? -1.0 : theta_prev_);
     converged = false;
     used_stale = false;
+    bool refresh_done = false;
     for (int iter = 1; iter <= max_iter && !converged; ++iter) {
         last_newton_iters_ = iter;
         ga_status st = evaluate_mass(t1, x.q);
@@ -260,6 +268,7 @@ ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_sta
             theta_prev_ = -1.0;
             convergence_.matrix_changed();
             refresh = false;
+            refresh_done = true;
         } else {
             used_stale = true;
         }
@@ -283,9 +292,42 @@ ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_sta
         converged = verdict == ConvergenceTest::Verdict::Converged;
         // Too slow with an old matrix: rebuild it at the current iterate. Full Newton
         // (GA_REUSE_NEVER, Algorithm 1 as printed) rebuilds at every iteration.
+        if (verdict == ConvergenceTest::Verdict::Slow && used_stale)
+            stale_was_slow_ = true;
+        else if (converged && used_stale && !refresh_done)
+            stale_was_slow_ = false;  // the old matrix did the whole step: keep reusing
         if (reuse == GA_REUSE_NEVER || (verdict == ConvergenceTest::Verdict::Slow && used_stale))
             refresh = true;
     }
+    return GA_OK;
+}
+
+ga_status Solver::unavoidable_work(double h)
+{
+    const State &x = accepted_;
+    const double t = x.t + h;
+    ga_status st = evaluate_mass(t, x.q);
+    if (!st)
+        st = model.force(t, x.q, x.v, f_);
+    if (!st)
+        st = model.constraint(t, x.q, phi_);
+    if (!st)
+        st = model.jacobian(t, x.q, J_);
+    if (st)
+        return st;
+    Model::dynamics_residual(M_, x.qdd, f_, J_, x.lambda, rq_);
+    if (!jacobian_valid_) {
+        const bool K = model.stiffness_needed(K_), C = model.damping_needed(C_);
+        if (K && (st = model.stiffness(t, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_)))
+            return st;
+        if (C && (st = model.damping(t, x.q, x.v, f_, C_)))
+            return st;
+        if (!S_.factorize_step(M_, C ? &C_ : nullptr, K ? &K_ : nullptr, J_, params, h, scaling))
+            return GA_ERR_SINGULAR;
+        jacobian_valid_ = true;
+        jacobian_h_ = h;
+    }
+    S_.solve(rq_, phi_, dq_, dlambda_, step_row_scale(params, h, scaling));
     return GA_OK;
 }
 

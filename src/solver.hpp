@@ -61,7 +61,13 @@ public:
         jacobian_valid_ = false;
         theta_prev_ = -1.0;
         mass_valid_ = false;
+        stale_was_slow_ = false;
     }
+
+    // For bench/: the unavoidable work of a step, done once at the current state -- one
+    // residual evaluation (callbacks and r^q, r^lambda) and one solve with the factorization
+    // at hand (made first if there is none). The per-step cost is measured against it.
+    ga_status unavoidable_work(double h);
 
     double last_rcond() const { return S_.rcond(); }
     int last_newton_iters() const { return last_newton_iters_; }
@@ -94,6 +100,7 @@ private:
     mutable bool jacobian_valid_ = false;
     mutable double theta_prev_ = -1.0;  // contraction rate seen with the current matrix
     mutable bool mass_valid_ = false;   // constant mass: M evaluated
+    mutable bool stale_was_slow_ = false;  // the reused matrix was too slow in the last step
     double jacobian_h_ = 0.0;
 
     // Step workspace, sized once.

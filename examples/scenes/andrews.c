@@ -329,6 +329,84 @@ int an31_stiffness(double t, const double *q, const double *v, const double *qdd
     return 0;
 }
 
+/* ---- the 31-coordinate model with declared patterns ---------------------------------------- */
+ga_status an31_declare_patterns(ga_solver *s)
+{
+    int rm[21], cm[21], rj[90], cj[90], rk[11], ck[11], k = 0;
+    for (int i = 0; i < 21; ++i) /* bodies: x, y, theta; the points are massless */
+        rm[i] = cm[i] = i;
+    for (int l = 0; l < 15; ++l) {
+        const link *L = &links[l];
+        const int r = 2 * l, th = CM(L->body) + 2;
+        rj[k] = r, cj[k++] = L->p;
+        rj[k] = r + 1, cj[k++] = L->p + 1;
+        if (L->q >= 0) {
+            rj[k] = r, cj[k++] = L->q;
+            rj[k] = r + 1, cj[k++] = L->q + 1;
+        }
+        rj[k] = r, cj[k++] = th;
+        rj[k] = r + 1, cj[k++] = th;
+    }
+    for (int b = 1; b <= 7; ++b)
+        rk[b - 1] = ck[b - 1] = CM(b) + 2;
+    rk[7] = PD, ck[7] = PD;
+    rk[8] = PD, ck[8] = PD + 1;
+    rk[9] = PD + 1, ck[9] = PD;
+    rk[10] = PD + 1, ck[10] = PD + 1;
+    ga_status st = ga_set_pattern(s, GA_MATRIX_MASS, 21, rm, cm);
+    if (!st)
+        st = ga_set_pattern(s, GA_MATRIX_JACOBIAN, k, rj, cj);
+    if (!st)
+        st = ga_set_pattern(s, GA_MATRIX_STIFFNESS, 11, rk, ck);
+    if (!st)
+        st = ga_set_pattern(s, GA_MATRIX_DAMPING, 0, NULL, NULL);
+    return st;
+}
+
+int an31_mass_sparse(double t, const double *q, double *M, void *user)
+{
+    (void)t, (void)q, (void)user;
+    for (int b = 1; b <= 7; ++b) {
+        M[CM(b)] = M[CM(b) + 1] = body_mass[b];
+        M[CM(b) + 2] = body_inertia[b];
+    }
+    return 0;
+}
+
+int an31_jacobian_sparse(double t, const double *q, double *J, void *user)
+{
+    int k = 0;
+    (void)t, (void)user;
+    for (int l = 0; l < 15; ++l) {
+        const link *L = &links[l];
+        double dr[2];
+        rotate(q[CM(L->body) + 2], L->b, -L->a, dr);
+        J[k++] = 1.0;
+        J[k++] = 1.0;
+        if (L->q >= 0) {
+            J[k++] = -1.0;
+            J[k++] = -1.0;
+        }
+        J[k++] = dr[0];
+        J[k++] = dr[1];
+    }
+    return 0;
+}
+
+int an31_stiffness_sparse(double t, const double *q, const double *v, const double *qdd,
+                          const double *lambda, double *K, void *user)
+{
+    double Kd[AN31_N * AN31_N];
+    an31_stiffness(t, q, v, qdd, lambda, Kd, user);
+    for (int b = 1; b <= 7; ++b)
+        K[b - 1] = Kd[(CM(b) + 2) * (AN31_N + 1)];
+    K[7] = Kd[PD + AN31_N * PD];
+    K[8] = Kd[PD + AN31_N * (PD + 1)];
+    K[9] = Kd[(PD + 1) + AN31_N * PD];
+    K[10] = Kd[(PD + 1) + AN31_N * (PD + 1)];
+    return 0;
+}
+
 static void absolute_angles(const double *q7, double *th)
 {
     th[1] = q7[BE];

@@ -15,6 +15,8 @@
 #ifndef GALPHA_SCENE_ANDREWS_H
 #define GALPHA_SCENE_ANDREWS_H
 
+#include <galpha.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -54,6 +56,15 @@ int an31_constraint_accel(double t, const double *q, const double *v, double *ou
 /* K_t = d(Phi_q^T lambda)/dq - df/dq (M is constant): rotation terms and the spring at D. */
 int an31_stiffness(double t, const double *q, const double *v, const double *qdd,
                    const double *lambda, double *K, void *user);
+/* The same model for a sparse solver: declares the patterns of M (the 21 body entries), Phi_q
+ * (4 or 6 entries per constraint pair), K_t (the 7 rotations and the spring point D) and C_t
+ * (empty: no velocity-dependent force), and callbacks that write the values in that order. */
+ga_status an31_declare_patterns(ga_solver *s);
+int an31_mass_sparse(double t, const double *q, double *M, void *user);
+int an31_jacobian_sparse(double t, const double *q, double *J, void *user);
+int an31_stiffness_sparse(double t, const double *q, const double *v, const double *qdd,
+                          const double *lambda, double *K, void *user);
+
 /* Consistent absolute coordinates and velocities from the 7 angles and their rates. */
 void an31_from_angles(const double *q7, const double *v7, double *q31, double *v31);
 /* The 7 Test Set angles from absolute coordinates. */

@@ -70,23 +70,37 @@ public:
             S_.topRightCorner(n_, m_) = S_.bottomLeftCorner(m_, n_).transpose();
         }
         const int N = n_ + m_;
-        const double anorm = dlange_("1", &N, &N, S_.data(), &N, work_.data(), 1);
-        const double *lu = nullptr;
+        // 1-norm of S now (the factors overwrite it); the condition estimate itself (dgecon,
+        // as expensive as the LU for small sizes) is computed only when asked for.
+        anorm_ = dlange_("1", &N, &N, S_.data(), &N, work_.data(), 1);
+        rcond_valid_ = false;
         if (kind_ == DenseKind::Lapack) {
             int info = 0;
             dgetrf_(&N, &N, S_.data(), &N, ipiv_.data(), &info);
             if (info > 0) {  // exact zero pivot
-                rcond_ = 0.0;
+                pivot_ratio_ = 0.0;
                 return false;
             }
-            lu = S_.data();
         } else {
             eigen_lu_.compute(S_);
-            lu = eigen_lu_.matrixLU().data();
         }
-        int info = 0;
-        dgecon_("1", &N, lu, &N, &anorm, &rcond_, work_.data(), iwork_.data(), &info, 1);
-        return rcond_ >= std::numeric_limits<double>::epsilon();
+        // Singular in double precision when the pivots span more than 1/(N eps).
+        const auto U = factors().diagonal().cwiseAbs();
+        const double umax = U.maxCoeff();
+        pivot_ratio_ = umax > 0.0 ? U.minCoeff() / umax : 0.0;
+        return pivot_ratio_ >= N * std::numeric_limits<double>::epsilon();
+    }
+
+    double rcond() const override
+    {
+        if (!rcond_valid_ && pivot_ratio_ > 0.0) {
+            const int N = n_ + m_;
+            int info = 0;
+            dgecon_("1", &N, factors().data(), &N, &anorm_, &rcond_, work_.data(), iwork_.data(),
+                    &info, 1);
+            rcond_valid_ = true;
+        }
+        return pivot_ratio_ > 0.0 ? rcond_ : 0.0;
     }
 
     void solve(Vec &rhs) override
@@ -102,7 +116,6 @@ public:
         dgetrs_("N", &N, &nrhs, S_.data(), &N, ipiv_.data(), rhs.data(), &N, &info, 1);
     }
 
-    double rcond() const override { return rcond_; }
     const char *name() const override
     {
         return kind_ == DenseKind::Lapack ? "dense LAPACK LU" : "dense Eigen LU";
@@ -111,11 +124,20 @@ public:
 private:
     DenseKind kind_;
     int n_ = 0, m_ = 0;
+    const Mat &factors() const
+    {
+        return kind_ == DenseKind::Lapack ? S_ : eigen_lu_.matrixLU();
+    }
+
     Mat S_;
-    Eigen::VectorXi ipiv_, iwork_;
-    Vec work_, x_;
+    mutable Eigen::VectorXi iwork_;
+    Eigen::VectorXi ipiv_;
+    mutable Vec work_;
+    Vec x_;
     Eigen::PartialPivLU<Mat> eigen_lu_;
-    double rcond_ = 0.0;
+    double anorm_ = 0.0, pivot_ratio_ = 0.0;
+    mutable double rcond_ = 0.0;
+    mutable bool rcond_valid_ = false;
 };
 
 }  // namespace
