@@ -108,7 +108,8 @@ Result measure(const Scene &sc, int solver, double tol, int repeats)
             // the unavoidable work at the final state, with the factorization at hand
             ga::Solver &core = s->core;
             core.unavoidable_work(sc.h);  // makes a factorization if there is none
-            const int reps = std::max(20, static_cast<int>(2000 / std::max(1L, steps / 100)));
+            // about a second of repetitions whatever the size
+            const int reps = std::max(3, static_cast<int>(2e5 / (sc.n + sc.m)));
             double best = 1e300;
             for (int block = 0; block < 5; ++block) {
                 const auto t1 = clock_type::now();

@@ -289,12 +289,14 @@ GA_API ga_status ga_set_constant_mass(ga_solver *s, int on);
 
 /** Newton predictor. Both converge to the same step solution (to the Newton tolerance). */
 typedef enum ga_predictor {
-    GA_PREDICTOR_CONSTANT_A = 0, /**< a_{n+1} = a_n, lambda_{n+1} = lambda_n (default): an O(h)
-                                      accurate start, so fewer iterations */
+    GA_PREDICTOR_CONSTANT_A = 0, /**< a_{n+1} = a_n, lambda_{n+1} = lambda_n: an O(h) accurate
+                                      start (gena's predictor) */
     GA_PREDICTOR_ZERO = 1,       /**< Algorithm 1 verbatim: qdd_{n+1} = 0, lambda_{n+1} = 0 */
     GA_PREDICTOR_EXTRAPOLATE = 2 /**< qdd_{n+1} extrapolated linearly with the third derivative
                                       that a_n - qdd_n carries (= delta_alpha h q''' + O(h^2)),
-                                      lambda_{n+1} = lambda_n: an O(h^2) accurate start */
+                                      lambda_{n+1} = lambda_n: an O(h^2) accurate start
+                                      (default; the constant-a predictor when rho_inf = 1, where
+                                      delta_alpha = 0, and in the first step) */
 } ga_predictor;
 
 /** predictor is a ::ga_predictor. Errors: GA_ERR_ARG, GA_ERR_STATE. */
@@ -329,9 +331,10 @@ GA_API ga_status ga_set_pattern(ga_solver *s, int which, int nnz, const int *row
                                 const int *cols);
 
 typedef enum ga_linear_solver {
-    GA_LINEAR_AUTO = 0,         /**< sparse when the patterns allow it and n + m >= 200,
-                                     dense otherwise (default) */
-    GA_LINEAR_DENSE = 1,        /**< dense LU, the faster implementation for the size */
+    GA_LINEAR_AUTO = 0,         /**< sparse when the patterns allow it and n + m >= 10, dense
+                                     otherwise (default; measured in bench/linear_algebra) */
+    GA_LINEAR_DENSE = 1,        /**< dense LU: Eigen's, faster than reference LAPACK's at every
+                                     size measured */
     GA_LINEAR_SPARSE = 2,       /**< sparse LU (KLU); needs the patterns */
     GA_LINEAR_DENSE_LAPACK = 3, /**< dense LU by LAPACK dgetrf/dgetrs */
     GA_LINEAR_DENSE_EIGEN = 4   /**< dense LU by Eigen's PartialPivLU */

@@ -34,7 +34,7 @@ public:
     double newton_tol = 1e-10;
     int max_iter = 20;
     bool scaling = true;
-    ga_predictor predictor = GA_PREDICTOR_CONSTANT_A;
+    ga_predictor predictor = GA_PREDICTOR_EXTRAPOLATE;
     ga_init_mode init_mode = GA_INIT_PROJECT;
     double init_tol = 1e-10;
     ga_reuse_mode reuse = GA_REUSE_AUTO;

@@ -8,8 +8,8 @@ chain chain_make(int links)
 {
     chain c;
     c.links = links;
-    c.length = 1.0 / links;
-    c.mass = 1.0 / links;
+    c.length = 1.0;
+    c.mass = 1.0;
     c.inertia = c.mass * c.length * c.length / 12.0;
     c.gravity = 9.81;
     return c;

@@ -1,8 +1,9 @@
 /* A planar chain of N rigid links hanging from a fixed pin, in absolute coordinates: per link
  * the centre of mass (x, y) and the angle theta (3N coordinates); the first link's start is
  * pinned at the origin and every other link's start is pinned to the previous link's end (2N
- * constraints). Gravity only. The chain has total length 1 m and mass 1 kg whatever N is
- * (slender links, I = m L^2 / 12), and starts straight and horizontal, at rest.
+ * constraints). Gravity only. Every link is a slender bar of 1 m and 1 kg (I = m L^2 / 12), so
+ * the iteration matrix is equally well scaled for every N; the chain starts straight and
+ * horizontal, at rest, and falls.
  *
  * The callbacks are written for declared sparsity patterns (ga_set_pattern): they fill values
  * in the order given by chain_pattern(). Everything is O(N). */

@@ -1,0 +1,149 @@
+// Dense LU by Eigen against LAPACK's dgetrf/dgetrs, and both against the sparse KLU path, on
+// real iteration matrices: those of the paper's scenes (dense) and of the N-link chain (dense
+// and sparse, from the same declared pattern). Factorization includes the assembly of S_t from
+// its blocks, as in a step. CSV on stdout; scripts/bench.sh turns it into a chart.
+#include <chrono>
+#include <cstdio>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "linear/iteration_matrix.hpp"
+extern "C" {
+#include "scenes/andrews.h"
+#include "scenes/chain.h"
+#include "scenes/slider_crank.h"
+}
+
+namespace {
+
+struct Blocks {
+    int n = 0, m = 0;
+    ga::ModelMatrix M, J, K, C;
+};
+
+// Blocks of a dense scene at its initial state.
+Blocks dense_blocks(int n, int m, ga_mass_fn mass, ga_jacobian_fn jac, void *user,
+                    const double *q)
+{
+    Blocks b;
+    b.n = n;
+    b.m = m;
+    b.M.set_dense(n, n);
+    b.J.set_dense(m, n);
+    b.K.set_dense(n, n);
+    b.C.set_dense(n, n);
+    for (auto *A : {&b.M, &b.J, &b.K, &b.C})
+        A->allocate();
+    mass(0.0, q, b.M.data(), user);
+    jac(0.0, q, b.J.data(), user);
+    return b;
+}
+
+// Blocks of the chain, as declared patterns (sparse) or dense matrices filled from them.
+Blocks chain_blocks(const chain &c, bool sparse)
+{
+    Blocks b;
+    b.n = 3 * c.links;
+    b.m = 2 * c.links;
+    std::vector<double> q(b.n), v(b.n);
+    chain_initial(&c, q.data(), v.data());
+    std::vector<ga::ModelMatrix *> mats = {&b.M, &b.J, &b.K, &b.C};
+    for (int which = 0; which < 4; ++which) {
+        const int rows = which == GA_MATRIX_JACOBIAN ? b.m : b.n;
+        const int nnz = chain_pattern(&c, which, nullptr, nullptr);
+        std::vector<int> r(nnz), cc(nnz);
+        chain_pattern(&c, which, r.data(), cc.data());
+        ga::ModelMatrix pattern;
+        pattern.set_pattern(rows, b.n, r.data(), cc.data(), nnz);
+        pattern.allocate();
+        if (which == GA_MATRIX_MASS)
+            chain_mass(0.0, q.data(), pattern.data(), const_cast<chain *>(&c));
+        if (which == GA_MATRIX_JACOBIAN)
+            chain_jacobian(0.0, q.data(), pattern.data(), const_cast<chain *>(&c));
+        if (sparse) {
+            *mats[which] = pattern;
+        } else {
+            mats[which]->set_dense(rows, b.n);
+            mats[which]->allocate();
+            for (int k = 0; k < nnz; ++k)
+                mats[which]->as_dense()(r[k], cc[k]) += pattern.data()[k];
+        }
+    }
+    return b;
+}
+
+double time_per_call(const std::function<void()> &f)
+{
+    using clk = std::chrono::steady_clock;
+    double best = 1e300;
+    int reps = 1;
+    for (;;) {  // grow the repetitions until a block takes 20 ms
+        const auto t0 = clk::now();
+        for (int r = 0; r < reps; ++r)
+            f();
+        const double dt = std::chrono::duration<double>(clk::now() - t0).count();
+        if (dt > 0.02) {
+            best = dt / reps;
+            break;
+        }
+        reps *= 2;
+    }
+    for (int block = 0; block < 4; ++block) {
+        const auto t0 = clk::now();
+        for (int r = 0; r < reps; ++r)
+            f();
+        best = std::min(best, std::chrono::duration<double>(clk::now() - t0).count() / reps);
+    }
+    return best;
+}
+
+void measure(const std::string &matrix, Blocks &b, const char *backend_name,
+             std::unique_ptr<ga::LinearBackend> backend)
+{
+    ga::IterationMatrix S;
+    S.setup(std::move(backend), b.n, b.m, b.M, b.J, b.K, b.C);
+    ga::Params p = ga::params_from_rho_inf(0.7);
+    const double h = 1e-3;
+    if (!S.factorize_step(b.M, nullptr, nullptr, b.J, p, h, true)) {
+        std::fprintf(stderr, "%s: singular\n", matrix.c_str());
+        return;
+    }
+    ga::Vec r1 = ga::Vec::Ones(b.n), r2 = ga::Vec::Ones(b.m), x1(b.n), x2(b.m);
+    const double tf = time_per_call([&] { S.factorize_step(b.M, nullptr, nullptr, b.J, p, h, true); });
+    const double ts = time_per_call([&] { S.solve(r1, r2, x1, x2, p.beta * h * h); });
+    std::printf("%s,%d,%s,%.4f,%.4f\n", matrix.c_str(), b.n + b.m, backend_name, 1e6 * tf,
+                1e6 * ts);
+    std::fflush(stdout);
+}
+
+}  // namespace
+
+int main()
+{
+    std::printf("matrix,size,backend,factorize_us,solve_us\n");
+    slider_crank scp = slider_crank_paper();
+    double qs[SC_N], vs[SC_N], q31[AN31_N], v31[AN31_N], v7[7] = {0};
+    sc_initial(&scp, 1.5707963267948966, qs, vs);
+    an31_from_angles(andrews_q0, v7, q31, v31);
+    struct Dense {
+        const char *name;
+        Blocks b;
+    } scenes[] = {
+        {"andrews7", dense_blocks(AN7_N, AN7_M, an7_mass, an7_jacobian, nullptr, andrews_q0)},
+        {"slider_crank", dense_blocks(SC_N, SC_M, sc_mass, sc_jacobian, &scp, qs)},
+        {"andrews31", dense_blocks(AN31_N, AN31_M, an31_mass, an31_jacobian, nullptr, q31)},
+    };
+    for (auto &s : scenes) {
+        measure(s.name, s.b, "eigen", ga::make_dense_backend(ga::DenseKind::Eigen));
+        measure(s.name, s.b, "lapack", ga::make_dense_backend(ga::DenseKind::Lapack));
+    }
+    for (int links : {2, 4, 8, 16, 32, 64, 128, 256}) {
+        const chain c = chain_make(links);
+        Blocks dense = chain_blocks(c, false), sparse = chain_blocks(c, true);
+        measure("chain", dense, "eigen", ga::make_dense_backend(ga::DenseKind::Eigen));
+        measure("chain", dense, "lapack", ga::make_dense_backend(ga::DenseKind::Lapack));
+        measure("chain", sparse, "klu", ga::make_sparse_backend());
+    }
+    return 0;
+}
