@@ -158,9 +158,14 @@ ga_status Solver::step(double h)
 // One step of Algorithm 1 from accepted_ into trial_. accepted_ is only read.
 ga_status Solver::attempt_step(double h)
 {
-    // A matrix that was too slow in the last step would only waste an iteration here.
-    bool refresh = reuse == GA_REUSE_NEVER || !jacobian_valid_ || stale_was_slow_ ||
+    // After a reused matrix was too slow, the next steps start with a fresh one; how many
+    // doubles with every failed attempt to reuse (up to 32) and resets when reuse works.
+    const bool skip_reuse = refresh_steps_left_ > 0;
+    if (skip_reuse)
+        --refresh_steps_left_;
+    bool refresh = reuse == GA_REUSE_NEVER || !jacobian_valid_ || skip_reuse ||
                    !h_within_reuse_band(jacobian_h_, h);
+    reuse_attempted_ = !refresh;
     bool converged = false, used_stale = false;
     last_newton_iters_ = 0;
     if (auto st = newton(h, refresh, converged, used_stale))
@@ -292,10 +297,13 @@ ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_sta
         converged = verdict == ConvergenceTest::Verdict::Converged;
         // Too slow with an old matrix: rebuild it at the current iterate. Full Newton
         // (GA_REUSE_NEVER, Algorithm 1 as printed) rebuilds at every iteration.
-        if (verdict == ConvergenceTest::Verdict::Slow && used_stale)
-            stale_was_slow_ = true;
-        else if (converged && used_stale && !refresh_done)
-            stale_was_slow_ = false;  // the old matrix did the whole step: keep reusing
+        if (verdict == ConvergenceTest::Verdict::Slow && used_stale && reuse_attempted_ &&
+            !refresh_done) {
+            reuse_backoff_ = std::min(2 * reuse_backoff_, 32);
+            refresh_steps_left_ = reuse_backoff_;
+        } else if (converged && reuse_attempted_ && !refresh_done) {
+            reuse_backoff_ = 1;  // the old matrix did the whole step: keep reusing
+        }
         if (reuse == GA_REUSE_NEVER || (verdict == ConvergenceTest::Verdict::Slow && used_stale))
             refresh = true;
     }

@@ -61,7 +61,8 @@ public:
         jacobian_valid_ = false;
         theta_prev_ = -1.0;
         mass_valid_ = false;
-        stale_was_slow_ = false;
+        refresh_steps_left_ = 0;
+        reuse_backoff_ = 1;
     }
 
     // For bench/: the unavoidable work of a step, done once at the current state -- one
@@ -100,7 +101,9 @@ private:
     mutable bool jacobian_valid_ = false;
     mutable double theta_prev_ = -1.0;  // contraction rate seen with the current matrix
     mutable bool mass_valid_ = false;   // constant mass: M evaluated
-    mutable bool stale_was_slow_ = false;  // the reused matrix was too slow in the last step
+    mutable int refresh_steps_left_ = 0;  // steps to start with a fresh matrix
+    mutable int reuse_backoff_ = 1;       // ... after the next failed attempt to reuse
+    bool reuse_attempted_ = false;        // this step started with an old matrix
     double jacobian_h_ = 0.0;
 
     // Step workspace, sized once.
