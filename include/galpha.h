@@ -110,8 +110,9 @@ typedef enum ga_status {
     GA_ERR_NEWTON = -8,         /**< Newton iteration did not converge in max_iter iterations */
     GA_ERR_INCONSISTENT = -9,   /**< initial values violate the constraints and were not, or
                                      could not be, projected onto them */
-    GA_ERR_INTERNAL = -10       /**< unexpected internal error, including a C++ exception thrown
+    GA_ERR_INTERNAL = -10,      /**< unexpected internal error, including a C++ exception thrown
                                      by a user callback written in C++ */
+    GA_ERR_STEP_SIZE = -11      /**< adaptive mode: the step size fell below its minimum */
 } ga_status;
 
 /** Fixed English name of a status (a ::ga_status value), e.g. "invalid argument"; "unknown
@@ -350,6 +351,77 @@ GA_API const char *ga_linear_solver_name(const ga_solver *s);
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */
+/** @name Formulation and variable step size */
+/**@{*/
+typedef enum ga_formulation {
+    GA_INDEX3 = 0,           /**< the paper's index-3 formulation (default) */
+    GA_INDEX2_STABILIZED = 1 /**< stabilized index-2 form of Arnold & Hante (GGL type): an extra
+                                  multiplier eta bends the position update along
+                                  Phi_q(q_n)^T so that the velocity constraint
+                                  Phi_q v + Phi_t = 0 holds at every step too. Multipliers stay
+                                  second order across step-size changes (index 3: an O(h) burst
+                                  after every change) and are far less sensitive to round-off
+                                  for small h; recommended with adaptive steps. Same callbacks
+                                  (Phi_t by finite differences); dense linear algebra only. */
+} ga_formulation;
+
+/** formulation is a ::ga_formulation. Errors: GA_ERR_ARG (also: index-2 with a sparse solver
+ *  already set up), GA_ERR_STATE. */
+GA_API ga_status ga_set_formulation(ga_solver *s, int formulation);
+
+/** Rescale the stored a_n to the size of the coming step, a_n <- qdd_n + (h/h_last)(a_n -
+ *  qdd_n), when h changes (1, default), or not (0). Without it the method drops to first order
+ *  when h changes often (ALGORITHMS.md sec. 1.1); the switch exists to show that.
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_rescale(ga_solver *s, int on);
+
+/** Corrected starting values (1, default) for the first step after ga_init: a_0 = qdd_0 +
+ *  delta_alpha h qddd_0 (qddd_0 from two extra consistent-acceleration solves) and, in the
+ *  index-3 formulation, an O(h^2) velocity offset along the constraint normals, so that
+ *  lambda has no O(h) start-up transient. 0: a_0 = qdd_0 as eq. (3) of the paper.
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_corrected_start(ga_solver *s, int on);
+
+/** Tolerances of adaptive mode: a step is accepted when the weighted RMS norm of its local
+ *  error estimates, e_i / (atol + rtol max(|y_i(t_n)|, |y_i(t_n+1)|)) over the positions and
+ *  velocities (multipliers excluded), is at most 1. Defaults 1e-6, 1e-6.
+ *  Errors: GA_ERR_ARG (rtol or atol not positive and finite), GA_ERR_STATE. */
+GA_API ga_status ga_set_tolerances(ga_solver *s, double rtol, double atol);
+
+/** Bounds of adaptive step sizes: h_min (0: 16 eps max(|t|, 1)) and h_max (0: none).
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_step_limits(ga_solver *s, double h_min, double h_max);
+
+/** Size of the first adaptive step (0, default: estimated from q, v, qdd and the tolerances).
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_initial_step(ga_solver *s, double h0);
+
+/** One adaptive step, of the size the controller proposes but not beyond t_stop (> t); a step
+ *  that reaches t_stop lands on it exactly. Steps rejected by the error test (counter
+ *  GA_COUNT_REJECTED_STEPS) or by a recoverable failure (Newton, callback > 0, NaN, singular
+ *  matrix; GA_COUNT_FAILED_STEPS) are retried smaller until one is accepted.
+ *  Error estimate (position, ALGORITHMS.md sec. 1.5a): h^2 (beta + delta_alpha/2 - 1/6)
+ *  (a_n+1 - a_n); velocity (sec. 1.5b) from the divided differences of a over two steps.
+ *  Controller: PI (Gustafsson), safety 0.9, growth at most 2 and not on consecutive steps nor
+ *  right after a rejection, a dead band [1, 1.2] that keeps h, shrink at least 0.2.
+ *  Use with ga_interpolate for output at user times without shortening steps.
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE, GA_ERR_STEP_SIZE, fatal callback failures, and the
+ *  statuses of ga_step. On failure the state is that of the last accepted step. */
+GA_API ga_status ga_step_adaptive(ga_solver *s, double t_stop);
+
+/** Adaptive steps until t_out (>= t), landing on it exactly (ga_get_t then returns t_out).
+ *  Errors: as ga_step_adaptive; steps accepted before a failure are kept. */
+GA_API ga_status ga_advance(ga_solver *s, double t_out);
+
+/** Dense output inside the last step [t_prev, t]: q and v by cubic Hermite interpolation
+ *  (from q, v, qdd at both ends; third-order local accuracy), lambda linear. Any of q (n), v
+ *  (n), lambda (m) may be NULL. Errors: GA_ERR_ARG (t outside the last step), GA_ERR_STATE
+ *  (no step since ga_init or ga_set_state). */
+GA_API ga_status ga_interpolate(const ga_solver *s, double t, double *q, double *v,
+                                double *lambda);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
 /** @name Consistent start */
 /**@{*/
 /** Optional callback for the constraint acceleration term (finite differences of Phi_q and Phi
@@ -391,11 +463,15 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
 /**@}*/
 
 /** @name Checkpoint and restart
- *  The full state (t, h_last, q, v, qdd, lambda, a) as a flat array of doubles, so a host
- *  simulator can save, restore and restart: a run restarted from a checkpoint continues
- *  bit-identically. The layout is [magic, layout version, n, m, t, h_last, q(n), v(n),
- *  qdd(n), lambda(m), a(n)]; treat it as opaque. ga_set_state needs callbacks set, allocates
- *  like ga_init (when the solver was not initialized) and makes the solver initialized. */
+ *  The full state as a flat array of doubles, so a host simulator can save, restore and
+ *  restart: a run restarted from a checkpoint continues bit-identically, in fixed-step and in
+ *  adaptive mode. Layout 2: [magic, layout version, n, m, t, h_last, h_next, err_prev, grew,
+ *  q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n)] (h_next, err_prev, grew: the step-size
+ *  controller; a_prev: the a of the step before, for the error estimate); treat it as opaque.
+ *  The factorized iteration matrix is not part of it: taking a checkpoint makes the next step
+ *  start with a fresh one, as a restart does. ga_set_state needs callbacks set, allocates like
+ *  ga_init (when the solver was not initialized) and makes the solver initialized; dense
+ *  output (ga_interpolate) is available again after the next step. */
 /**@{*/
 /** Number of doubles in a checkpoint. Errors: GA_ERR_ARG. */
 GA_API ga_status ga_state_size(const ga_solver *s, size_t *len);
@@ -413,7 +489,8 @@ GA_API ga_status ga_set_state(ga_solver *s, const double *buf, size_t len);
 /**@{*/
 typedef enum ga_counter {
     GA_COUNT_STEPS = 0,          /**< accepted steps */
-    GA_COUNT_FAILED_STEPS = 1,   /**< ga_step calls that failed after starting the step */
+    GA_COUNT_FAILED_STEPS = 1,   /**< step attempts that failed (Newton, callbacks, NaN,
+                                      singular matrix), in ga_step or inside adaptive steps */
     GA_COUNT_NEWTON_ITERS = 2,   /**< Newton iterations (linear solves in ga_step) */
     GA_COUNT_FACTORIZATIONS = 3, /**< LU factorizations (including ga_init's) */
     GA_COUNT_RESIDUALS = 4,      /**< evaluations of the residual (r^q, r^lambda) */
@@ -423,9 +500,12 @@ typedef enum ga_counter {
     GA_COUNT_JACOBIAN_EVALS = 8, /**< constraint Jacobian callback calls */
     GA_COUNT_STIFFNESS_EVALS = 9, /**< K_t evaluations (callback or finite differences) */
     GA_COUNT_DAMPING_EVALS = 10, /**< C_t evaluations (callback or finite differences) */
-    GA_COUNT_ACCEL_EVALS = 11    /**< constraint acceleration term evaluations */
+    GA_COUNT_ACCEL_EVALS = 11,   /**< constraint acceleration term evaluations */
+    GA_COUNT_REJECTED_STEPS = 12 /**< adaptive mode: steps rejected by the error test (steps
+                                      whose Newton iteration or callbacks failed count in
+                                      GA_COUNT_FAILED_STEPS) */
 } ga_counter;
-#define GA_COUNTER_COUNT 12
+#define GA_COUNTER_COUNT 13
 
 /** Value of the counter `key` (a ::ga_counter). Errors: GA_ERR_ARG (NULL or unknown key),
  *  GA_ERR_STATE. */
@@ -442,10 +522,13 @@ typedef enum ga_info {
                                    iteration matrix factorized last, as solved: scaled by
                                    eq. (10) or not; 1/value is its condition number */
     GA_INFO_NEWTON_ITERS = 1, /**< Newton iterations of the last ga_step (accepted or not) */
-    GA_INFO_NEWTON_RATIO = 2  /**< last increment / tolerance ratio of that step's stopping
+    GA_INFO_NEWTON_RATIO = 2, /**< last increment / tolerance ratio of that step's stopping
                                    test (<= 1 means converged by the relative test) */
+    GA_INFO_ERROR_ESTIMATE = 3, /**< adaptive mode: weighted error norm of the last step
+                                     attempted (<= 1: accepted) */
+    GA_INFO_H_NEXT = 4          /**< adaptive mode: step size the controller proposes next */
 } ga_info;
-#define GA_INFO_COUNT 3
+#define GA_INFO_COUNT 5
 
 /** Value of the diagnostic `key` (a ::ga_info); 0 before anything was computed.
  *  Errors: GA_ERR_ARG (NULL or unknown key), GA_ERR_STATE (from a callback). */

@@ -88,6 +88,7 @@ GA_API const char *ga_strerror(int status)
     case GA_ERR_NEWTON: return "Newton iteration did not converge";
     case GA_ERR_INCONSISTENT: return "inconsistent initial values";
     case GA_ERR_INTERNAL: return "internal error";
+    case GA_ERR_STEP_SIZE: return "step size below its minimum";
     }
     return "unknown status";
 }
@@ -310,6 +311,109 @@ GA_API const char *ga_linear_solver_name(const ga_solver *s)
     return s->core.linear_backend();
 }
 
+GA_API ga_status ga_set_formulation(ga_solver *s, int formulation)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (formulation != GA_INDEX3 && formulation != GA_INDEX2_STABILIZED)
+            return c.diag.fail(GA_ERR_ARG, "unknown formulation %d", formulation);
+        if (formulation == GA_INDEX2_STABILIZED && !c.index2_available())
+            return c.diag.fail(GA_ERR_ARG, "the stabilized index-2 formulation needs a dense "
+                               "solver; this one was set up sparse");
+        c.formulation = static_cast<ga_formulation>(formulation);
+        c.invalidate_jacobian();
+        return GA_OK;
+    });
+}
+
+static ga_status set_switch(ga_solver *s, int on, const char *what, bool ga::Solver::*field)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (on != 0 && on != 1)
+            return c.diag.fail(GA_ERR_ARG, "%s must be 0 or 1, got %d", what, on);
+        c.*field = on == 1;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_rescale(ga_solver *s, int on)
+{
+    return set_switch(s, on, "rescale", &ga::Solver::rescale_a);
+}
+
+GA_API ga_status ga_set_corrected_start(ga_solver *s, int on)
+{
+    return set_switch(s, on, "corrected start", &ga::Solver::corrected_start);
+}
+
+GA_API ga_status ga_set_tolerances(ga_solver *s, double rtol, double atol)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!(rtol > 0.0 && std::isfinite(rtol)) || !(atol > 0.0 && std::isfinite(atol)))
+            return c.diag.fail(GA_ERR_ARG, "tolerances rtol = %g, atol = %g must be positive "
+                               "and finite", rtol, atol);
+        c.control.rtol = rtol;
+        c.control.atol = atol;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_step_limits(ga_solver *s, double h_min, double h_max)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!(h_min >= 0.0 && std::isfinite(h_min)) || !(h_max >= 0.0 && std::isfinite(h_max)) ||
+            (h_max > 0.0 && h_min > h_max))
+            return c.diag.fail(GA_ERR_ARG, "step limits h_min = %g, h_max = %g: need 0 <= h_min "
+                               "<= h_max (0 = none)", h_min, h_max);
+        c.control.h_min = h_min;
+        c.control.h_max = h_max;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_initial_step(ga_solver *s, double h0)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!(h0 >= 0.0 && std::isfinite(h0)))
+            return c.diag.fail(GA_ERR_ARG, "initial step %g must be >= 0 and finite", h0);
+        c.control.h_init = h0;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_step_adaptive(ga_solver *s, double t_stop)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!c.initialized())
+            return c.diag.fail(GA_ERR_STATE, "ga_step_adaptive before ga_init");
+        if (!std::isfinite(t_stop))
+            return c.diag.fail(GA_ERR_ARG, "t_stop = %g is not finite", t_stop);
+        return c.step_adaptive(t_stop);
+    });
+}
+
+GA_API ga_status ga_advance(ga_solver *s, double t_out)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!c.initialized())
+            return c.diag.fail(GA_ERR_STATE, "ga_advance before ga_init");
+        if (!std::isfinite(t_out))
+            return c.diag.fail(GA_ERR_ARG, "t_out = %g is not finite", t_out);
+        return c.advance(t_out);
+    });
+}
+
+GA_API ga_status ga_interpolate(const ga_solver *s, double t, double *q, double *v,
+                                double *lambda)
+{
+    return reading(s, [&](const ga::Solver &c) {
+        if (!c.initialized())
+            return GA_ERR_STATE;
+        if (!std::isfinite(t))
+            return GA_ERR_ARG;
+        return c.interpolate(t, q, v, lambda);
+    });
+}
+
 GA_API ga_status ga_set_predictor(ga_solver *s, int predictor)
 {
     return guarded(s, [&](ga::Solver &c) {
@@ -465,6 +569,8 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value)
         case GA_INFO_RCOND: *value = c.last_rcond(); return GA_OK;
         case GA_INFO_NEWTON_ITERS: *value = c.last_newton_iters(); return GA_OK;
         case GA_INFO_NEWTON_RATIO: *value = c.last_newton_ratio(); return GA_OK;
+        case GA_INFO_ERROR_ESTIMATE: *value = c.control.err_last; return GA_OK;
+        case GA_INFO_H_NEXT: *value = c.control.h_next; return GA_OK;
         default: return GA_ERR_ARG;
         }
     });

@@ -32,6 +32,7 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
     if (auto st = setup())
         return st;
     invalidate_jacobian();
+    jacobian_valid_ = false;
     State &x = trial_;
     x.t = t0;
     x.h_last = 0.0;
@@ -47,21 +48,40 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
             return st;
     }
 
-    // [M Phi_q^T; Phi_q 0] [qdd0; lambda0] = [f; -(Phi_qq(v,v) + 2 Phi_qt v + Phi_tt)].
-    // The first block row is multiplied by sigma = max|Phi_q| / max|M| so that both blocks
-    // have the same size; the unknown in the second block is then sigma lambda0.
-    ga_status st = model.mass(t0, x.q, M_);
-    if (!st)
-        st = model.force(t0, x.q, x.v, f_);
-    if (!st)
-        st = model.jacobian(t0, x.q, J_);
-    if (!st)
-        st = model.constraint_accel(t0, x.q, x.v, c_);
-    if (st) {
+    if (auto st = consistent_accelerations(t0, x.q, x.v, x.qdd, x.lambda)) {
         diag.append(" (consistent initial accelerations at t0 = %.17g)", t0);
         return st;
     }
+    x.a = x.qdd;  // eq. (3): a_0 = qdd_0
+    x.a_prev = x.a;
+
+    accepted_.swap(trial_);
+    initialized_ = true;
+    previous_valid_ = false;
+    start_pending_ = true;  // corrected starting values need the h of the first step
+    control.h_next = 0.0;
+    control.err_prev = 1.0;
+    control.grew = false;
+    return GA_OK;
+}
+
+// [M Phi_q^T; Phi_q 0] [qdd; lambda] = [f; -(Phi_qq(v,v) + 2 Phi_qt v + Phi_tt)] at (t, q, v).
+// The first block row is multiplied by sigma = max|Phi_q| / max|M| so that both blocks have the
+// same size; the unknown in the second block is then sigma lambda. Leaves M_, f_, J_ at q.
+ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v, Vec &qdd,
+                                           Vec &lambda)
+{
+    ga_status st = model.mass(t, q, M_);
+    if (!st)
+        st = model.force(t, q, v, f_);
+    if (!st)
+        st = model.jacobian(t, q, J_);
+    if (!st)
+        st = model.constraint_accel(t, q, v, c_);
+    if (st)
+        return st;
     mass_valid_ = model.constant_mass;
+    jacobian_valid_ = false;  // S_ holds another matrix now
     double sigma = 1.0;
     const double mmax = max_abs(M_), jmax = max_abs(J_);
     if (mmax > 0.0 && jmax > 0.0)
@@ -69,20 +89,56 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
     count(counters, GA_COUNT_FACTORIZATIONS);
     if (!S_.factorize_kkt(M_, sigma, J_))
         return diag.fail(GA_ERR_SINGULAR,
-                         "saddle-point matrix [M Phi_q^T; Phi_q 0] is singular at t0 = %.17g "
+                         "saddle-point matrix [M Phi_q^T; Phi_q 0] is singular at t = %.17g "
                          "(rcond = %.3g): redundant constraints, or M singular on the null "
                          "space of Phi_q",
-                         t0, S_.rcond());
+                         t, S_.rcond());
     rq_ = -sigma * f_;
-    S_.solve(rq_, c_, x.qdd, x.lambda);
+    S_.solve(rq_, c_, qdd, lambda);
     if (m_ > 0)
-        x.lambda /= sigma;
-    if (!x.qdd.allFinite() || !x.lambda.allFinite())
-        return diag.fail(GA_ERR_NONFINITE, "initial accelerations or multipliers are not finite");
-    x.a = x.qdd;  // eq. (3): a_0 = qdd_0
+        lambda /= sigma;
+    if (!qdd.allFinite() || !lambda.allFinite())
+        return diag.fail(GA_ERR_NONFINITE, "consistent accelerations or multipliers are not "
+                         "finite at t = %.17g", t);
+    return GA_OK;
+}
 
-    accepted_.swap(trial_);
-    initialized_ = true;
+// Corrected starting values for the first step of size h (ALGORITHMS.md sec. 3.4-3.5):
+// a_0 = qdd_0 + delta_alpha h qddd_0, with h qddd_0 from a central difference of consistent
+// accelerations at t0 -+ h; in the index-3 formulation also v_0 + dv, the normal-direction
+// velocity offset that lets the first step absorb its own position error
+// l_0 = h^3 (1 - 6 beta - 3 delta_alpha)/6 qddd_0 instead of passing it to a_1 and lambda.
+// Without them lambda carries an O(h) transient (index 3) or an O(delta_alpha h) one (index 2).
+ga_status Solver::starting_values(double h)
+{
+    const State &s = accepted_;
+    const Params &p = params;
+    const double delta_alpha = p.alpha_m - p.alpha_f;
+    // h qddd_0 = (qdd(t0 + h) - qdd(t0 - h)) / 2 along the Taylor polynomial of the start
+    State &x = trial_;  // scratch: the step has not started
+    for (int side = 0; side < 2; ++side) {
+        const double sh = side == 0 ? h : -h;
+        x.q = s.q + sh * s.v + (0.5 * sh * sh) * s.qdd;
+        x.v = s.v + sh * s.qdd;
+        Vec &out = side == 0 ? x.a : x.a_prev;
+        if (auto st = consistent_accelerations(s.t + sh, x.q, x.v, out, lambda_tmp_)) {
+            diag.append(" (corrected starting values for the first step, h = %g)", h);
+            return st;
+        }
+    }
+    qdd_tmp_ = 0.5 * (x.a - x.a_prev);  // h qddd_0
+    a_n_ = s.qdd + delta_alpha * qdd_tmp_;
+    if (formulation == GA_INDEX3 && m_ > 0) {
+        // [M Phi_q^T; Phi_q 0] [dv; dlambda] = [0; Phi_q l_0 / h] at the start
+        if (auto st = consistent_accelerations(s.t, s.q, s.v, x.qdd, x.lambda))
+            return st;
+        dq_ = ((1.0 - 6.0 * p.beta - 3.0 * delta_alpha) / 6.0 * h) * qdd_tmp_;  // l_0 / h
+        phi_.setZero();
+        J_.multiply_add(-1.0, dq_, phi_);
+        rq_.setZero();
+        S_.solve(rq_, phi_, dw_, dlambda_);
+        v_n_ = s.v + dw_;
+    }
     return GA_OK;
 }
 

@@ -25,16 +25,17 @@ constexpr double kMinTrustedRate = 0.05;
 constexpr int kIterationBudget = 4;
 }  // namespace
 
-ConvergenceTest::Verdict ConvergenceTest::check(double tol, const Vec &dq, double beta_prime,
-                                                const Vec &dlambda, const Vec &q, const Vec &qdd,
-                                                const Vec &lambda)
+ConvergenceTest::Verdict ConvergenceTest::check(double tol, const Vec &dq, const Vec &dw,
+                                                double beta_prime, const Vec &dlambda,
+                                                const Vec &q, const Vec &qdd, const Vec &lambda)
 {
     ++iteration_;
     ++with_matrix_;
     const double dq_norm = dq.lpNorm<Eigen::Infinity>();
     const double q_norm = q.lpNorm<Eigen::Infinity>();
+    const double dw_norm = &dw == &dq ? dq_norm : dw.lpNorm<Eigen::Infinity>();
     double eta = std::max(relative(dq_norm, tol, q_norm),
-                          relative(beta_prime * dq_norm, tol, qdd.lpNorm<Eigen::Infinity>()));
+                          relative(beta_prime * dw_norm, tol, qdd.lpNorm<Eigen::Infinity>()));
     if (dlambda.size() > 0)
         eta = std::max(eta, relative(dlambda.lpNorm<Eigen::Infinity>(), tol,
                                      lambda.lpNorm<Eigen::Infinity>()));

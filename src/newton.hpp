@@ -48,8 +48,10 @@ public:
         with_matrix_ = 0;
     }
 
-    Verdict check(double tol, const Vec &dq, double beta_prime, const Vec &dlambda, const Vec &q,
-                  const Vec &qdd, const Vec &lambda);
+    // dq: position increment; dw: the increment that moves the accelerations (qdd += beta' dw;
+    // the same vector as dq except in the stabilized index-2 formulation).
+    Verdict check(double tol, const Vec &dq, const Vec &dw, double beta_prime, const Vec &dlambda,
+                  const Vec &q, const Vec &qdd, const Vec &lambda);
 
     double ratio() const { return ratio_; }  // eta of the last update
     double rate() const { return rate_; }    // last measured theta (< 0: none yet)

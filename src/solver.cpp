@@ -8,8 +8,9 @@ namespace ga {
 
 namespace {
 constexpr double kStateMagic = 26465.0;  // 0x6761, "ga"
-constexpr double kStateVersion = 1.0;
-constexpr std::size_t kStateHeader = 6;  // magic, version, n, m, t, h_last
+constexpr double kStateVersion = 2.0;
+// magic, version, n, m, t, h_last, h_next, err_prev, grew
+constexpr std::size_t kStateHeader = 9;
 
 // Reuse of the iteration matrix after a change of h. Scaled, S_t depends on h only through
 // gamma h C_t and beta h^2 K_t; the band is IDA's for its c_j (ALGORITHMS.md sec. 4.5):
@@ -33,6 +34,7 @@ void State::allocate(int n, int m)
     qdd.setZero(n);
     lambda.setZero(m);
     a.setZero(n);
+    a_prev.setZero(n);
 }
 
 void State::swap(State &other)
@@ -44,6 +46,7 @@ void State::swap(State &other)
     qdd.swap(other.qdd);
     lambda.swap(other.lambda);
     a.swap(other.a);
+    a_prev.swap(other.a_prev);
 }
 
 Solver::Solver(int n, int m)
@@ -51,6 +54,10 @@ Solver::Solver(int n, int m)
 {
     accepted_.allocate(n, m);
     trial_.allocate(n, m);
+    previous_.allocate(n, m);
+    a_n_.setZero(n);
+    v_n_.setZero(n);
+    lambda_n_.setZero(m);
     M_.set_dense(n, n);
     J_.set_dense(m, n);
     K_.set_dense(n, n);
@@ -89,6 +96,10 @@ ga_status Solver::setup()
     case GA_LINEAR_AUTO: sparse = sparse_possible && n_ + m_ >= kSparseMinSize; break;
     default: sparse = false;
     }
+    if (formulation == GA_INDEX2_STABILIZED && linear_solver == GA_LINEAR_SPARSE)
+        return diag.fail(GA_ERR_ARG, "the stabilized index-2 formulation needs a dense solver");
+    if (formulation == GA_INDEX2_STABILIZED)
+        sparse = false;
     std::unique_ptr<LinearBackend> backend;
     if (sparse) {
         backend = make_sparse_backend();
@@ -105,18 +116,30 @@ ga_status Solver::setup()
         backend = make_dense_backend(linear_solver == GA_LINEAR_DENSE_LAPACK ? DenseKind::Lapack
                                                                              : DenseKind::Eigen);
     }
+    const bool dense = !sparse || !backend;
     M_.allocate();
     J_.allocate();
     K_.allocate();
     C_.allocate();
+    B_.copy_layout(J_);
     f_.setZero(n_);
     phi_.setZero(m_);
+    phi_v_.setZero(m_);
     rq_.setZero(n_);
     dq_.setZero(n_);
+    dw_.setZero(n_);
     dlambda_.setZero(m_);
+    deta_.setZero(m_);
     c_.setZero(m_);
+    qdd_tmp_.setZero(n_);
+    lambda_tmp_.setZero(m_);
     model.allocate_workspace(M_, J_, K_, C_);
     S_.setup(std::move(backend), n_, m_, M_, J_, K_, C_);
+    if (dense) {  // the stabilized index-2 formulation is dense only
+        Bd_.setZero(m_, n_);
+        S2_.setup(n_, m_);
+        index2_ready_ = true;
+    }
     workspace_ready_ = true;
     return GA_OK;
 }
@@ -149,15 +172,41 @@ ga_status Solver::step(double h)
         invalidate_jacobian();
         return st;
     }
-    accepted_.swap(trial_);  // commit
+    commit(false, 0.0);
     failed.committed = true;
-    count(counters, GA_COUNT_STEPS);
     return GA_OK;
 }
 
-// One step of Algorithm 1 from accepted_ into trial_. accepted_ is only read.
+void Solver::commit(bool land_on, double t_land)
+{
+    accepted_.swap(trial_);    // the new step becomes the state ...
+    previous_.swap(trial_);    // ... and the old one the start of the interval for dense output
+    if (land_on)
+        accepted_.t = t_land;  // exactly, not t_n + h rounded
+    previous_valid_ = true;
+    start_pending_ = false;
+    count(counters, GA_COUNT_STEPS);
+}
+
+// One step from accepted_ into trial_. accepted_ is only read.
 ga_status Solver::attempt_step(double h)
 {
+    if (formulation == GA_INDEX2_STABILIZED && !index2_ready_)
+        return diag.fail(GA_ERR_ARG, "the stabilized index-2 formulation needs a dense solver");
+    const State &s = accepted_;
+    // The start of the step. a_n carries the shift delta_alpha h_last; rescaled to the h of
+    // this step the scheme stays second order under any sequence of step sizes (ALGORITHMS.md
+    // sec. 1.2): a_n <- qdd_n + (h / h_last) (a_n - qdd_n).
+    if (rescale_a && s.h_last > 0.0 && h != s.h_last)
+        a_n_ = s.qdd + (h / s.h_last) * (s.a - s.qdd);
+    else
+        a_n_ = s.a;
+    v_n_ = s.v;
+    lambda_n_ = s.lambda;
+    if (start_pending_ && corrected_start)
+        if (auto st = starting_values(h))
+            return st;
+
     // After a reused matrix was too slow, the next steps start with a fresh one; how many
     // doubles with every failed attempt to reuse (up to 32) and resets when reuse works.
     const bool skip_reuse = refresh_steps_left_ > 0;
@@ -180,15 +229,15 @@ ga_status Solver::attempt_step(double h)
         return diag.fail(GA_ERR_NEWTON,
                          "Newton iteration did not converge in %d iterations in the step from "
                          "t = %.17g with h = %g (last increment / tolerance = %.3g)",
-                         max_iter, accepted_.t, h, convergence_.ratio());
-    const State &s = accepted_;
+                         max_iter, s.t, h, convergence_.ratio());
     State &x = trial_;
     if (!x.q.allFinite() || !x.v.allFinite() || !x.qdd.allFinite() || !x.lambda.allFinite())
         return diag.fail(GA_ERR_NONFINITE, "step from t = %.17g with h = %g produced a "
                          "non-finite state", s.t, h);
     const Params &p = params;
     // Algorithm 1, last line: a_{n+1} from eq. (3) with the converged qdd_{n+1}.
-    x.a = (p.alpha_f * s.qdd - p.alpha_m * s.a + (1.0 - p.alpha_f) * x.qdd) / (1.0 - p.alpha_m);
+    x.a = (p.alpha_f * s.qdd - p.alpha_m * a_n_ + (1.0 - p.alpha_f) * x.qdd) / (1.0 - p.alpha_m);
+    x.a_prev = a_n_;
     x.t = s.t + h;
     x.h_last = h;
     if (convergence_.rate() >= 0.0)
@@ -196,21 +245,48 @@ ga_status Solver::attempt_step(double h)
     return GA_OK;
 }
 
-// Predictor and Newton iteration of Algorithm 1. With `refresh` the iteration matrix is
-// rebuilt before the first solve; otherwise the factorization of an earlier step is reused
-// (modified Newton) and rebuilt only if the iteration contracts too slowly.
+// Rebuild and factorize the iteration matrix at the current iterate.
+ga_status Solver::factorize(double h, bool tangents_K, bool tangents_C, int iter)
+{
+    count(counters, GA_COUNT_FACTORIZATIONS);
+    jacobian_valid_ = false;
+    const ModelMatrix *C = tangents_C ? &C_ : nullptr, *K = tangents_K ? &K_ : nullptr;
+    const bool ok = formulation == GA_INDEX2_STABILIZED
+                        ? S2_.factorize(M_, C, K, J_, Bd_, params, h)
+                        : S_.factorize_step(M_, C, K, J_, params, h, scaling);
+    if (!ok)
+        return diag.fail(GA_ERR_SINGULAR,
+                         "iteration matrix S_t%s is singular (rcond = %.3g) in Newton iteration "
+                         "%d of the step from t = %.17g with h = %g",
+                         formulation == GA_INDEX2_STABILIZED ? " (stabilized index-2)"
+                         : scaling                           ? " (scaled, eq. 10)"
+                                                             : " (unscaled)",
+                         last_rcond(), iter, accepted_.t, h);
+    jacobian_valid_ = true;
+    jacobian_h_ = h;
+    theta_prev_ = -1.0;
+    convergence_.matrix_changed();
+    return GA_OK;
+}
+
+// Predictor and Newton iteration of Algorithm 1 (or of its stabilized index-2 variant). With
+// `refresh` the iteration matrix is rebuilt before the first solve; otherwise the
+// factorization of an earlier step is reused (modified Newton) and rebuilt only if the
+// iteration contracts too slowly.
 ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_stale)
 {
     const Params &p = params;
     const NewtonCoefficients c = newton_coefficients(p, h);  // eq. (6)
     const double row_scale = step_row_scale(p, h, scaling);
+    const bool index2 = formulation == GA_INDEX2_STABILIZED;
     const State &s = accepted_;
+    const Vec &a_n = a_n_, &v_n = v_n_;
     State &x = trial_;
     const double t1 = s.t + h;
 
     // Predictor (Algorithm 1, lines 1-7). The paper starts from qdd_{n+1} = 0, lambda = 0;
-    // the default starts from a_{n+1} = a_n, lambda_{n+1} = lambda_n, i.e. the qdd_{n+1} that
-    // eq. (3) maps to a_{n+1} = a_n. Both iterate to the same solution.
+    // the others start from a_{n+1} = a_n, or from qdd extrapolated linearly; lambda_n.
+    // All iterate to the same solution.
     const double delta_alpha = p.alpha_m - p.alpha_f;
     if (predictor == GA_PREDICTOR_ZERO) {
         x.qdd.setZero();
@@ -219,14 +295,25 @@ ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_sta
         // a_n - qdd_n = delta_alpha h_last qddd + O(h^2) (ALGORITHMS.md sec. 0), hence
         // qdd(t_n + h) = qdd_n + (h / h_last) (a_n - qdd_n) / delta_alpha + O(h^2).
         x.qdd = s.qdd + (h / (s.h_last * delta_alpha)) * (s.a - s.qdd);
-        x.lambda = s.lambda;
+        x.lambda = lambda_n_;
     } else {
-        x.qdd = (s.a - p.alpha_f * s.qdd) / (1.0 - p.alpha_f);
-        x.lambda = s.lambda;
+        x.qdd = (a_n - p.alpha_f * s.qdd) / (1.0 - p.alpha_f);
+        x.lambda = lambda_n_;
     }
-    x.a = (p.alpha_f * s.qdd - p.alpha_m * s.a + (1.0 - p.alpha_f) * x.qdd) / (1.0 - p.alpha_m);
-    x.q = s.q + h * s.v + (h * h) * ((0.5 - p.beta) * s.a + p.beta * x.a);  // eq. (4)
-    x.v = s.v + h * ((1.0 - p.gamma) * s.a + p.gamma * x.a);               // eq. (5)
+    x.a = (p.alpha_f * s.qdd - p.alpha_m * a_n + (1.0 - p.alpha_f) * x.qdd) / (1.0 - p.alpha_m);
+    x.q = s.q + h * v_n + (h * h) * ((0.5 - p.beta) * a_n + p.beta * x.a);  // eq. (4)
+    x.v = v_n + h * ((1.0 - p.gamma) * a_n + p.gamma * x.a);               // eq. (5)
+    if (index2 && m_ > 0) {
+        // B = Phi_q(q_n): the direction of the position correction -h B^T eta (sec. 2.1)
+        if (auto st = model.jacobian(s.t, s.q, B_))
+            return st;
+        Bd_.setZero();
+        if (B_.dense())
+            Bd_ = B_.as_dense();
+        else
+            for (int k = 0; k < B_.nnz(); ++k)
+                Bd_(B_.row_index()[k], B_.col_index()[k]) += B_.data()[k];
+    }
 
     const bool tangents_K = model.stiffness_needed(K_);
     const bool tangents_C = model.damping_needed(C_);
@@ -243,6 +330,11 @@ ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_sta
             st = model.constraint(t1, x.q, phi_);
         if (!st)
             st = model.jacobian(t1, x.q, J_);
+        if (!st && index2 && m_ > 0) {
+            // the velocity constraint Phi_q v + Phi_t
+            st = model.constraint_dt(t1, x.q, phi_v_);
+            J_.multiply_add(1.0, x.v, phi_v_);
+        }
         if (!st) {
             // Residuals r^q (eq. 1, not weighted) and r^lambda = Phi (eq. 2).
             Model::dynamics_residual(M_, x.qdd, f_, J_, x.lambda, rq_);
@@ -252,51 +344,46 @@ ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_sta
             st = model.stiffness(t1, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_);
         if (!st && refresh && tangents_C)
             st = model.damping(t1, x.q, x.v, f_, C_);
-        if (st) {
-            diag.append(" (Newton iteration %d of the step from t = %.17g with h = %g)", iter,
-                        s.t, h);
-            return st;
-        }
-        if (refresh) {
-            // S_t at the current iterate, in the scaled form (9)-(10).
-            count(counters, GA_COUNT_FACTORIZATIONS);
-            jacobian_valid_ = false;
-            if (!S_.factorize_step(M_, tangents_C ? &C_ : nullptr, tangents_K ? &K_ : nullptr,
-                                   J_, p, h, scaling))
-                return diag.fail(GA_ERR_SINGULAR,
-                                 "iteration matrix S_t%s is singular (rcond = %.3g) in Newton "
-                                 "iteration %d of the step from t = %.17g with h = %g",
-                                 scaling ? " (scaled, eq. 10)" : " (unscaled)", S_.rcond(), iter,
-                                 s.t, h);
-            jacobian_valid_ = true;
-            jacobian_h_ = h;
-            theta_prev_ = -1.0;
-            convergence_.matrix_changed();
+        if (!st && refresh) {
+            st = factorize(h, tangents_K, tangents_C, iter);
             refresh = false;
             refresh_done = true;
-        } else {
+        } else if (!st) {
             used_stale = true;
         }
-        // [dq; dlambda] = -S_t^{-1} [r^q; r^lambda]
-        S_.solve(rq_, phi_, dq_, dlambda_, row_scale);
+        if (st) {
+            if (st != GA_ERR_SINGULAR)
+                diag.append(" (Newton iteration %d of the step from t = %.17g with h = %g)",
+                            iter, s.t, h);
+            return st;
+        }
+        // [dq; dlambda] = -S_t^{-1} [r^q; r^lambda], in the scaled form (9)-(10)
+        const Vec *dw = &dq_;
+        if (index2) {
+            S2_.solve(rq_, phi_, phi_v_, p, h, dq_, dlambda_, deta_);
+            dw_ = dq_;
+            if (m_ > 0)
+                dw_.noalias() += Bd_.transpose() * deta_;  // the Newmark part of the update
+            dw = &dw_;
+        } else {
+            S_.solve(rq_, phi_, dq_, dlambda_, row_scale);
+        }
         count(counters, GA_COUNT_NEWTON_ITERS);
-        if (!dq_.allFinite() || !dlambda_.allFinite())
+        if (!dq_.allFinite() || !dlambda_.allFinite() || !dw->allFinite())
             return diag.fail(GA_ERR_NONFINITE,
                              "Newton increment is not finite in iteration %d of the step from "
                              "t = %.17g with h = %g",
                              iter, s.t, h);
 
         // Algorithm 1, correction: q += dq, v += gamma' dq, qdd += beta' dq (eq. 7),
-        // lambda += dlambda.
+        // lambda += dlambda (index 2: v and qdd move with the Newmark part dw only).
         x.q += dq_;
-        x.v += c.gamma_prime * dq_;
-        x.qdd += c.beta_prime * dq_;
+        x.v += c.gamma_prime * (*dw);
+        x.qdd += c.beta_prime * (*dw);
         x.lambda += dlambda_;
-        const auto verdict = convergence_.check(newton_tol, dq_, c.beta_prime, dlambda_, x.q,
-                                                x.qdd, x.lambda);
+        const auto verdict = convergence_.check(newton_tol, dq_, *dw, c.beta_prime, dlambda_,
+                                                x.q, x.qdd, x.lambda);
         converged = verdict == ConvergenceTest::Verdict::Converged;
-        // Too slow with an old matrix: rebuild it at the current iterate. Full Newton
-        // (GA_REUSE_NEVER, Algorithm 1 as printed) rebuilds at every iteration.
         if (verdict == ConvergenceTest::Verdict::Slow && used_stale && reuse_attempted_ &&
             !refresh_done) {
             reuse_backoff_ = std::min(2 * reuse_backoff_, 32);
@@ -304,10 +391,24 @@ ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_sta
         } else if (converged && reuse_attempted_ && !refresh_done) {
             reuse_backoff_ = 1;  // the old matrix did the whole step: keep reusing
         }
+        // Too slow with an old matrix: rebuild it at the current iterate. Full Newton
+        // (GA_REUSE_NEVER, Algorithm 1 as printed) rebuilds at every iteration.
         if (reuse == GA_REUSE_NEVER || (verdict == ConvergenceTest::Verdict::Slow && used_stale))
             refresh = true;
     }
     return GA_OK;
+}
+
+double Solver::last_rcond() const
+{
+    return formulation == GA_INDEX2_STABILIZED ? S2_.rcond() : S_.rcond();
+}
+
+const char *Solver::linear_backend() const
+{
+    if (workspace_ready_ && formulation == GA_INDEX2_STABILIZED)
+        return "dense Eigen LU (stabilized index-2)";
+    return S_.backend_name();
 }
 
 ga_status Solver::unavoidable_work(double h)
@@ -341,7 +442,7 @@ ga_status Solver::unavoidable_work(double h)
 
 std::size_t Solver::state_size() const
 {
-    return kStateHeader + 4 * static_cast<std::size_t>(n_) + static_cast<std::size_t>(m_);
+    return kStateHeader + 5 * static_cast<std::size_t>(n_) + static_cast<std::size_t>(m_);
 }
 
 void Solver::get_state(double *buf) const
@@ -353,8 +454,11 @@ void Solver::get_state(double *buf) const
     buf[3] = m_;
     buf[4] = s.t;
     buf[5] = s.h_last;
+    buf[6] = control.h_next;
+    buf[7] = control.err_prev;
+    buf[8] = control.grew ? 1.0 : 0.0;
     double *p = buf + kStateHeader;
-    for (const Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a}) {
+    for (const Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev}) {
         Eigen::Map<Vec>(p, x->size()) = *x;
         p += x->size();
     }
@@ -382,12 +486,17 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
     State &s = accepted_;
     s.t = buf[4];
     s.h_last = buf[5];
+    control.h_next = buf[6];
+    control.err_prev = buf[7];
+    control.grew = buf[8] != 0.0;
     const double *p = buf + kStateHeader;
-    for (Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a}) {
+    for (Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev}) {
         *x = Eigen::Map<const Vec>(p, x->size());
         p += x->size();
     }
     invalidate_jacobian();
+    previous_valid_ = false;
+    start_pending_ = false;
     initialized_ = true;
     return GA_OK;
 }

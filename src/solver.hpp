@@ -1,11 +1,12 @@
-// ga::Solver: the state (t, q, v, qdd, lambda, a), the options, and one step of Algorithm 1
-// with commit/rollback and the reuse of the iteration matrix. The consistent start lives in
-// init.cpp.
+// ga::Solver: the state (t, q, v, qdd, lambda, a), the options, one step of Algorithm 1 (or of
+// its stabilized index-2 variant) with commit/rollback and the reuse of the iteration matrix.
+// The consistent start lives in init.cpp, step-size control and dense output in control.cpp.
 #pragma once
 
 #include <cstddef>
 
 #include "diagnostics.hpp"
+#include "linear/index2_matrix.hpp"
 #include "linear/iteration_matrix.hpp"
 #include "model.hpp"
 #include "newton.hpp"
@@ -17,9 +18,20 @@ struct State {
     double t = 0.0;
     double h_last = 0.0;  // size of the step that produced this state (0 at the start)
     Vec q, v, qdd, lambda, a;
+    Vec a_prev;           // a of the state before (variable-step error estimate)
 
     void allocate(int n, int m);
     void swap(State &other);  // pointer swaps only: no allocation, no copy
+};
+
+// Step-size control (adaptive mode, control.cpp): options and the controller's own state.
+struct Control {
+    double rtol = 1e-6, atol = 1e-6;
+    double h_min = 0.0, h_max = 0.0, h_init = 0.0;  // 0: automatic / unlimited
+    // controller state (part of the checkpoint)
+    double h_next = 0.0, err_prev = 1.0;
+    bool grew = false;
+    double err_last = 0.0;  // error norm of the last accepted step
 };
 
 class Solver {
@@ -39,6 +51,10 @@ public:
     double init_tol = 1e-10;
     ga_reuse_mode reuse = GA_REUSE_AUTO;
     ga_linear_solver linear_solver = GA_LINEAR_AUTO;
+    ga_formulation formulation = GA_INDEX3;
+    bool rescale_a = true;
+    bool corrected_start = true;
+    Control control;
 
     Counters counters{};
     Diagnostics diag;
@@ -47,13 +63,19 @@ public:
     // Layout of the user's matrices (dense unless a pattern was declared); fixed at setup.
     ModelMatrix &matrix(ga_matrix which);
     bool setup_done() const { return workspace_ready_; }
-    const char *linear_backend() const { return S_.backend_name(); }
+    bool index2_available() const { return !workspace_ready_ || index2_ready_; }
+    const char *linear_backend() const;
 
     bool initialized() const { return initialized_; }
     const State &state() const { return accepted_; }
 
     ga_status init(double t0, const double *q0, const double *v0);  // init.cpp
     ga_status step(double h);
+    // Adaptive mode (control.cpp): one controlled step, not beyond t_stop (landing on it
+    // exactly if it is reached); or steps until t_out exactly.
+    ga_status step_adaptive(double t_stop);
+    ga_status advance(double t_out);
+    ga_status interpolate(double t, double *q, double *v, double *lambda) const;
 
     // Anything that changes the iteration matrix (options, callbacks) calls this.
     void invalidate_jacobian() const
@@ -70,13 +92,13 @@ public:
     // at hand (made first if there is none). The per-step cost is measured against it.
     ga_status unavoidable_work(double h);
 
-    double last_rcond() const { return S_.rcond(); }
+    double last_rcond() const;
     int last_newton_iters() const { return last_newton_iters_; }
     double last_newton_ratio() const { return convergence_.ratio(); }
 
-    // Checkpoint: [magic, version, n, m, t, h_last, q, v, qdd, lambda, a]. Taking one also
-    // drops the reusable iteration matrix, so that the run continues exactly as a restart
-    // from the checkpoint does (the matrix is not part of the state).
+    // Checkpoint (layout 2): [magic, 2, n, m, t, h_last, h_next, err_prev, grew, q, v, qdd,
+    // lambda, a, a_prev]. Taking one also drops the reusable iteration matrix, so that the run
+    // continues exactly as a restart from the checkpoint does (the matrix is not part of it).
     std::size_t state_size() const;
     void get_state(double *buf) const;
     ga_status set_state(const double *buf, std::size_t len);
@@ -85,31 +107,48 @@ private:
     ga_status setup();  // chooses the backend and allocates everything; throws std::bad_alloc
     ga_status attempt_step(double h);
     ga_status newton(double h, bool refresh, bool &converged, bool &used_stale);
+    ga_status factorize(double h, bool tangents_K, bool tangents_C, int iter);
     ga_status evaluate_mass(double t, const Vec &q);
-    ga_status project_positions(double t, Vec &q);                  // init.cpp
-    ga_status project_velocities(double t, const Vec &q, Vec &v);   // init.cpp
+    void commit(bool land_on, double t_land);
+    double error_norm(double h) const;  // control.cpp
+    // init.cpp
+    ga_status project_positions(double t, Vec &q);
+    ga_status project_velocities(double t, const Vec &q, Vec &v);
+    ga_status consistent_accelerations(double t, const Vec &q, const Vec &v, Vec &qdd,
+                                       Vec &lambda);
+    ga_status starting_values(double h);
 
     int n_, m_;
     bool initialized_ = false;
     bool workspace_ready_ = false;
+    bool index2_ready_ = false;
     int last_newton_iters_ = 0;
 
     State accepted_;  // the last accepted step: never touched by a step that fails
     State trial_;     // the step being computed
+    State previous_;  // the accepted step before (dense output)
+    bool previous_valid_ = false;
+    bool start_pending_ = false;  // first step after ga_init: corrected starting values
+
+    // The start of the step being computed: a_n rescaled to h (ALGORITHMS.md 1.2) and, in the
+    // first step, the corrected a_0 and v_0 (sec. 3.4-3.5).
+    Vec a_n_, v_n_, lambda_n_;
 
     // Reuse of the factorized iteration matrix across iterations and steps.
     mutable bool jacobian_valid_ = false;
-    mutable double theta_prev_ = -1.0;  // contraction rate seen with the current matrix
-    mutable bool mass_valid_ = false;   // constant mass: M evaluated
-    mutable int refresh_steps_left_ = 0;  // steps to start with a fresh matrix
-    mutable int reuse_backoff_ = 1;       // ... after the next failed attempt to reuse
-    bool reuse_attempted_ = false;        // this step started with an old matrix
+    mutable double theta_prev_ = -1.0;   // contraction rate seen with the current matrix
+    mutable bool mass_valid_ = false;    // constant mass: M evaluated
+    mutable int refresh_steps_left_ = 0; // steps to start with a fresh matrix
+    mutable int reuse_backoff_ = 1;      // ... after the next failed attempt to reuse
+    bool reuse_attempted_ = false;       // this step started with an old matrix
     double jacobian_h_ = 0.0;
 
     // Step workspace, sized once.
-    ModelMatrix M_, J_, K_, C_;
-    Vec f_, phi_, rq_, dq_, dlambda_, c_;
+    ModelMatrix M_, J_, K_, C_, B_;
+    Mat Bd_;  // index-2: Phi_q(q_n), dense
+    Vec f_, phi_, phi_v_, rq_, dq_, dw_, dlambda_, deta_, c_, qdd_tmp_, lambda_tmp_;
     IterationMatrix S_;
+    Index2Matrix S2_;
     ConvergenceTest convergence_;
 };
 

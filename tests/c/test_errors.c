@@ -234,12 +234,12 @@ static void calls_out_of_order_are_refused(void **state)
     assert_int_equal(ga_get_q(s, q), GA_ERR_STATE);
     assert_int_equal(ga_get_state(s, buf, STATE_MAX), GA_ERR_STATE);
     buf[0] = 26465.0; /* a well-formed checkpoint still needs callbacks */
-    buf[1] = 1.0;
+    buf[1] = 2.0;
     buf[2] = 2.0;
     buf[3] = 1.0;
-    for (int i = 4; i < 6 + 4 * 2 + 1; ++i)
+    for (int i = 4; i < 9 + 5 * 2 + 1; ++i)
         buf[i] = 0.0;
-    assert_int_equal(ga_set_state(s, buf, 6 + 4 * 2 + 1), GA_ERR_STATE);
+    assert_int_equal(ga_set_state(s, buf, 9 + 5 * 2 + 1), GA_ERR_STATE);
     /* callbacks: mass required, constraint + jacobian required for m > 0 */
     assert_int_equal(ga_set_callbacks(s, NULL, pendulum_force, pendulum_constraint,
                                       pendulum_jacobian, &p),

@@ -12,7 +12,7 @@
 
 #include "helpers.h"
 
-enum { THREADS = 4, LEN = 6 + 4 * 2 + 1 };
+enum { THREADS = 4, LEN = 9 + 5 * 2 + 1 };
 
 typedef struct job {
     pendulum p;

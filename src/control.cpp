@@ -1,0 +1,160 @@
+// Adaptive mode: local error estimate, step-size controller, landing on output times, and
+// dense output (ALGORITHMS.md sec. 1).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "solver.hpp"
+
+namespace ga {
+
+namespace {
+const double kEps = std::numeric_limits<double>::epsilon();
+constexpr double kSafety = 0.9;
+constexpr double kMaxGrowth = 2.0, kMinShrink = 0.2;
+constexpr double kDeadBand = 1.2;  // growth below this keeps h (and the factorization)
+constexpr double kFailureShrink = 0.25;
+
+bool recoverable(ga_status st)
+{
+    return st == GA_ERR_NEWTON || st == GA_ERR_CALLBACK_RETRY || st == GA_ERR_NONFINITE ||
+           st == GA_ERR_SINGULAR;
+}
+}  // namespace
+
+// Weighted RMS norm of the local error estimates of the step just computed (trial_ from
+// accepted_ with a_n_), over positions and velocities; multipliers are not part of it, as in
+// index-aware DAE codes (sec. 1.5d).
+//   positions (sec. 1.5a): e_q = h^2 (beta + delta_alpha/2 - 1/6) (a_{n+1} - a_n)
+//   velocities (sec. 1.5b): e_v = C_v h^3 qdddd with C_v = 1/12 - delta_alpha^2
+//       + delta_alpha (alpha_m - 1/2), qdddd from the divided differences of a over the last
+//       two steps (not available in the first step, where e_v = 0)
+double Solver::error_norm(double h) const
+{
+    const Params &p = params;
+    const State &s = accepted_, &x = trial_;
+    const double da = p.alpha_m - p.alpha_f;
+    const double cq = h * h * (p.beta + 0.5 * da - 1.0 / 6.0);
+    const double cv = 1.0 / 12.0 - da * da + da * (p.alpha_m - 0.5);
+    const double rtol = control.rtol, atol = control.atol;
+    double sum = 0.0;
+    for (int i = 0; i < n_; ++i) {
+        const double eq = cq * (x.a[i] - a_n_[i]);
+        const double wq = atol + rtol * std::max(std::fabs(s.q[i]), std::fabs(x.q[i]));
+        double ev = 0.0;
+        if (s.h_last > 0.0) {
+            const double d4 = ((x.a[i] - a_n_[i]) / h - (s.a[i] - s.a_prev[i]) / s.h_last) /
+                              (0.5 * (h + s.h_last));
+            ev = cv * h * h * h * d4;
+        }
+        const double wv = atol + rtol * std::max(std::fabs(s.v[i]), std::fabs(x.v[i]));
+        sum += (eq / wq) * (eq / wq) + (ev / wv) * (ev / wv);
+    }
+    return std::sqrt(sum / (2.0 * n_));
+}
+
+ga_status Solver::step_adaptive(double t_stop)
+{
+    const double t = accepted_.t;
+    const double remaining = t_stop - t;
+    if (!(remaining > 0.0))
+        return diag.fail(GA_ERR_ARG, "t_stop = %.17g is not after t = %.17g", t_stop, t);
+    double h = control.h_next;
+    if (!(h > 0.0)) {
+        // First step: a step over which the acceleration alone moves q by the position
+        // tolerance (the controller grows it quickly), unless the user gave one.
+        const double tol_q = control.atol + control.rtol * accepted_.q.lpNorm<Eigen::Infinity>();
+        const double acc = accepted_.qdd.lpNorm<Eigen::Infinity>();
+        const double vel = accepted_.v.lpNorm<Eigen::Infinity>();
+        h = control.h_init > 0.0 ? control.h_init
+            : acc > 0.0          ? 0.5 * std::sqrt(2.0 * tol_q / acc)
+            : vel > 0.0          ? tol_q / vel
+                                 : 1e-3 * remaining;
+    }
+    if (control.h_max > 0.0)
+        h = std::min(h, control.h_max);
+    const double h_min = control.h_min > 0.0 ? control.h_min
+                                             : 16.0 * kEps * std::max(std::fabs(t), 1.0);
+    bool rejected = false;
+    for (;;) {
+        bool land = false;
+        if (h >= remaining * (1.0 - 1e-12)) {
+            h = remaining;
+            land = true;
+        }
+        if (h < h_min && !land)
+            return diag.fail(GA_ERR_STEP_SIZE,
+                             "step size %g fell below the minimum %g at t = %.17g (last error "
+                             "estimate %.3g)",
+                             h, h_min, t, control.err_last);
+        ga_status st = attempt_step(h);
+        if (st == GA_OK) {
+            const double err = error_norm(h);
+            control.err_last = err;
+            if (err <= 1.0) {
+                commit(land, t_stop);
+                // PI controller (Gustafsson; k = 3 for a local error O(h^3)), growth at most 2,
+                // no growth right after a rejection or on two consecutive steps (sec. 1.2),
+                // and a dead band that keeps h (and the factorization) for small growth.
+                const double e = std::max(err, 1e-10);
+                double fac = kSafety * std::pow(e, -0.7 / 3.0) *
+                             std::pow(std::max(control.err_prev, 1e-10), 0.4 / 3.0);
+                fac = std::clamp(fac, kMinShrink, kMaxGrowth);
+                if (fac > 1.0 && (rejected || control.grew || fac < kDeadBand))
+                    fac = 1.0;
+                control.grew = fac > 1.0;
+                control.err_prev = e;
+                control.h_next = h * fac;
+                if (control.h_max > 0.0)
+                    control.h_next = std::min(control.h_next, control.h_max);
+                return GA_OK;
+            }
+            count(counters, GA_COUNT_REJECTED_STEPS);
+            h *= std::max(kMinShrink, kSafety * std::pow(err, -1.0 / 3.0));
+        } else if (recoverable(st)) {
+            count(counters, GA_COUNT_FAILED_STEPS);
+            invalidate_jacobian();
+            h *= kFailureShrink;
+        } else {
+            count(counters, GA_COUNT_FAILED_STEPS);
+            invalidate_jacobian();
+            return st;
+        }
+        rejected = true;
+    }
+}
+
+ga_status Solver::advance(double t_out)
+{
+    if (t_out < accepted_.t)
+        return diag.fail(GA_ERR_ARG, "t_out = %.17g is before t = %.17g", t_out, accepted_.t);
+    while (accepted_.t < t_out)
+        if (auto st = step_adaptive(t_out))
+            return st;
+    return GA_OK;
+}
+
+// Cubic Hermite interpolation of q (from q, v at both ends) and of v (from v, qdd) over the
+// last step; lambda linear.
+ga_status Solver::interpolate(double t, double *q, double *v, double *lambda) const
+{
+    if (!previous_valid_)
+        return GA_ERR_STATE;
+    const State &a = previous_, &b = accepted_;
+    const double h = b.t - a.t;
+    const double slack = 1e-12 * std::max(std::fabs(b.t), 1.0);
+    if (!(t >= a.t - slack && t <= b.t + slack))
+        return GA_ERR_ARG;
+    const double th = std::clamp((t - a.t) / h, 0.0, 1.0);
+    const double h00 = (2 * th - 3) * th * th + 1, h10 = ((th - 2) * th + 1) * th;
+    const double h01 = (3 - 2 * th) * th * th, h11 = (th - 1) * th * th;
+    if (q)
+        Eigen::Map<Vec>(q, n_) = h00 * a.q + (h10 * h) * a.v + h01 * b.q + (h11 * h) * b.v;
+    if (v)
+        Eigen::Map<Vec>(v, n_) = h00 * a.v + (h10 * h) * a.qdd + h01 * b.v + (h11 * h) * b.qdd;
+    if (lambda && m_ > 0)
+        Eigen::Map<Vec>(lambda, m_) = (1.0 - th) * a.lambda + th * b.lambda;
+    return GA_OK;
+}
+
+}  // namespace ga
