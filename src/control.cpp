@@ -29,26 +29,40 @@ bool recoverable(ga_status st)
 //   velocities (sec. 1.5b): e_v = C_v h^3 qdddd with C_v = 1/12 - delta_alpha^2
 //       + delta_alpha (alpha_m - 1/2), qdddd from the divided differences of a over the last
 //       two steps (not available in the first step, where e_v = 0)
-double Solver::error_norm(double h) const
+// With constraints both estimates are projected onto the tangent space of the constraints,
+// null(Phi_q), along the directions constraint forces act in, M^-1 Phi_q^T (the M-orthogonal
+// projection): exact and numerical solution both satisfy the constraints, so their difference
+// has no such component to leading order, while a carries the transients of the multipliers
+// after step-size changes (index 3), which would otherwise throttle the controller.
+double Solver::error_norm(double h)
 {
     const Params &p = params;
     const State &s = accepted_, &x = trial_;
     const double da = p.alpha_m - p.alpha_f;
     const double cq = h * h * (p.beta + 0.5 * da - 1.0 / 6.0);
     const double cv = 1.0 / 12.0 - da * da + da * (p.alpha_m - 0.5);
+    Vec &eq = dq_, &ev = dw_;  // scratch
+    eq = cq * (x.a - a_n_);
+    if (s.h_last > 0.0)
+        ev = (cv * h * h * h / (0.5 * (h + s.h_last))) *
+             ((x.a - a_n_) / h - (s.a - s.a_prev) / s.h_last);
+    else
+        ev.setZero();
+    if (m_ > 0 && P_.ready() && P_.factorize_kkt(M_, 1.0, J_)) {
+        for (Vec *e : {&eq, &ev}) {
+            // [M Phi_q^T; Phi_q 0] [x; y] = [M e; 0]: x = e - M^-1 Phi_q^T y, Phi_q x = 0
+            rq_.setZero();
+            M_.multiply_add(-1.0, *e, rq_);
+            phi_.setZero();
+            P_.solve(rq_, phi_, *e, lambda_tmp_);
+        }
+    }
     const double rtol = control.rtol, atol = control.atol;
     double sum = 0.0;
     for (int i = 0; i < n_; ++i) {
-        const double eq = cq * (x.a[i] - a_n_[i]);
         const double wq = atol + rtol * std::max(std::fabs(s.q[i]), std::fabs(x.q[i]));
-        double ev = 0.0;
-        if (s.h_last > 0.0) {
-            const double d4 = ((x.a[i] - a_n_[i]) / h - (s.a[i] - s.a_prev[i]) / s.h_last) /
-                              (0.5 * (h + s.h_last));
-            ev = cv * h * h * h * d4;
-        }
         const double wv = atol + rtol * std::max(std::fabs(s.v[i]), std::fabs(x.v[i]));
-        sum += (eq / wq) * (eq / wq) + (ev / wv) * (ev / wv);
+        sum += (eq[i] / wq) * (eq[i] / wq) + (ev[i] / wv) * (ev[i] / wv);
     }
     return std::sqrt(sum / (2.0 * n_));
 }

@@ -116,7 +116,7 @@ ga_status Solver::setup()
         backend = make_dense_backend(linear_solver == GA_LINEAR_DENSE_LAPACK ? DenseKind::Lapack
                                                                              : DenseKind::Eigen);
     }
-    const bool dense = !sparse || !backend;
+    const bool dense = !sparse || !backend;  // (before backend is moved)
     M_.allocate();
     J_.allocate();
     K_.allocate();
@@ -134,7 +134,11 @@ ga_status Solver::setup()
     qdd_tmp_.setZero(n_);
     lambda_tmp_.setZero(m_);
     model.allocate_workspace(M_, J_, K_, C_);
+    const bool sparse_backend = sparse && backend;
     S_.setup(std::move(backend), n_, m_, M_, J_, K_, C_);
+    if (m_ > 0)
+        P_.setup(sparse_backend ? make_sparse_backend() : make_dense_backend(DenseKind::Eigen), n_,
+                 m_, M_, J_, K_, C_);
     if (dense) {  // the stabilized index-2 formulation is dense only
         Bd_.setZero(m_, n_);
         S2_.setup(n_, m_);

@@ -110,7 +110,7 @@ private:
     ga_status factorize(double h, bool tangents_K, bool tangents_C, int iter);
     ga_status evaluate_mass(double t, const Vec &q);
     void commit(bool land_on, double t_land);
-    double error_norm(double h) const;  // control.cpp
+    double error_norm(double h);  // control.cpp
     // init.cpp
     ga_status project_positions(double t, Vec &q);
     ga_status project_velocities(double t, const Vec &q, Vec &v);
@@ -148,6 +148,7 @@ private:
     Mat Bd_;  // index-2: Phi_q(q_n), dense
     Vec f_, phi_, phi_v_, rq_, dq_, dw_, dlambda_, deta_, c_, qdd_tmp_, lambda_tmp_;
     IterationMatrix S_;
+    IterationMatrix P_;  // [I Phi_q^T; Phi_q 0]: tangent projection of error estimates
     Index2Matrix S2_;
     ConvergenceTest convergence_;
 };
