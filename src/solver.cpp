@@ -229,6 +229,15 @@ ga_status Solver::attempt_step(double h)
         if (auto st = newton(h, true, converged, used_stale))
             return st;
     }
+    if (!converged && predictor == GA_PREDICTOR_EXTRAPOLATE) {
+        // An extrapolation through a rough a_n (after abrupt changes of h, or without
+        // rescaling) can start Newton outside its basin: once more from a_{n+1} = a_n.
+        predictor = GA_PREDICTOR_CONSTANT_A;
+        const ga_status st = newton(h, true, converged, used_stale);
+        predictor = GA_PREDICTOR_EXTRAPOLATE;
+        if (st)
+            return st;
+    }
     if (!converged)
         return diag.fail(GA_ERR_NEWTON,
                          "Newton iteration did not converge in %d iterations in the step from "

@@ -1,0 +1,500 @@
+/* Accuracy on demand: variable steps (a_n rescaled), the stabilized index-2 formulation,
+ * corrected starting values, the local error estimate and controller, ga_advance and dense
+ * output. Oracles: the mathematics of ALGORITHMS.md (secs. 1, 2.6, 6.5) and independent RK4
+ * solutions; none of the expected values comes from galpha. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "helpers.h"
+#include "scene_run.h"
+#include "scenes/andrews.h"
+#include "scenes/index1_rk4.h"
+#include "scenes/slider_crank.h"
+
+static pendulum P = {1.0, 1.0, 9.81};
+static const double TH0 = 1.0, OM0 = 0.5;
+
+/* Exact pendulum, advanced incrementally (RK4 on the angle with substeps of at most 1e-5). */
+typedef struct exact_pendulum {
+    double t, th, om;
+} exact_pendulum;
+
+static void exact_advance(exact_pendulum *e, double t_to)
+{
+    const long n = (long)ceil((t_to - e->t) / 1e-5 - 1e-9);
+    const double h = n > 0 ? (t_to - e->t) / n : 0.0, w2 = P.gravity / P.length;
+    for (long i = 0; i < n; ++i) {
+        const double k1t = e->om, k1o = -w2 * sin(e->th);
+        const double k2t = e->om + 0.5 * h * k1o, k2o = -w2 * sin(e->th + 0.5 * h * k1t);
+        const double k3t = e->om + 0.5 * h * k2o, k3o = -w2 * sin(e->th + 0.5 * h * k2t);
+        const double k4t = e->om + h * k3o, k4o = -w2 * sin(e->th + h * k3t);
+        e->th += h / 6.0 * (k1t + 2 * k2t + 2 * k3t + k4t);
+        e->om += h / 6.0 * (k1o + 2 * k2o + 2 * k3o + k4o);
+    }
+    e->t = t_to;
+}
+
+static double exact_lambda(const exact_pendulum *e)
+{
+    return P.mass * (P.length * P.length * e->om * e->om + P.gravity * P.length * cos(e->th)) /
+           (P.length * P.length);
+}
+
+static ga_solver *pendulum_solver(double rho, int formulation, int rescale, int corrected)
+{
+    ga_solver *s = NULL;
+    double q[2], v[2];
+    pendulum_state(&P, TH0, OM0, q, v);
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &P),
+                     GA_OK);
+    assert_int_equal(ga_set_constraint_accel(s, pendulum_constraint_accel), GA_OK);
+    assert_int_equal(ga_set_rho_inf(s, rho), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    assert_int_equal(ga_set_rescale(s, rescale), GA_OK);
+    assert_int_equal(ga_set_corrected_start(s, corrected), GA_OK);
+    assert_int_equal(ga_set_newton(s, 1e-12, 20), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    return s;
+}
+
+/* ---- variable steps: rescaling a_n keeps order 2 (ALGORITHMS.md 1.1-1.2) -------------------- */
+/* A fixed pseudo-random pattern of 20 step ratios in [0.5, 1.5], normalized to sum to 1 and
+ * repeated 2^k times at 2^-k of the size: h changes at (almost) every step, at every level. */
+static void run_random_steps(int rescale, int level, double *eq, double *ev, double *el)
+{
+    enum { PATTERN = 20 };
+    double ratio[PATTERN], sum = 0.0;
+    unsigned state = 12345u;
+    for (int i = 0; i < PATTERN; ++i) {
+        state = state * 1103515245u + 12345u;
+        ratio[i] = 0.5 + (double)((state >> 8) & 0xffff) / 65535.0;
+        sum += ratio[i];
+    }
+    ga_solver *s = pendulum_solver(0.9, GA_INDEX2_STABILIZED, rescale, 1);
+    const int repeats = 1 << level;
+    for (int r = 0; r < repeats; ++r)
+        for (int i = 0; i < PATTERN; ++i)
+            assert_int_equal(ga_step(s, ratio[i] / sum / repeats), GA_OK);
+    double t, q[2], v[2], lambda;
+    ga_get_t(s, &t);
+    ga_get_q(s, q);
+    ga_get_v(s, v);
+    ga_get_lambda(s, &lambda);
+    const pendulum_exact ex = pendulum_reference(&P, TH0, OM0, t, 200000);
+    *eq = max_abs_diff(q, ex.q, 2);
+    *ev = max_abs_diff(v, ex.v, 2);
+    *el = fabs(lambda - ex.lambda);
+    ga_free(s);
+}
+
+static void rescaling_keeps_order_two_under_random_steps(void **state)
+{
+    (void)state;
+    enum { K = 4 };
+    double hs[K], e[3][K];
+    for (int k = 0; k < K; ++k) {
+        hs[k] = 1.0 / (20.0 * (1 << (k + 2)));
+        run_random_steps(1, k + 2, &e[0][k], &e[1][k], &e[2][k]);
+    }
+    const double oq = fit_order(hs, e[0], K), ov = fit_order(hs, e[1], K);
+    const double ol = fit_order(hs, e[2], K);
+    printf("  random steps (ratios 0.5 to 1.5), index-2, a_n rescaled: order q %.2f v %.2f "
+           "lambda %.2f\n",
+           oq, ov, ol);
+    assert_true(oq > 1.8 && ov > 1.8 && ol > 1.8);
+}
+
+/* The same ODE as ALGORITHMS.md 1.1, theta'' = -9.81 sin(theta) from theta = 1 at rest, steps
+ * h, 2h, h, 2h, ... to t = 1: without rescaling the order drops towards 1. */
+static int pend_ode_mass(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    M[0] = 1.0;
+    return 0;
+}
+static int pend_ode_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)v, (void)u;
+    f[0] = -9.81 * sin(q[0]);
+    return 0;
+}
+
+static void without_rescaling_alternating_steps_lose_an_order(void **state)
+{
+    (void)state;
+    enum { K = 4 };
+    pendulum unit = {1.0, 1.0, 9.81};
+    const pendulum_exact ex = pendulum_reference(&unit, 1.0, 0.0, 1.0, 200000);
+    const double exact = atan2(ex.q[0], -ex.q[1]);
+    double hs[K], err[2][K];
+    for (int r = 0; r < 2; ++r)
+        for (int k = 0; k < K; ++k) {
+            ga_solver *s = NULL;
+            double q = 1.0, v = 0.0;
+            hs[k] = 1.0 / (30.0 * (1 << k));
+            assert_int_equal(ga_create(1, 0, &s), GA_OK);
+            assert_int_equal(ga_set_callbacks(s, pend_ode_mass, pend_ode_force, NULL, NULL, NULL),
+                             GA_OK);
+            assert_int_equal(ga_set_rescale(s, r), GA_OK);
+            assert_int_equal(ga_set_newton(s, 1e-13, 20), GA_OK);
+            assert_int_equal(ga_init(s, 0.0, &q, &v), GA_OK);
+            for (long i = 0; i < lround(1.0 / (3.0 * hs[k])); ++i) {
+                assert_int_equal(ga_step(s, hs[k]), GA_OK);
+                assert_int_equal(ga_step(s, 2.0 * hs[k]), GA_OK);
+            }
+            ga_get_q(s, &q);
+            err[r][k] = fabs(q - exact);
+            ga_free(s);
+        }
+    const double on = fit_order(hs, err[1], K), off = fit_order(hs, err[0], K);
+    printf("  steps h, 2h, h, ... on theta'' = -g sin(theta): order %.2f with rescaling, %.2f "
+           "without (error at the finest h %.1e vs %.1e)\n",
+           on, off, err[1][K - 1], err[0][K - 1]);
+    assert_true(on > 1.9);
+    assert_true(off < 1.6);
+    assert_true(err[0][K - 1] > 2.0 * err[1][K - 1]);
+}
+
+/* ---- multipliers across a step change (ALGORITHMS.md 1.4) ------------------------------------ */
+static double lambda_error_after_change(int formulation, double h)
+{
+    /* h until t = 0.5, then 2h; max |lambda error| over (0.5, 0.6] */
+    ga_solver *s = pendulum_solver(0.8, formulation, 1, 1);
+    exact_pendulum e = {0.0, TH0, OM0};
+    const long n1 = lround(0.5 / h), n2 = lround(0.1 / (2 * h));
+    for (long k = 0; k < n1; ++k)
+        assert_int_equal(ga_step(s, h), GA_OK);
+    double worst = 0.0, t, lambda;
+    for (long k = 0; k < n2; ++k) {
+        assert_int_equal(ga_step(s, 2 * h), GA_OK);
+        ga_get_t(s, &t);
+        ga_get_lambda(s, &lambda);
+        exact_advance(&e, t);
+        worst = fmax(worst, fabs(lambda - exact_lambda(&e)));
+    }
+    ga_free(s);
+    return worst;
+}
+
+static void index2_multipliers_stay_second_order_across_step_changes(void **state)
+{
+    (void)state;
+    enum { K = 4 };
+    double hs[K], e2[K], e3[K];
+    for (int k = 0; k < K; ++k) {
+        hs[k] = 0.01 / (1 << k);
+        e2[k] = lambda_error_after_change(GA_INDEX2_STABILIZED, hs[k]);
+        e3[k] = lambda_error_after_change(GA_INDEX3, hs[k]);
+    }
+    const double o2 = fit_order(hs, e2, K), o3 = fit_order(hs, e3, K);
+    printf("  lambda error just after h -> 2h: index-2 %.1e ... %.1e (order %.2f); index-3 %.1e "
+           "... %.1e (order %.2f)\n",
+           e2[0], e2[K - 1], o2, e3[0], e3[K - 1], o3);
+    assert_true(o2 > 1.8);
+    assert_true(o3 < 1.3);
+}
+
+/* ---- start-up transient (ALGORITHMS.md 2.6) ---------------------------------------------- */
+static double startup_lambda_error(int corrected, double h)
+{
+    ga_solver *s = pendulum_solver(0.9, GA_INDEX3, 1, corrected);
+    exact_pendulum e = {0.0, TH0, OM0};
+    double worst = 0.0, t, lambda;
+    for (long k = 0; k < lround(0.1 / h); ++k) {
+        assert_int_equal(ga_step(s, h), GA_OK);
+        ga_get_t(s, &t);
+        ga_get_lambda(s, &lambda);
+        exact_advance(&e, t);
+        worst = fmax(worst, fabs(lambda - exact_lambda(&e)));
+    }
+    ga_free(s);
+    return worst;
+}
+
+static void corrected_start_removes_the_first_order_transient(void **state)
+{
+    (void)state;
+    enum { K = 4 };
+    double hs[K], on[K], off[K];
+    for (int k = 0; k < K; ++k) {
+        hs[k] = 0.01 / (1 << k);
+        on[k] = startup_lambda_error(1, hs[k]);
+        off[k] = startup_lambda_error(0, hs[k]);
+    }
+    const double o_on = fit_order(hs, on, K), o_off = fit_order(hs, off, K);
+    printf("  max lambda error over [0, 0.1]: corrected start %.1e (order %.2f), a_0 = qdd_0 "
+           "%.1e (order %.2f)\n",
+           on[K - 1], o_on, off[K - 1], o_off);
+    assert_true(o_on > 1.8);
+    assert_true(o_off < 1.3);
+    assert_true(off[K - 1] > 10.0 * on[K - 1]);
+}
+
+/* ---- the error estimate against the true local error (ALGORITHMS.md 1.5, 6.5) -------------- */
+static int ode_mass(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    M[0] = 1.0;
+    return 0;
+}
+static int ode_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)v, (void)u;
+    f[0] = -9.81 * sin(q[0]);
+    return 0;
+}
+
+/* One adaptive step of size h of theta'' = -9.81 sin(theta) from smooth starting values (a_n,
+ * a_{n-1} on the shifted acceleration of ALGORITHMS.md sec. 0, constant step h); returns
+ * GA_INFO_ERROR_ESTIMATE and, through *truth, the same weighted norm of the true local errors
+ * (numerical minus RK4). Tolerances 1 make the weights 1 + max(|y_n|, |y_n+1|). */
+static double estimate_vs_truth(double h, double *truth)
+{
+    const double th = 0.7, om = 0.3, g = 9.81;
+    double am, af, beta, gamma;
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(1, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, ode_mass, ode_force, NULL, NULL, NULL), GA_OK);
+    assert_int_equal(ga_set_newton(s, 1e-14, 20), GA_OK);
+    assert_int_equal(ga_set_tolerances(s, 1.0, 1.0), GA_OK);
+    ga_get_params(s, &am, &af, &beta, &gamma);
+    const double da = am - af;
+    /* derivatives of theta at t_n */
+    const double a2 = -g * sin(th), a3 = -g * cos(th) * om;
+    const double a4 = g * sin(th) * om * om - g * cos(th) * a2;
+    const double a5 = g * cos(th) * om * om * om + 3 * g * sin(th) * om * a2 - g * cos(th) * a3;
+    /* a(t) = qdd(t + da h) + da (am - 1/2) h^2 qdddd(t + ...): shifted accelerations */
+    double buf[9 + 5 * 1 + 0];
+    buf[0] = 26465.0, buf[1] = 2.0, buf[2] = 1.0, buf[3] = 0.0;
+    buf[4] = 0.0, buf[5] = h, buf[6] = h, buf[7] = 1.0, buf[8] = 0.0;
+    buf[9] = th, buf[10] = om, buf[11] = a2;
+    buf[12] = a2 + da * h * a3 + (0.5 * da * da + da * (am - 0.5)) * h * h * a4;
+    buf[13] = (a2 - h * a3 + 0.5 * h * h * a4) + da * h * (a3 - h * a4) +
+              (0.5 * da * da + da * (am - 0.5)) * h * h * (a4 - h * a5);
+    assert_int_equal(ga_set_state(s, buf, 14), GA_OK);
+    assert_int_equal(ga_step_adaptive(s, 1.0), GA_OK);
+    double h_taken, est, q, v;
+    ga_get_h_last(s, &h_taken);
+    assert_true(fabs(h_taken - h) < 1e-15);
+    ga_get_info(s, GA_INFO_ERROR_ESTIMATE, &est);
+    ga_get_q(s, &q);
+    ga_get_v(s, &v);
+    /* exact one-step solution */
+    double y[2] = {th, om};
+    const long n = 20000;
+    const double k = h / n;
+    for (long i = 0; i < n; ++i) {
+        const double k1t = y[1], k1o = -g * sin(y[0]);
+        const double k2t = y[1] + 0.5 * k * k1o, k2o = -g * sin(y[0] + 0.5 * k * k1t);
+        const double k3t = y[1] + 0.5 * k * k2o, k3o = -g * sin(y[0] + 0.5 * k * k2t);
+        const double k4t = y[1] + k * k3o, k4o = -g * sin(y[0] + k * k3t);
+        y[0] += k / 6.0 * (k1t + 2 * k2t + 2 * k3t + k4t);
+        y[1] += k / 6.0 * (k1o + 2 * k2o + 2 * k3o + k4o);
+    }
+    const double wq = 1.0 + fmax(fabs(th), fabs(q)), wv = 1.0 + fmax(fabs(om), fabs(v));
+    *truth = sqrt(0.5 * (pow((q - y[0]) / wq, 2) + pow((v - y[1]) / wv, 2)));
+    ga_free(s);
+    return est;
+}
+
+static void error_estimate_tends_to_the_true_local_error(void **state)
+{
+    (void)state;
+    double ratio[3];
+    for (int k = 0; k < 3; ++k) {
+        const double h = 0.02 / (1 << k);
+        double truth;
+        const double est = estimate_vs_truth(h, &truth);
+        ratio[k] = est / truth;
+        printf("  h = %-6g estimate %.3e, true local error %.3e, ratio %.3f\n", h, est, truth,
+               ratio[k]);
+    }
+    assert_true(fabs(ratio[2] - 1.0) < 0.15);
+    assert_true(fabs(ratio[2] - 1.0) <= fabs(ratio[0] - 1.0) + 0.02);
+}
+
+/* ---- ga_advance and dense output --------------------------------------------------------- */
+static void advance_lands_on_every_output_time(void **state)
+{
+    (void)state;
+    ga_solver *s = pendulum_solver(0.9, GA_INDEX2_STABILIZED, 1, 1);
+    assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+    exact_pendulum e = {0.0, TH0, OM0};
+    for (int k = 1; k <= 10; ++k) {
+        const double t_out = 0.1 * k;
+        double t, q[2], ex[2], dummy[2];
+        assert_int_equal(ga_advance(s, t_out), GA_OK);
+        ga_get_t(s, &t);
+        assert_true(t == t_out); /* exactly */
+        ga_get_q(s, q);
+        exact_advance(&e, t_out);
+        pendulum_state(&P, e.th, e.om, ex, dummy);
+        assert_true(max_abs_diff(q, ex, 2) < 1e-3); /* global error at the tolerance's scale */
+    }
+    long long steps, rejected;
+    ga_get_counter(s, GA_COUNT_STEPS, &steps);
+    ga_get_counter(s, GA_COUNT_REJECTED_STEPS, &rejected);
+    printf("  pendulum to t = 1 with rtol = atol = 1e-6: %lld steps, %lld rejected\n", steps,
+           rejected);
+    ga_free(s);
+}
+
+static void interpolation_agrees_with_a_step_ending_there(void **state)
+{
+    (void)state;
+    ga_solver *s = pendulum_solver(0.9, GA_INDEX2_STABILIZED, 1, 1);
+    assert_int_equal(ga_set_tolerances(s, 1e-5, 1e-5), GA_OK);
+    double ckpt[9 + 5 * 2 + 1], t0, t1;
+    for (int k = 0; k < 25; ++k)
+        assert_int_equal(ga_step_adaptive(s, 10.0), GA_OK);
+    assert_int_equal(ga_get_state(s, ckpt, 20), GA_OK);
+    ga_get_t(s, &t0);
+    assert_int_equal(ga_step_adaptive(s, 10.0), GA_OK);
+    ga_get_t(s, &t1);
+    /* ends of the interval: the interpolant is exact there */
+    double qa[2], qb[2], q[2], v[2], lam, est;
+    assert_int_equal(ga_interpolate(s, t1, qa, NULL, NULL), GA_OK);
+    ga_get_q(s, qb);
+    assert_true(max_abs_diff(qa, qb, 2) < 1e-15);
+    assert_int_equal(ga_interpolate(s, t0 - 1.0, q, v, &lam), GA_ERR_ARG);
+    /* inside: against a step from t0 that ends at tau */
+    const double tau = t0 + 0.37 * (t1 - t0);
+    assert_int_equal(ga_interpolate(s, tau, q, v, &lam), GA_OK);
+    ga_get_info(s, GA_INFO_ERROR_ESTIMATE, &est);
+    ga_solver *r = pendulum_solver(0.9, GA_INDEX2_STABILIZED, 1, 1);
+    assert_int_equal(ga_set_state(r, ckpt, 20), GA_OK);
+    assert_int_equal(ga_step(r, tau - t0), GA_OK);
+    double qr[2], vr[2];
+    ga_get_q(r, qr);
+    ga_get_v(r, vr);
+    const double scale = 1e-5 * (1.0 + 1.0); /* atol + rtol |q|: the estimate's unit */
+    printf("  interpolated vs stepped to tau: |dq| = %.1e, |dv| = %.1e (error estimate %.2f x "
+           "%.0e)\n",
+           max_abs_diff(q, qr, 2), max_abs_diff(v, vr, 2), est, scale);
+    assert_true(max_abs_diff(q, qr, 2) < 10.0 * scale);
+    assert_true(max_abs_diff(v, vr, 2) < 10.0 * scale);
+    ga_free(r);
+    ga_free(s);
+}
+
+/* ---- whole runs ----------------------------------------------------------------------------- */
+static void slider_crank_runs_adaptively_to_its_end(void **state)
+{
+    (void)state;
+    slider_crank p = slider_crank_paper();
+    double q[SC_N], v[SC_N], qr[SC_N], vr[SC_N];
+    sc_initial(&p, M_PI / 2, q, v);
+    memcpy(qr, q, sizeof q);
+    memcpy(vr, v, sizeof v);
+    rk4_model md = {SC_N, SC_M, sc_mass, sc_force, sc_jacobian, sc_constraint_accel, &p};
+    assert_int_equal(index1_rk4(&md, 0.0, 1.0, 200000, qr, vr, NULL, NULL), 0);
+    for (int form = 0; form < 2; ++form) {
+        ga_solver *s = NULL;
+        assert_int_equal(ga_create(SC_N, SC_M, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, sc_mass, sc_force, sc_constraint, sc_jacobian, &p),
+                         GA_OK);
+        assert_int_equal(ga_set_tangents(s, sc_stiffness, NULL), GA_OK);
+        assert_int_equal(ga_set_formulation(s, form), GA_OK);
+        assert_int_equal(ga_set_rho_inf(s, 0.7), GA_OK);
+        assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        assert_int_equal(ga_advance(s, 1.0), GA_OK);
+        double qe[SC_N], phi[SC_M], t;
+        ga_get_t(s, &t);
+        ga_get_q(s, qe);
+        sc_constraint(t, qe, phi, &p);
+        long long steps;
+        ga_get_counter(s, GA_COUNT_STEPS, &steps);
+        const double e = fabs(qe[SC_TH1] - qr[SC_TH1]) / fabs(qr[SC_TH1]);
+        printf("  slider-crank, %s, rtol 1e-6: %lld steps, crank angle error %.1e\n",
+               form ? "index-2" : "index-3", steps, e);
+        assert_true(t == 1.0);
+        assert_true(e < 1e-3);
+        for (int i = 0; i < SC_M; ++i)
+            assert_true(fabs(phi[i]) < 1e-12);
+        ga_free(s);
+    }
+}
+
+static void andrews_error_follows_the_tolerance(void **state)
+{
+    (void)state;
+    enum { K = 6 };
+    double rtol[K], err[K];
+    long long res[K];
+    for (int k = 0; k < K; ++k) {
+        rtol[k] = pow(10.0, -2.0 - k);
+        ga_solver *s = NULL;
+        double v0[7] = {0}, q[7];
+        assert_int_equal(ga_create(7, 6, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, an7_mass, an7_force, an7_constraint,
+                                          an7_jacobian, NULL),
+                         GA_OK);
+        assert_int_equal(ga_set_constraint_accel(s, an7_constraint_accel), GA_OK);
+        assert_int_equal(ga_set_rho_inf(s, 0.7), GA_OK);
+        assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
+        assert_int_equal(ga_set_tolerances(s, rtol[k], rtol[k]), GA_OK);
+        assert_int_equal(ga_set_newton(s, fmin(1e-6, 1e-2 * rtol[k]), 20), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, andrews_q0, v0), GA_OK);
+        assert_int_equal(ga_advance(s, andrews_t_end), GA_OK);
+        ga_get_q(s, q);
+        double e = 0.0, r = 0.0;
+        for (int i = 0; i < 7; ++i) {
+            e += pow(q[i] - andrews_q_ref[i], 2);
+            r += pow(andrews_q_ref[i], 2);
+        }
+        err[k] = sqrt(e / r);
+        ga_get_counter(s, GA_COUNT_RESIDUALS, &res[k]);
+        printf("  Andrews, index-2, rtol %.0e: angle error %.2e, %lld residual evaluations\n",
+               rtol[k], err[k], res[k]);
+        ga_free(s);
+    }
+    const double slope = fit_order(rtol, err, K);
+    printf("  tolerance proportionality: slope of log(error) against log(rtol) = %.2f\n", slope);
+    assert_true(slope >= 0.7 && slope <= 1.3);
+}
+
+static void step_size_floor_is_reported(void **state)
+{
+    (void)state;
+    ga_solver *s = pendulum_solver(0.9, GA_INDEX3, 1, 1);
+    double before[20], after[20];
+    assert_int_equal(ga_set_tolerances(s, 1e-12, 1e-12), GA_OK);
+    assert_int_equal(ga_set_step_limits(s, 0.05, 0.0), GA_OK);
+    assert_int_equal(ga_set_initial_step(s, 0.05), GA_OK);
+    assert_int_equal(ga_get_state(s, before, 20), GA_OK);
+    assert_int_equal(ga_advance(s, 1.0), GA_ERR_STEP_SIZE);
+    assert_non_null(strstr(ga_last_error(s), "fell below the minimum"));
+    assert_int_equal(ga_get_state(s, after, 20), GA_OK);
+    assert_memory_equal(before, after, sizeof before);
+    assert_int_equal(ga_set_step_limits(s, 0.2, 0.1), GA_ERR_ARG);
+    assert_int_equal(ga_set_tolerances(s, 0.0, 1e-6), GA_ERR_ARG);
+    assert_int_equal(ga_advance(s, -1.0), GA_ERR_ARG);
+    assert_int_equal(ga_step_adaptive(s, 0.0), GA_ERR_ARG);
+    ga_free(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(rescaling_keeps_order_two_under_random_steps),
+        cmocka_unit_test(without_rescaling_alternating_steps_lose_an_order),
+        cmocka_unit_test(index2_multipliers_stay_second_order_across_step_changes),
+        cmocka_unit_test(corrected_start_removes_the_first_order_transient),
+        cmocka_unit_test(error_estimate_tends_to_the_true_local_error),
+        cmocka_unit_test(advance_lands_on_every_output_time),
+        cmocka_unit_test(interpolation_agrees_with_a_step_ending_there),
+        cmocka_unit_test(slider_crank_runs_adaptively_to_its_end),
+        cmocka_unit_test(andrews_error_follows_the_tolerance),
+        cmocka_unit_test(step_size_floor_is_reported),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
