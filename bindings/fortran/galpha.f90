@@ -20,19 +20,26 @@ module galpha
   integer(c_int), parameter, public :: GA_OK = 0, GA_ERR_ARG = -1, GA_ERR_STATE = -2, &
        GA_ERR_NOMEM = -3, GA_ERR_CALLBACK = -4, GA_ERR_CALLBACK_RETRY = -5, &
        GA_ERR_NONFINITE = -6, GA_ERR_SINGULAR = -7, GA_ERR_NEWTON = -8, &
-       GA_ERR_INCONSISTENT = -9, GA_ERR_INTERNAL = -10
+       GA_ERR_INCONSISTENT = -9, GA_ERR_INTERNAL = -10, GA_ERR_STEP_SIZE = -11
   ! ---- options ----------------------------------------------------------------------------
   integer(c_int), parameter, public :: GA_TANGENT_AUTO = 0, GA_TANGENT_FD = 1, &
        GA_TANGENT_NEGLECT = 2
-  integer(c_int), parameter, public :: GA_PREDICTOR_CONSTANT_A = 0, GA_PREDICTOR_ZERO = 1
+  integer(c_int), parameter, public :: GA_PREDICTOR_CONSTANT_A = 0, GA_PREDICTOR_ZERO = 1, &
+       GA_PREDICTOR_EXTRAPOLATE = 2
+  integer(c_int), parameter, public :: GA_REUSE_AUTO = 0, GA_REUSE_NEVER = 1
+  integer(c_int), parameter, public :: GA_MATRIX_MASS = 0, GA_MATRIX_JACOBIAN = 1, &
+       GA_MATRIX_STIFFNESS = 2, GA_MATRIX_DAMPING = 3
+  integer(c_int), parameter, public :: GA_LINEAR_AUTO = 0, GA_LINEAR_DENSE = 1, &
+       GA_LINEAR_SPARSE = 2, GA_LINEAR_DENSE_LAPACK = 3, GA_LINEAR_DENSE_EIGEN = 4
+  integer(c_int), parameter, public :: GA_INDEX3 = 0, GA_INDEX2_STABILIZED = 1
   integer(c_int), parameter, public :: GA_INIT_PROJECT = 0, GA_INIT_REFUSE = 1
   integer(c_int), parameter, public :: GA_COUNT_STEPS = 0, GA_COUNT_FAILED_STEPS = 1, &
        GA_COUNT_NEWTON_ITERS = 2, GA_COUNT_FACTORIZATIONS = 3, GA_COUNT_RESIDUALS = 4, &
        GA_COUNT_MASS_EVALS = 5, GA_COUNT_FORCE_EVALS = 6, GA_COUNT_CONSTRAINT_EVALS = 7, &
        GA_COUNT_JACOBIAN_EVALS = 8, GA_COUNT_STIFFNESS_EVALS = 9, &
-       GA_COUNT_DAMPING_EVALS = 10, GA_COUNT_ACCEL_EVALS = 11
+       GA_COUNT_DAMPING_EVALS = 10, GA_COUNT_ACCEL_EVALS = 11, GA_COUNT_REJECTED_STEPS = 12
   integer(c_int), parameter, public :: GA_INFO_RCOND = 0, GA_INFO_NEWTON_ITERS = 1, &
-       GA_INFO_NEWTON_RATIO = 2
+       GA_INFO_NEWTON_RATIO = 2, GA_INFO_ERROR_ESTIMATE = 3, GA_INFO_H_NEXT = 4
 
   ! ---- callback interfaces ----------------------------------------------------------------
   abstract interface
@@ -240,6 +247,80 @@ module galpha
        integer(c_int), value :: key
        real(c_double), intent(out) :: value
      end function ga_get_info
+     integer(c_int) function ga_set_jacobian_reuse(s, mode) bind(C, name="ga_set_jacobian_reuse")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: mode
+     end function ga_set_jacobian_reuse
+     integer(c_int) function ga_set_constant_mass(s, on) bind(C, name="ga_set_constant_mass")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: on
+     end function ga_set_constant_mass
+     integer(c_int) function ga_set_pattern(s, which, nnz, rows, cols) &
+          bind(C, name="ga_set_pattern")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: which, nnz
+       integer(c_int), intent(in) :: rows(*), cols(*)  ! 0-based, as in C
+     end function ga_set_pattern
+     integer(c_int) function ga_set_linear_solver(s, solver) bind(C, name="ga_set_linear_solver")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: solver
+     end function ga_set_linear_solver
+     type(c_ptr) function ga_linear_solver_name(s) bind(C, name="ga_linear_solver_name")
+       import :: c_ptr
+       type(c_ptr), value :: s
+     end function ga_linear_solver_name
+     integer(c_int) function ga_set_formulation(s, formulation) &
+          bind(C, name="ga_set_formulation")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: formulation
+     end function ga_set_formulation
+     integer(c_int) function ga_set_rescale(s, on) bind(C, name="ga_set_rescale")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: on
+     end function ga_set_rescale
+     integer(c_int) function ga_set_corrected_start(s, on) bind(C, name="ga_set_corrected_start")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: on
+     end function ga_set_corrected_start
+     integer(c_int) function ga_set_tolerances(s, rtol, atol) bind(C, name="ga_set_tolerances")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: rtol, atol
+     end function ga_set_tolerances
+     integer(c_int) function ga_set_step_limits(s, h_min, h_max) &
+          bind(C, name="ga_set_step_limits")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: h_min, h_max
+     end function ga_set_step_limits
+     integer(c_int) function ga_set_initial_step(s, h0) bind(C, name="ga_set_initial_step")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: h0
+     end function ga_set_initial_step
+     integer(c_int) function ga_step_adaptive(s, t_stop) bind(C, name="ga_step_adaptive")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: t_stop
+     end function ga_step_adaptive
+     integer(c_int) function ga_advance(s, t_out) bind(C, name="ga_advance")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: t_out
+     end function ga_advance
+     integer(c_int) function ga_interpolate(s, t, q, v, lambda) bind(C, name="ga_interpolate")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: t
+       real(c_double), intent(out) :: q(*), v(*), lambda(*)
+     end function ga_interpolate
      function c_strlen(p) bind(C, name="strlen")
        import :: c_ptr, c_size_t
        type(c_ptr), value :: p
@@ -251,7 +332,11 @@ module galpha
        ga_set_constraint_accel, ga_set_rho_inf, ga_set_params, ga_get_params, ga_set_newton, &
        ga_set_scaling, ga_set_predictor, ga_set_init_mode, ga_init, ga_step, ga_get_t, &
        ga_get_h_last, ga_get_q, ga_get_v, ga_get_qdd, ga_get_lambda, ga_get_a, &
-       ga_state_size, ga_get_state, ga_set_state, ga_get_counter, ga_reset_counters, ga_get_info
+       ga_state_size, ga_get_state, ga_set_state, ga_get_counter, ga_reset_counters, ga_get_info, &
+       ga_set_jacobian_reuse, ga_set_constant_mass, ga_set_pattern, ga_set_linear_solver, &
+       ga_linear_solver_name, ga_set_formulation, ga_set_rescale, ga_set_corrected_start, &
+       ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
+       ga_interpolate
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
@@ -272,6 +357,9 @@ module galpha
      procedure :: set_newton => solver_set_newton
      procedure :: init => solver_init
      procedure :: step => solver_step
+     procedure :: set_tolerances => solver_set_tolerances
+     procedure :: set_formulation => solver_set_formulation
+     procedure :: advance => solver_advance
      procedure :: t => solver_t
      procedure :: get_q => solver_get_q
      procedure :: get_v => solver_get_v
@@ -406,6 +494,24 @@ contains
     real(c_double), intent(in) :: h
     status = ga_step(this%handle, h)
   end function solver_step
+
+  integer(c_int) function solver_set_tolerances(this, rtol, atol) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: rtol, atol
+    status = ga_set_tolerances(this%handle, rtol, atol)
+  end function solver_set_tolerances
+
+  integer(c_int) function solver_set_formulation(this, formulation) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: formulation
+    status = ga_set_formulation(this%handle, formulation)
+  end function solver_set_formulation
+
+  integer(c_int) function solver_advance(this, t_out) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t_out
+    status = ga_advance(this%handle, t_out)
+  end function solver_advance
 
   real(c_double) function solver_t(this) result(t)
     class(galpha_solver), intent(in) :: this

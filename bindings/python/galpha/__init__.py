@@ -10,12 +10,18 @@ M(q) q'' = f(q, q', t) - Phi_q^T lambda, Phi(q, t) = 0 -- Python bindings over c
 or, for time histories, galpha.integrate(...). The low-level mirror of the C API is
 galpha._ffi (one function per C function)."""
 from . import _ffi
-from ._ffi import (GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_RCOND,  # noqa: F401
-                   GA_INIT_PROJECT, GA_INIT_REFUSE, GA_PREDICTOR_CONSTANT_A, GA_PREDICTOR_ZERO,
-                   GA_TANGENT_AUTO, GA_TANGENT_FD, GA_TANGENT_NEGLECT)
+from ._ffi import (GA_INDEX2_STABILIZED, GA_INDEX3, GA_INFO_ERROR_ESTIMATE,  # noqa: F401
+                   GA_INFO_H_NEXT, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_RCOND,
+                   GA_INIT_PROJECT, GA_INIT_REFUSE, GA_LINEAR_AUTO, GA_LINEAR_DENSE,
+                   GA_LINEAR_DENSE_EIGEN, GA_LINEAR_DENSE_LAPACK, GA_LINEAR_SPARSE,
+                   GA_MATRIX_DAMPING, GA_MATRIX_JACOBIAN, GA_MATRIX_MASS, GA_MATRIX_STIFFNESS,
+                   GA_PREDICTOR_CONSTANT_A, GA_PREDICTOR_EXTRAPOLATE, GA_PREDICTOR_ZERO,
+                   GA_REUSE_AUTO, GA_REUSE_NEVER, GA_TANGENT_AUTO, GA_TANGENT_FD,
+                   GA_TANGENT_NEGLECT)
 from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceError,  # noqa: F401
                      GalphaError, InconsistentError, InternalError, NonFiniteError,
-                     OutOfMemoryError, RecoverableError, SingularMatrixError, StateError)
+                     OutOfMemoryError, RecoverableError, SingularMatrixError, StateError,
+                     StepSizeError)
 from .integrate import IntegrateResult, integrate  # noqa: F401
 from .solver import Solver  # noqa: F401
 

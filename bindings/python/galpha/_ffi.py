@@ -96,15 +96,22 @@ GA_ERR_SINGULAR = -7
 GA_ERR_NEWTON = -8
 GA_ERR_INCONSISTENT = -9
 GA_ERR_INTERNAL = -10
+GA_ERR_STEP_SIZE = -11
 
 # Enumerations.
 GA_TANGENT_AUTO, GA_TANGENT_FD, GA_TANGENT_NEGLECT = 0, 1, 2
-GA_PREDICTOR_CONSTANT_A, GA_PREDICTOR_ZERO = 0, 1
+GA_PREDICTOR_CONSTANT_A, GA_PREDICTOR_ZERO, GA_PREDICTOR_EXTRAPOLATE = 0, 1, 2
+GA_REUSE_AUTO, GA_REUSE_NEVER = 0, 1
+GA_MATRIX_MASS, GA_MATRIX_JACOBIAN, GA_MATRIX_STIFFNESS, GA_MATRIX_DAMPING = 0, 1, 2, 3
+(GA_LINEAR_AUTO, GA_LINEAR_DENSE, GA_LINEAR_SPARSE, GA_LINEAR_DENSE_LAPACK,
+ GA_LINEAR_DENSE_EIGEN) = 0, 1, 2, 3, 4
+GA_INDEX3, GA_INDEX2_STABILIZED = 0, 1
 GA_INIT_PROJECT, GA_INIT_REFUSE = 0, 1
-GA_INFO_RCOND, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO = 0, 1, 2
+(GA_INFO_RCOND, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_ERROR_ESTIMATE,
+ GA_INFO_H_NEXT) = 0, 1, 2, 3, 4
 COUNTERS = ("steps", "failed_steps", "newton_iters", "factorizations", "residuals",
             "mass_evals", "force_evals", "constraint_evals", "jacobian_evals",
-            "stiffness_evals", "damping_evals", "accel_evals")
+            "stiffness_evals", "damping_evals", "accel_evals", "rejected_steps")
 
 _S = ctypes.c_void_p  # ga_solver *
 _I = ctypes.c_int
@@ -145,6 +152,20 @@ _SIGNATURES = {
     "ga_get_counter": (_I, [_S, _I, _P(ctypes.c_longlong)]),
     "ga_reset_counters": (_I, [_S]),
     "ga_get_info": (_I, [_S, _I, _P(_D)]),
+    "ga_set_jacobian_reuse": (_I, [_S, _I]),
+    "ga_set_constant_mass": (_I, [_S, _I]),
+    "ga_set_pattern": (_I, [_S, _I, _I, _P(_I), _P(_I)]),
+    "ga_set_linear_solver": (_I, [_S, _I]),
+    "ga_linear_solver_name": (ctypes.c_char_p, [_S]),
+    "ga_set_formulation": (_I, [_S, _I]),
+    "ga_set_rescale": (_I, [_S, _I]),
+    "ga_set_corrected_start": (_I, [_S, _I]),
+    "ga_set_tolerances": (_I, [_S, _D, _D]),
+    "ga_set_step_limits": (_I, [_S, _D, _D]),
+    "ga_set_initial_step": (_I, [_S, _D]),
+    "ga_step_adaptive": (_I, [_S, _D]),
+    "ga_advance": (_I, [_S, _D]),
+    "ga_interpolate": (_I, [_S, _D, c_double_p, c_double_p, c_double_p]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():

@@ -62,9 +62,14 @@ class InternalError(GalphaError, RuntimeError):
     status = _ffi.GA_ERR_INTERNAL
 
 
+class StepSizeError(GalphaError, RuntimeError):
+    """Adaptive mode: the step size fell below its minimum."""
+    status = _ffi.GA_ERR_STEP_SIZE
+
+
 _BY_STATUS = {cls.status: cls for cls in (
     ArgumentError, StateError, OutOfMemoryError, CallbackError, CallbackRetry, NonFiniteError,
-    SingularMatrixError, ConvergenceError, InconsistentError, InternalError)}
+    SingularMatrixError, ConvergenceError, InconsistentError, InternalError, StepSizeError)}
 
 
 def error_for(status, message):

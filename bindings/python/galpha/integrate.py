@@ -16,9 +16,14 @@ class IntegrateResult(dict):
             self.success, self.message, len(self.t) - 1, self.t[-1])
 
 
-def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h, *, m=0, **options):
-    """Integrate from t_span[0] to t_span[1] with fixed steps h (the last one shortened to land
-    on t_span[1]) and record every accepted step.
+def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=0, t_eval=None,
+              **options):
+    """Integrate from t_span[0] to t_span[1] and record every accepted step, or the states at
+    the times t_eval (by dense output, without shortening steps).
+
+    With h: fixed steps h (the last one shortened to land on t_span[1]). Without h: adaptive
+    steps controlled by `tolerances=(rtol, atol)` (default 1e-6, 1e-6); the stabilized index-2
+    formulation is recommended then (`formulation=galpha.GA_INDEX2_STABILIZED`).
 
     `options` go to Solver (rho_inf, newton, stiffness, constraint_accel, ...). A failure of
     the method (no convergence, singular matrix, ...) ends the integration with success=False
@@ -40,17 +45,42 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h, *, m=0, **op
             as_.append(s.qdd)
             ls.append(s.lam)
 
-        record()
+        def record_eval(t_prev):
+            while pending and pending[0] <= s.t:
+                te = pending.pop(0)
+                if te == s.t or te <= t_prev:
+                    record()
+                    ts[-1] = te
+                else:
+                    qi, vi, li = s.interpolate(te)
+                    ts.append(te)
+                    qs.append(qi)
+                    vs.append(vi)
+                    as_.append(np.full(n, np.nan))  # accelerations are not interpolated
+                    ls.append(li)
+
+        pending = sorted(float(t) for t in t_eval) if t_eval is not None else None
+        if pending is None:
+            record()
+        else:
+            record_eval(t0)
         while True:
             remaining = t1 - s.t
             if remaining <= 1e-12 * max(1.0, abs(t1)):
                 break
+            t_prev = s.t
             try:
-                s.step(h if remaining > h * (1.0 + 1e-9) else remaining)
+                if h is None:
+                    s.step_adaptive(t1)
+                else:
+                    s.step(h if remaining > h * (1.0 + 1e-9) else remaining)
             except GalphaError as e:
                 status, message = e.status, str(e)
                 break
-            record()
+            if pending is None:
+                record()
+            else:
+                record_eval(t_prev)
         stats = s.stats
     return IntegrateResult(t=np.array(ts), q=np.array(qs), v=np.array(vs), qdd=np.array(as_),
                            lam=np.array(ls).reshape(len(ts), m), stats=stats,

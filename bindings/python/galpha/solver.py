@@ -45,9 +45,12 @@ class Solver:
     stiffness(t, q, v, qdd, lam, K), damping(t, q, v, C), constraint_accel(t, q, v, out)
         Optional exact tangents and constraint acceleration term (finite differences
         otherwise).
-    rho_inf, params, newton, tangent_mode, scaling, predictor, init_mode
+    rho_inf, params, newton, tangent_mode, scaling, predictor, init_mode, formulation,
+    tolerances, reuse, constant_mass, linear_solver, rescale, corrected_start, step_limits
         Options, as the C setters (ga_set_rho_inf, ga_set_params((alpha_m, alpha_f, beta,
-        gamma)), ga_set_newton((tol, max_iter)), ...).
+        gamma)), ga_set_newton((tol, max_iter)), ga_set_tolerances((rtol, atol)),
+        ga_set_step_limits((h_min, h_max)), ga_set_formulation(galpha.GA_INDEX2_STABILIZED),
+        ...).
 
     Use as a context manager, or call close(); the handle is also freed by the garbage
     collector.
@@ -56,7 +59,9 @@ class Solver:
     def __init__(self, n, m, mass, force=None, constraint=None, jacobian=None, *,
                  stiffness=None, damping=None, constraint_accel=None, rho_inf=None,
                  params=None, newton=None, tangent_mode=None, scaling=None, predictor=None,
-                 init_mode=None):
+                 init_mode=None, formulation=None, tolerances=None, reuse=None,
+                 constant_mass=None, linear_solver=None, rescale=None, corrected_start=None,
+                 step_limits=None):
         self._ptr = None
         self._pending = None          # exception raised inside a callback
         self._views = {}              # (address, shape, writeable) -> ndarray
@@ -124,6 +129,18 @@ class Solver:
             self._check(_ffi.ga_set_predictor(self._ptr, int(predictor)))
         if init_mode is not None:
             self._check(_ffi.ga_set_init_mode(self._ptr, int(init_mode[0]), float(init_mode[1])))
+        for value, setter in ((formulation, _ffi.ga_set_formulation), (reuse, _ffi.ga_set_jacobian_reuse),
+                              (linear_solver, _ffi.ga_set_linear_solver)):
+            if value is not None:
+                self._check(setter(self._ptr, int(value)))
+        for value, setter in ((constant_mass, _ffi.ga_set_constant_mass), (rescale, _ffi.ga_set_rescale),
+                              (corrected_start, _ffi.ga_set_corrected_start)):
+            if value is not None:
+                self._check(setter(self._ptr, int(bool(value))))
+        if tolerances is not None:
+            self._check(_ffi.ga_set_tolerances(self._ptr, float(tolerances[0]), float(tolerances[1])))
+        if step_limits is not None:
+            self._check(_ffi.ga_set_step_limits(self._ptr, float(step_limits[0]), float(step_limits[1])))
 
     # ---- plumbing ---------------------------------------------------------------------------
     def _view(self, address, shape, writeable=False):
@@ -211,6 +228,25 @@ class Solver:
     def step(self, h):
         """One step of size h. On failure raises; the state stays at the last accepted step."""
         self._check(_ffi.ga_step(self._handle(), float(h)))
+
+    def step_adaptive(self, t_stop):
+        """One error-controlled step, not beyond t_stop (see ga_step_adaptive)."""
+        self._check(_ffi.ga_step_adaptive(self._handle(), float(t_stop)))
+
+    def advance(self, t_out):
+        """Error-controlled steps until t_out exactly (see ga_advance)."""
+        self._check(_ffi.ga_advance(self._handle(), float(t_out)))
+
+    def interpolate(self, t):
+        """(q, v, lam) at t inside the last step (dense output, see ga_interpolate)."""
+        q, v, lam = np.empty(self.n), np.empty(self.n), np.empty(max(self.m, 1))
+        self._check(_ffi.ga_interpolate(self._handle(), float(t), self._dp(q), self._dp(v),
+                                        self._dp(lam)))
+        return q, v, lam[:self.m]
+
+    @property
+    def linear_solver_name(self):
+        return _ffi.ga_linear_solver_name(self._handle()).decode()
 
     # ---- state ------------------------------------------------------------------------------
     @property
