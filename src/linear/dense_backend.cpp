@@ -70,9 +70,10 @@ public:
             S_.topRightCorner(n_, m_) = S_.bottomLeftCorner(m_, n_).transpose();
         }
         const int N = n_ + m_;
-        // 1-norm of S now (the factors overwrite it); the condition estimate itself (dgecon,
-        // as expensive as the LU for small sizes) is computed only when asked for.
-        anorm_ = dlange_("1", &N, &N, S_.data(), &N, work_.data(), 1);
+        // The condition estimate (dgecon, as expensive as the LU for small sizes) is computed
+        // only when asked for; it needs the 1-norm of S, which LAPACK's factors overwrite.
+        if (kind_ == DenseKind::Lapack)
+            anorm_ = dlange_("1", &N, &N, S_.data(), &N, work_.data(), 1);
         rcond_valid_ = false;
         if (kind_ == DenseKind::Lapack) {
             int info = 0;
@@ -96,6 +97,8 @@ public:
         if (!rcond_valid_ && pivot_ratio_ > 0.0) {
             const int N = n_ + m_;
             int info = 0;
+            if (kind_ == DenseKind::Eigen)  // S is intact: Eigen factorizes a copy
+                anorm_ = dlange_("1", &N, &N, S_.data(), &N, work_.data(), 1);
             dgecon_("1", &N, factors().data(), &N, &anorm_, &rcond_, work_.data(), iwork_.data(),
                     &info, 1);
             rcond_valid_ = true;
@@ -135,7 +138,8 @@ private:
     mutable Vec work_;
     Vec x_;
     Eigen::PartialPivLU<Mat> eigen_lu_;
-    double anorm_ = 0.0, pivot_ratio_ = 0.0;
+    mutable double anorm_ = 0.0;
+    double pivot_ratio_ = 0.0;
     mutable double rcond_ = 0.0;
     mutable bool rcond_valid_ = false;
 };

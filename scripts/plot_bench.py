@@ -1,0 +1,167 @@
+#!/usr/bin/python3
+"""Charts of docs/perf from the CSV files scripts/bench.sh writes there, and the figures the
+performance notes quote (printed). Usage: plot_bench.py DIR"""
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+DIR = sys.argv[1] if len(sys.argv) > 1 else "docs/perf"
+
+
+def rows(name):
+    path = os.path.join(DIR, name)
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def num(x):
+    try:
+        return float(x)
+    except ValueError:
+        return math.nan
+
+
+def save(fig, name):
+    fig.tight_layout()
+    fig.savefig(os.path.join(DIR, name), dpi=110)
+    plt.close(fig)
+    print("  wrote", os.path.join(DIR, name))
+
+
+# ---- per-step cost against the unavoidable work ---------------------------------------------
+sc = rows("step_cost.csv")
+if sc:
+    fig, ax = plt.subplots(figsize=(11, 4))
+    labels, cost, limit = [], [], []
+    for r in sc:
+        labels.append("%s\n%s\ntol %s" % (r["scene"], r["backend"].replace("dense ", ""),
+                                           r["newton_tol"]))
+        cost.append(num(r["us_per_step"]))
+        limit.append(num(r["limit_us"]))
+        print("  step cost %-17s %-16s tol %-6s %7.2f us/step, limit %6.2f us, ratio %5.2f, "
+              "%.2f Newton it/step, %.2f factorizations/step" % (
+                  r["scene"], r["backend"], r["newton_tol"], cost[-1], limit[-1],
+                  num(r["ratio"]), num(r["newton_per_step"]), num(r["factorizations_per_step"])))
+    x = np.arange(len(labels))
+    ax.bar(x - 0.2, cost, 0.4, label="mean cost per step")
+    ax.bar(x + 0.2, limit, 0.4, label="limit: one residual + one solve")
+    for i, r in enumerate(sc):
+        ax.text(x[i] - 0.2, cost[i], "%.1fx" % num(r["ratio"]), ha="center", va="bottom",
+                fontsize=7)
+    ax.set_xticks(x)
+    ax.set_xticklabels(labels, fontsize=6)
+    ax.set_yscale("log")
+    ax.set_ylabel("microseconds")
+    ax.legend()
+    ax.set_title("Cost per step against the unavoidable work (paper's scenes, fixed h)")
+    save(fig, "step_cost.png")
+
+# ---- chain scaling ------------------------------------------------------------------------------
+ch = rows("chain.csv")
+if ch:
+    N = np.array([num(r["links"]) for r in ch])
+    us = np.array([num(r["us_per_step"]) for r in ch])
+    lim = np.array([num(r["limit_us"]) for r in ch])
+    mem = np.array([num(r["peak_rss_kib"]) for r in ch]) / 1024.0
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.2))
+    ax[0].loglog(N, us, "o-", label="time per step")
+    ax[0].loglog(N, lim, "s--", label="limit (one residual + one solve)")
+    ax[0].loglog(N, us[0] * N / N[0], "k:", lw=1, label="linear in N")
+    ax[0].set(xlabel="links N (3N coordinates, 2N constraints)", ylabel="microseconds")
+    ax[0].legend()
+    ax[0].grid(True, which="both", lw=0.3)
+    ax[1].loglog(N, mem, "o-", label="peak resident memory")
+    ax[1].loglog(N, mem[-1] * N / N[-1], "k:", lw=1, label="linear in N")
+    ax[1].set(xlabel="links N", ylabel="MiB")
+    ax[1].legend()
+    ax[1].grid(True, which="both", lw=0.3)
+    fig.suptitle("N-link chain, sparse path (KLU), h = 1e-3, 10 steps")
+    save(fig, "chain.png")
+    i1, i2 = list(N).index(1000), list(N).index(100000)
+    print("  chain: time per step %.3g us at N = 1000, %.3g us at N = 100000: %.0f-fold; peak "
+          "memory %.1f MiB -> %.1f MiB" % (us[i1], us[i2], us[i2] / us[i1], mem[i1], mem[i2]))
+
+# ---- linear algebra -------------------------------------------------------------------------
+la = rows("linear_algebra.csv")
+if la:
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for backend, style in (("eigen", "o-"), ("lapack", "s-"), ("klu", "^-")):
+        pts = sorted((num(r["size"]), num(r["factorize_us"])) for r in la
+                     if r["backend"] == backend and r["matrix"] == "chain")
+        if pts:
+            ax.loglog(*zip(*pts), style, label="chain, " + backend)
+    for r in la:
+        if r["matrix"] != "chain":
+            ax.loglog(num(r["size"]), num(r["factorize_us"]),
+                      "o" if r["backend"] == "eigen" else "s", color="gray", ms=4)
+            ax.annotate(r["matrix"], (num(r["size"]), num(r["factorize_us"])), fontsize=6)
+    ax.set(xlabel="unknowns n + m", ylabel="assembly + factorization [us]",
+           title="Eigen LU vs reference LAPACK (dense) vs KLU (sparse)")
+    ax.legend()
+    ax.grid(True, which="both", lw=0.3)
+    save(fig, "linear_algebra.png")
+
+
+# ---- work-precision against IDA ---------------------------------------------------------------
+def curve(data, method):
+    pts = sorted((num(r["error"]), num(r["cpu_seconds"]), num(r["residuals"])) for r in data
+                 if r["method"] == method and not math.isnan(num(r["error"])))
+    return pts
+
+
+def cheapest_within(pts, target):
+    ok = [p for p in pts if p[0] <= target]
+    return min(ok, key=lambda p: p[1]) if ok else None
+
+
+for name, target in (("wp_andrews.csv", 1e-3), ("wp_slider_crank.csv", 1e-3)):
+    data = rows(name)
+    if not data:
+        continue
+    scene = data[0]["scene"]
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
+    methods = [("ida", "SUNDIALS IDA (index 1, BDF, rtol = atol swept)", "k"),
+               ("galpha", "galpha fixed h (full Newton)", "C0"),
+               ("galpha_simplified", "galpha fixed h (tangents neglected)", "C1"),
+               ("galpha_adaptive", "galpha adaptive (index 2)", "C2")]
+    best = {}
+    for method, label, color in methods:
+        pts = curve(data, method)
+        if not pts:
+            continue
+        e, cpu, res = zip(*pts)
+        ax[0].loglog(cpu, e, "o-", color=color, label=label, ms=4)
+        ax[1].loglog(res, e, "o-", color=color, label=label, ms=4)
+        best[method] = cheapest_within(pts, target)
+    for a in ax:
+        a.axhline(target, color="gray", lw=0.5)
+        a.grid(True, which="both", lw=0.3)
+        a.legend(fontsize=7)
+    ax[0].set(xlabel="CPU time [s]", ylabel="max relative error at the final time")
+    ax[1].set(xlabel="residual evaluations (IDA: with its difference-quotient Jacobian)")
+    ida = best.get("ida")
+    lines = []
+    for method, _, _ in methods[1:]:
+        b = best.get(method)
+        if ida and b:
+            lines.append("%s: %.2fx less CPU, %.2fx fewer residuals than IDA at error <= %g" % (
+                method, ida[1] / b[1], ida[2] / b[2], target))
+    fig.suptitle("%s: work against accuracy, measured in the same run\n%s" % (
+        scene, "; ".join(lines[:2])), fontsize=9)
+    for line in lines:
+        print("  %s: %s" % (scene, line))
+    save(fig, name.replace(".csv", ".png"))
+
+po = rows("python_overhead.csv")
+for r in po:
+    print("  python overhead: %s %.2f us/step (%s x C)" % (r["binding"], num(r["us_per_step"]),
+                                                         r["ratio_to_c"]))
