@@ -365,6 +365,68 @@ static void work(const char *dir)
     fclose(f);
 }
 
+/* ---- accuracy on demand: adaptive steps on Andrews (7 angles) ------------------------------ */
+static double angle_error2(const double *q)
+{
+    double e = 0.0, r = 0.0;
+    for (int i = 0; i < 7; ++i) {
+        e += pow(q[i] - andrews_q_ref[i], 2);
+        r += pow(andrews_q_ref[i], 2);
+    }
+    return sqrt(e / r);
+}
+
+static void adaptive(const char *dir)
+{
+    FILE *f = open_csv(dir, "adaptive.csv",
+                       "mode,formulation,setting,angle_error,residuals,steps,rejected,failed");
+    FILE *hist = open_csv(dir, "adaptive_steps.csv", "t,h,formulation");
+    const scene a7 = andrews7_scene();
+    for (int form = 0; form < 2; ++form) {
+        for (int k = 0; k <= 10; ++k) {
+            const double rtol = pow(10.0, -2.0 - 0.5 * k);
+            ga_solver *s = NULL;
+            ga_create(7, 6, &s);
+            ga_set_callbacks(s, a7.mass, a7.force, a7.constraint, a7.jacobian, NULL);
+            ga_set_constraint_accel(s, a7.accel);
+            ga_set_rho_inf(s, 0.7);
+            ga_set_formulation(s, form);
+            ga_set_tolerances(s, rtol, rtol);
+            ga_set_newton(s, fmin(1e-6, 1e-2 * rtol), 20);
+            ga_init(s, 0.0, a7.q0, a7.v0);
+            ga_status st = GA_OK;
+            double t = 0.0;
+            while (!st && t < andrews_t_end) {
+                st = ga_step_adaptive(s, andrews_t_end);
+                ga_get_t(s, &t);
+                if (!st && k == 6) {
+                    double h;
+                    ga_get_h_last(s, &h);
+                    fprintf(hist, "%.9g,%.6g,%s\n", t, h, form ? "index2" : "index3");
+                }
+            }
+            double q[7];
+            long long res, steps, rej, fail;
+            ga_get_q(s, q);
+            ga_get_counter(s, GA_COUNT_RESIDUALS, &res);
+            ga_get_counter(s, GA_COUNT_STEPS, &steps);
+            ga_get_counter(s, GA_COUNT_REJECTED_STEPS, &rej);
+            ga_get_counter(s, GA_COUNT_FAILED_STEPS, &fail);
+            fprintf(f, "adaptive,%s,%.3g,%.6e,%lld,%lld,%lld,%lld\n", form ? "index2" : "index3",
+                    rtol, st ? NAN : angle_error2(q), res, steps, rej, fail);
+            ga_free(s);
+        }
+    }
+    for (int k = 0; k < 9; ++k) {
+        const double h = 3e-4 / (1 << k);
+        const run_out r = run(&a7, (run_opts){h, andrews_t_end, 0.7, 1, NULL, NULL});
+        fprintf(f, "fixed,index3,%.6g,%.6e,%lld,%lld,0,0\n", h, angle_error2(r.q), r.residuals,
+                r.steps);
+    }
+    fclose(f);
+    fclose(hist);
+}
+
 int main(int argc, char **argv)
 {
     const char *dir = argc > 1 ? argv[1] : ".";
@@ -374,7 +436,7 @@ int main(int argc, char **argv)
         void (*fn)(const char *);
     } studies[] = {{"trajectories", trajectories}, {"convergence", convergence},
                    {"damping", damping},           {"scaling", scaling},
-                   {"work", work}};
+                   {"work", work},                 {"adaptive", adaptive}};
     for (size_t i = 0; i < sizeof studies / sizeof studies[0]; ++i) {
         if (only && strcmp(only, studies[i].name))
             continue;

@@ -166,3 +166,32 @@ for k in range(2):
 fig.suptitle("Work against accuracy, fixed step sizes (error: crank angle; Andrews: 2-norm of "
              "the 7 angles)")
 save(fig, "work_precision.png")
+
+# ---- accuracy on demand: adaptive steps -------------------------------------------------------
+ad = read("adaptive.csv")
+fig, ax = plt.subplots(1, 3, figsize=(16, 4.3))
+for form, color in (("index2", "C2"), ("index3", "C3")):
+    idx = [i for i in range(len(ad["mode"])) if ad["mode"][i] == "adaptive" and
+           ad["formulation"][i] == form and np.isfinite(ad["angle_error"][i])]
+    rt, err, res = ad["setting"][idx], ad["angle_error"][idx], ad["residuals"][idx]
+    ax[0].loglog(rt, err, "o-", color=color,
+                 label="%s: slope %.2f" % (form, slope(rt, err)))
+    ax[1].loglog(res, err, "o-", color=color, label="adaptive, " + form)
+idx = [i for i in range(len(ad["mode"])) if ad["mode"][i] == "fixed"]
+ax[1].loglog(ad["residuals"][idx], ad["angle_error"][idx], "s--", color="C0",
+             label="fixed h = 3e-4 / 2^k")
+ax[0].loglog([1e-7, 1e-2], [1e-7, 1e-2], "k:", lw=1, label="error = rtol")
+ax[0].set(xlabel="rtol = atol", ylabel="relative angle error at t = 0.03",
+          title="tolerance proportionality")
+ax[1].set(xlabel="residual evaluations", ylabel="relative angle error at t = 0.03",
+          title="work against accuracy")
+hs = read("adaptive_steps.csv")
+for form, color in (("index2", "C2"), ("index3", "C3")):
+    idx = [i for i in range(len(hs["formulation"])) if hs["formulation"][i] == form]
+    ax[2].semilogy(hs["t"][idx] * 1e3, hs["h"][idx], "-", color=color, label=form)
+ax[2].set(xlabel="t [ms]", ylabel="step size h", title="step sizes, rtol = 1e-5")
+for a in ax:
+    a.grid(True, which="both", lw=0.3)
+    a.legend(fontsize=8)
+fig.suptitle("Andrews (7 angles), adaptive steps: error control on positions and velocities")
+save(fig, "adaptive.png")

@@ -91,10 +91,16 @@ ga_status Solver::step_adaptive(double t_stop)
                                              : 16.0 * kEps * std::max(std::fabs(t), 1.0);
     bool rejected = false;
     for (;;) {
+        // Approaching t_stop, no sliver of a last step: up to 1.5 h take it all (the error
+        // test decides), up to 2 h split it in two equal steps.
+        // After a rejection only the clamp to t_stop applies (else the stretch would undo the
+        // shrink).
         bool land = false;
-        if (h >= remaining * (1.0 - 1e-12)) {
+        if (h * (rejected ? 1.0 : 1.5) >= remaining) {
             h = remaining;
             land = true;
+        } else if (!rejected && h * 2.0 > remaining) {
+            h = 0.5 * remaining;
         }
         if (h < h_min && !land)
             return diag.fail(GA_ERR_STEP_SIZE,
