@@ -195,6 +195,24 @@ int main(int argc, char **argv)
         }
         return 0;
     }
+    if (mode == "chain_steps" && argc > 2) {
+        // just the steps (for instruction counting under callgrind --toggle-collect=ga_step)
+        const int links = std::atoi(argv[2]);
+        const int steps = argc > 3 ? std::atoi(argv[3]) : 10;
+        chain c = chain_make(links);
+        Scene sc{"chain", 3 * links, 2 * links, chain_mass, chain_force, chain_constraint,
+                 chain_jacobian, chain_stiffness, chain_constraint_accel, &c,
+                 std::vector<double>(3 * links), std::vector<double>(3 * links), 1e-3,
+                 steps * 1e-3, 0.7, 1, declare_chain};
+        chain_initial(&c, sc.q0.data(), sc.v0.data());
+        ga_solver *s = make(sc, GA_LINEAR_SPARSE, 1e-10);
+        ga_init(s, 0.0, sc.q0.data(), sc.v0.data());
+        for (int k = 0; k < steps; ++k)
+            if (ga_step(s, sc.h))
+                return 1;
+        ga_free(s);
+        return 0;
+    }
     if (mode == "chain" && argc > 2) {
         const int links = std::atoi(argv[2]);
         const int steps = argc > 3 ? std::atoi(argv[3]) : 20;

@@ -404,7 +404,9 @@ GA_API ga_status ga_set_initial_step(ga_solver *s, double h0);
  *  (a_n+1 - a_n); velocity (sec. 1.5b) from the divided differences of a over two steps.
  *  Controller: PI (Gustafsson), safety 0.9, growth at most 2 and not on consecutive steps nor
  *  right after a rejection, a dead band [1, 1.2] that keeps h, shrink at least 0.2.
- *  Use with ga_interpolate for output at user times without shortening steps.
+ *  Use with ga_interpolate for output at user times without shortening steps. The first
+ *  adaptive call allocates the workspace of the error estimate's projection (fixed-step runs
+ *  do without it); ga_step_adaptive never allocates after that.
  *  Errors: GA_ERR_ARG, GA_ERR_STATE, GA_ERR_STEP_SIZE, fatal callback failures, and the
  *  statuses of ga_step. On failure the state is that of the last accepted step. */
 GA_API ga_status ga_step_adaptive(ga_solver *s, double t_stop);

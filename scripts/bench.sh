@@ -20,6 +20,16 @@ echo "links,n,m,backend,steps,newton_per_step,factorizations_per_step,us_per_ste
 for N in 10 30 100 300 1000 3000 10000 30000 100000; do
     "$b/step_cost" chain "$N" 10 >> "$out/chain.csv"
 done
+if command -v valgrind >/dev/null; then
+    echo "chain: instructions inside ga_step (callgrind), the work regardless of the memory hierarchy"
+    echo "links,instructions_per_step" > "$out/chain_instructions.csv"
+    for N in 1000 10000 100000; do
+        valgrind --tool=callgrind --toggle-collect=ga_step --callgrind-out-file=/dev/null \
+            "$b/step_cost" chain_steps "$N" 10 2>&1 |
+            sed -n "s/.*Collected : \([0-9]*\).*/$N,\1/p" |
+            awk -F, '{printf "%s,%.0f\n", $1, $2 / 10}' >> "$out/chain_instructions.csv"
+    done
+fi
 echo "linear algebra"
 "$b/linear_algebra" > "$out/linear_algebra.csv"
 echo "work-precision against IDA"

@@ -19,6 +19,6 @@ ensure_packages() {
     fi
 }
 
-BUILD_PACKAGES=(build-essential cmake pkg-config libeigen3-dev liblapack-dev)
+BUILD_PACKAGES=(build-essential cmake pkg-config libeigen3-dev liblapack-dev libsuitesparse-dev)
 TEST_PACKAGES=(libcmocka-dev gfortran python3 python3-numpy python3-pytest python3-venv binutils)
 JOBS=$(nproc 2>/dev/null || echo 2)

@@ -89,6 +89,10 @@ if ch:
     i1, i2 = list(N).index(1000), list(N).index(100000)
     print("  chain: time per step %.3g us at N = 1000, %.3g us at N = 100000: %.0f-fold; peak "
           "memory %.1f MiB -> %.1f MiB" % (us[i1], us[i2], us[i2] / us[i1], mem[i1], mem[i2]))
+    ins = {int(num(r["links"])): num(r["instructions_per_step"]) for r in rows("chain_instructions.csv")}
+    if 1000 in ins and 100000 in ins:
+        print("  chain: instructions per step %.3g at N = 1000, %.3g at N = 100000: %.0f-fold" % (
+            ins[1000], ins[100000], ins[100000] / ins[1000]))
 
 # ---- linear algebra -------------------------------------------------------------------------
 la = rows("linear_algebra.csv")

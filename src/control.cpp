@@ -69,6 +69,7 @@ double Solver::error_norm(double h)
 
 ga_status Solver::step_adaptive(double t_stop)
 {
+    setup_projection();
     const double t = accepted_.t;
     const double remaining = t_stop - t;
     if (!(remaining > 0.0))

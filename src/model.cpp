@@ -102,11 +102,15 @@ void Model::allocate_workspace(const ModelMatrix &M, const ModelMatrix &J, const
     phi_minus_.setZero(m_);
     g_plus_.setZero(m_);
     g_minus_.setZero(m_);
-    M_pert_.copy_layout(M);
+    // n x n scratch only where finite differences may be needed: the Jacobian scratch also
+    // serves the constraint acceleration term
+    const bool fd_stiffness = !cb.stiffness || tangent_mode == GA_TANGENT_FD;
+    if (fd_stiffness && !constant_mass)
+        M_pert_.copy_layout(M);
     J_pert_.copy_layout(J);
-    if (!K.dense())
+    if (!K.dense() && fd_stiffness)
         k_groups_.build(K);
-    if (!C.dense())
+    if (!C.dense() && (!cb.damping || tangent_mode == GA_TANGENT_FD))
         c_groups_.build(C);
 }
 
@@ -207,9 +211,12 @@ void Model::dynamics_residual(const ModelMatrix &M, const Vec &qdd, const Vec &f
 ga_status Model::perturbed_residual(double t, const Vec &qp, const Vec &v, const Vec &qdd,
                                     const Vec &lambda, const ModelMatrix &M, Vec &r)
 {
-    if (!constant_mass)
+    if (!constant_mass) {
+        if (M_pert_.size() != M.size())
+            M_pert_.copy_layout(M);  // options changed after setup: allocate once, here
         if (auto st = mass(t, qp, M_pert_))
             return st;
+    }
     if (auto st = force(t, qp, v, f_pert_))
         return st;
     if (auto st = jacobian(t, qp, J_pert_))
@@ -245,6 +252,8 @@ ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
         return GA_OK;
     }
     K.set_zero();
+    if (k_groups_.count() == 0 && K.nnz() > 0)
+        k_groups_.build(K);  // options changed after setup: built once, here
     const auto &ri = K.row_index();
     const auto &ci = K.col_index();
     for (int g = 0; g < k_groups_.count(); ++g) {
@@ -292,6 +301,8 @@ ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, Mod
         return GA_OK;
     }
     C.set_zero();
+    if (c_groups_.count() == 0 && C.nnz() > 0)
+        c_groups_.build(C);  // options changed after setup: built once, here
     const auto &ri = C.row_index();
     const auto &ci = C.col_index();
     for (int g = 0; g < c_groups_.count(); ++g) {

@@ -134,11 +134,8 @@ ga_status Solver::setup()
     qdd_tmp_.setZero(n_);
     lambda_tmp_.setZero(m_);
     model.allocate_workspace(M_, J_, K_, C_);
-    const bool sparse_backend = sparse && backend;
+    sparse_backend_ = sparse && backend;
     S_.setup(std::move(backend), n_, m_, M_, J_, K_, C_);
-    if (m_ > 0)
-        P_.setup(sparse_backend ? make_sparse_backend() : make_dense_backend(DenseKind::Eigen), n_,
-                 m_, M_, J_, K_, C_);
     if (dense) {  // the stabilized index-2 formulation is dense only
         Bd_.setZero(m_, n_);
         S2_.setup(n_, m_);
@@ -146,6 +143,15 @@ ga_status Solver::setup()
     }
     workspace_ready_ = true;
     return GA_OK;
+}
+
+// The projection of error estimates (adaptive mode only): set up at the first adaptive call,
+// so that fixed-step runs do not pay for a second factorization workspace.
+void Solver::setup_projection()
+{
+    if (m_ > 0 && !P_.ready())
+        P_.setup(sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Eigen),
+                 n_, m_, M_, J_, K_, C_);
 }
 
 ga_status Solver::evaluate_mass(double t, const Vec &q)

@@ -105,6 +105,7 @@ public:
 
 private:
     ga_status setup();  // chooses the backend and allocates everything; throws std::bad_alloc
+    void setup_projection();
     ga_status attempt_step(double h);
     ga_status newton(double h, bool refresh, bool &converged, bool &used_stale);
     ga_status factorize(double h, bool tangents_K, bool tangents_C, int iter);
@@ -122,6 +123,7 @@ private:
     bool initialized_ = false;
     bool workspace_ready_ = false;
     bool index2_ready_ = false;
+    bool sparse_backend_ = false;
     int last_newton_iters_ = 0;
 
     State accepted_;  // the last accepted step: never touched by a step that fails
