@@ -366,15 +366,6 @@ static void work(const char *dir)
 }
 
 /* ---- accuracy on demand: adaptive steps on Andrews (7 angles) ------------------------------ */
-static double angle_error2(const double *q)
-{
-    double e = 0.0, r = 0.0;
-    for (int i = 0; i < 7; ++i) {
-        e += pow(q[i] - andrews_q_ref[i], 2);
-        r += pow(andrews_q_ref[i], 2);
-    }
-    return sqrt(e / r);
-}
 
 static void adaptive(const char *dir)
 {
@@ -413,14 +404,14 @@ static void adaptive(const char *dir)
             ga_get_counter(s, GA_COUNT_REJECTED_STEPS, &rej);
             ga_get_counter(s, GA_COUNT_FAILED_STEPS, &fail);
             fprintf(f, "adaptive,%s,%.3g,%.6e,%lld,%lld,%lld,%lld\n", form ? "index2" : "index3",
-                    rtol, st ? NAN : angle_error2(q), res, steps, rej, fail);
+                    rtol, st ? NAN : andrews_angle_error(q), res, steps, rej, fail);
             ga_free(s);
         }
     }
     for (int k = 0; k < 9; ++k) {
         const double h = 3e-4 / (1 << k);
         const run_out r = run(&a7, (run_opts){h, andrews_t_end, 0.7, 1, NULL, NULL});
-        fprintf(f, "fixed,index3,%.6g,%.6e,%lld,%lld,0,0\n", h, angle_error2(r.q), r.residuals,
+        fprintf(f, "fixed,index3,%.6g,%.6e,%lld,%lld,0,0\n", h, andrews_angle_error(r.q), r.residuals,
                 r.steps);
     }
     fclose(f);

@@ -7,15 +7,6 @@
 #include "demo_run.h"
 #include "scenes/andrews.h"
 
-static double angle_error(const double *q7)
-{
-    double e = 0.0, r = 0.0;
-    for (int i = 0; i < 7; ++i) {
-        e += (q7[i] - andrews_q_ref[i]) * (q7[i] - andrews_q_ref[i]);
-        r += andrews_q_ref[i] * andrews_q_ref[i];
-    }
-    return sqrt(e / r);
-}
 
 int main(void)
 {
@@ -31,7 +22,7 @@ int main(void)
         return 1;
     printf("  relative 2-norm error of the 7 angles vs the published reference: %.3e; "
            "lambda_1 vs reference: %.3e\n",
-           angle_error(q), fabs(lam[0] - andrews_lambda_ref[0]) / andrews_lambda_ref[0]);
+           andrews_angle_error(q), fabs(lam[0] - andrews_lambda_ref[0]) / andrews_lambda_ref[0]);
 
     an31_from_angles(andrews_q0, v7, q31, v31);
     static const char *names31[] = {"th1 = beta", "x_F", "y_F"};
@@ -45,6 +36,6 @@ int main(void)
     an31_to_angles(q, ang);
     printf("  relative 2-norm error of the 7 angles vs the published reference: %.3e; "
            "force at E on the triangle vs reference lambda_1: %.3e\n",
-           angle_error(ang), fabs(lam[24] - andrews_lambda_ref[0]) / andrews_lambda_ref[0]);
+           andrews_angle_error(ang), fabs(lam[24] - andrews_lambda_ref[0]) / andrews_lambda_ref[0]);
     return 0;
 }

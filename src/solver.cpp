@@ -264,6 +264,24 @@ ga_status Solver::attempt_step(double h)
     return GA_OK;
 }
 
+// Residuals r^q (eq. 1, not weighted) into rq_ and r^lambda = Phi (eq. 2) into phi_ at (t, x),
+// leaving M_, f_ and J_ evaluated there.
+ga_status Solver::residual(double t, const State &x)
+{
+    ga_status st = evaluate_mass(t, x.q);
+    if (!st)
+        st = model.force(t, x.q, x.v, f_);
+    if (!st)
+        st = model.constraint(t, x.q, phi_);
+    if (!st)
+        st = model.jacobian(t, x.q, J_);
+    if (st)
+        return st;
+    Model::dynamics_residual(M_, x.qdd, f_, J_, x.lambda, rq_);
+    count(counters, GA_COUNT_RESIDUALS);
+    return GA_OK;
+}
+
 // Rebuild and factorize the iteration matrix at the current iterate.
 ga_status Solver::factorize(double h, bool tangents_K, bool tangents_C, int iter)
 {
@@ -342,22 +360,11 @@ ga_status Solver::newton(double h, bool refresh, bool &converged, bool &used_sta
     bool refresh_done = false;
     for (int iter = 1; iter <= max_iter && !converged; ++iter) {
         last_newton_iters_ = iter;
-        ga_status st = evaluate_mass(t1, x.q);
-        if (!st)
-            st = model.force(t1, x.q, x.v, f_);
-        if (!st)
-            st = model.constraint(t1, x.q, phi_);
-        if (!st)
-            st = model.jacobian(t1, x.q, J_);
+        ga_status st = residual(t1, x);
         if (!st && index2 && m_ > 0) {
             // the velocity constraint Phi_q v + Phi_t
             st = model.constraint_dt(t1, x.q, phi_v_);
             J_.multiply_add(1.0, x.v, phi_v_);
-        }
-        if (!st) {
-            // Residuals r^q (eq. 1, not weighted) and r^lambda = Phi (eq. 2).
-            Model::dynamics_residual(M_, x.qdd, f_, J_, x.lambda, rq_);
-            count(counters, GA_COUNT_RESIDUALS);
         }
         if (!st && refresh && tangents_K)
             st = model.stiffness(t1, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_);
@@ -434,16 +441,9 @@ ga_status Solver::unavoidable_work(double h)
 {
     const State &x = accepted_;
     const double t = x.t + h;
-    ga_status st = evaluate_mass(t, x.q);
-    if (!st)
-        st = model.force(t, x.q, x.v, f_);
-    if (!st)
-        st = model.constraint(t, x.q, phi_);
-    if (!st)
-        st = model.jacobian(t, x.q, J_);
+    ga_status st = residual(t, x);
     if (st)
         return st;
-    Model::dynamics_residual(M_, x.qdd, f_, J_, x.lambda, rq_);
     if (!jacobian_valid_) {
         const bool K = model.stiffness_needed(K_), C = model.damping_needed(C_);
         if (K && (st = model.stiffness(t, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_)))

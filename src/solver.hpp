@@ -108,6 +108,7 @@ private:
     void setup_projection();
     ga_status attempt_step(double h);
     ga_status newton(double h, bool refresh, bool &converged, bool &used_stale);
+    ga_status residual(double t, const State &x);
     ga_status factorize(double h, bool tangents_K, bool tangents_C, int iter);
     ga_status evaluate_mass(double t, const Vec &q);
     void commit(bool land_on, double t_land);

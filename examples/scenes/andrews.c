@@ -38,6 +38,16 @@ const double andrews_lambda_ref[6] = {1.9917534810453967e+02, -2.975530997497352
                                       2.3066543611622130e+01, 3.1452725275772760e+01,
                                       2.2642494786394398e+01, 1.1617392352612933e+01};
 
+double andrews_angle_error(const double *q7)
+{
+    double e = 0.0, r = 0.0;
+    for (int i = 0; i < 7; ++i) {
+        e += (q7[i] - andrews_q_ref[i]) * (q7[i] - andrews_q_ref[i]);
+        r += andrews_q_ref[i] * andrews_q_ref[i];
+    }
+    return sqrt(e / r);
+}
+
 /* ---- 7 relative angles: the Test Set's equations ----------------------------------------- */
 enum { BE, TH, GA, PH, DE, OM, EP };
 

@@ -34,15 +34,6 @@ static scene andrews31(void)
     return sc;
 }
 
-static double angle_error(const double *q7)
-{
-    double e = 0.0, r = 0.0;
-    for (int i = 0; i < 7; ++i) {
-        e += (q7[i] - andrews_q_ref[i]) * (q7[i] - andrews_q_ref[i]);
-        r += andrews_q_ref[i] * andrews_q_ref[i];
-    }
-    return sqrt(e / r);
-}
 
 enum { K = 8, FIT = 5 };
 static double HS[K], E7[K], L7[K], B7[K], E31[K], L31[K], B31[K], D[K], DR[K];
@@ -58,7 +49,7 @@ static int run_all(void **state)
         if (r7.status)
             return -1;
         memcpy(ANG7[k], r7.q, sizeof ANG7[k]);
-        E7[k] = angle_error(r7.q);
+        E7[k] = andrews_angle_error(r7.q);
         B7[k] = fabs(r7.q[0] - andrews_q_ref[0]) / fabs(andrews_q_ref[0]);
         L7[k] = fabs(r7.lambda[0] - andrews_lambda_ref[0]) / fabs(andrews_lambda_ref[0]);
         printf("  7 angles  h = %-9.3g angles %.3e beta %.3e lambda1 %.3e  max|Phi| %.1e  "
@@ -73,7 +64,7 @@ static int run_all(void **state)
         if (r31.status)
             return -1;
         an31_to_angles(r31.q, ANG31[k]);
-        E31[k] = angle_error(ANG31[k]);
+        E31[k] = andrews_angle_error(ANG31[k]);
         B31[k] = fabs(ANG31[k][0] - andrews_q_ref[0]) / fabs(andrews_q_ref[0]);
         L31[k] = fabs(r31.lambda[LAMBDA_E_ON_TRIANGLE] - andrews_lambda_ref[0]) /
                  fabs(andrews_lambda_ref[0]);
