@@ -114,16 +114,6 @@ void Model::allocate_workspace(const ModelMatrix &M, const ModelMatrix &J, const
         c_groups_.build(C);
 }
 
-bool Model::stiffness_available(const ModelMatrix &K) const
-{
-    return !stiffness_needed(K) || K.dense() || cb.stiffness || !K.zero();
-}
-
-bool Model::damping_available(const ModelMatrix &C) const
-{
-    return !damping_needed(C) || C.dense() || cb.damping || !C.zero();
-}
-
 ga_status Model::callback_status(int rc, const char *name, double t)
 {
     if (rc == 0)

@@ -53,9 +53,6 @@ public:
     {
         return uses_tangents() && !C.zero() && (cb.force || cb.damping);
     }
-    // Can K (or C) be obtained in this storage: by callback, or by finite differences?
-    bool stiffness_available(const ModelMatrix &K) const;
-    bool damping_available(const ModelMatrix &C) const;
 
     ga_status mass(double t, const Vec &q, ModelMatrix &M);
     ga_status force(double t, const Vec &q, const Vec &v, Vec &f);
