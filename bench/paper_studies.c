@@ -337,7 +337,7 @@ static void work(const char *dir)
         const scene *sc = &scenes[si];
         for (int k = 0; k < 8; ++k) {
             const double h = (si == 0 ? 5e-3 : 3e-4) / (1 << k);
-            run_out best;
+            run_out best = {0};
             for (int rep = 0; rep < 3; ++rep) { /* CPU time: best of three */
                 const run_out r = run(sc, (run_opts){h, sc->t_end, 0.7, 1, NULL, NULL});
                 if (rep == 0 || r.cpu < best.cpu)

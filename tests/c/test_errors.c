@@ -91,8 +91,10 @@ static int setup(void **state)
 {
     fixture *x = calloc(1, sizeof *x);
     double q[2], v[2];
+    if (!x)
+        return -1;
     x->model.p = (pendulum){1.0, 1.0, 9.81};
-    if (!x || ga_create(2, 1, &x->s) != GA_OK)
+    if (ga_create(2, 1, &x->s) != GA_OK)
         return -1;
     pendulum_state(&x->model.p, 1.0, 0.5, q, v);
     if (ga_set_callbacks(x->s, f_mass, f_force, f_constraint, f_jacobian, &x->model) ||
