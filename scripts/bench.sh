@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 . scripts/deps.sh
 ensure_packages "${BUILD_PACKAGES[@]}" libsuitesparse-dev libsundials-dev python3 python3-numpy \
     python3-matplotlib
-cmake -S . -B build-demo -DCMAKE_BUILD_TYPE=Release -DGALPHA_BUILD_TESTS=OFF >/dev/null
+cmake -S . -B build-demo -DCMAKE_BUILD_TYPE=Release -DGALPHA_BUILD_TESTS=OFF -DGALPHA_BUILD_BENCH=ON >/dev/null
 cmake --build build-demo -j "$JOBS" >/dev/null
 out=docs/perf
 mkdir -p "$out"

@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/deps.sh
 ensure_packages "${BUILD_PACKAGES[@]}" python3 python3-numpy python3-matplotlib
-cmake -S . -B build-demo -DCMAKE_BUILD_TYPE=Release -DGALPHA_BUILD_TESTS=OFF >/dev/null
+cmake -S . -B build-demo -DCMAKE_BUILD_TYPE=Release -DGALPHA_BUILD_TESTS=OFF -DGALPHA_BUILD_BENCH=ON >/dev/null
 cmake --build build-demo -j "$JOBS" --target paper_studies >/dev/null
 mkdir -p docs/paper
 ./build-demo/bench/paper_studies docs/paper "$@"
