@@ -383,7 +383,6 @@ static void adaptive(const char *dir)
             ga_set_rho_inf(s, 0.7);
             ga_set_formulation(s, form);
             ga_set_tolerances(s, rtol, rtol);
-            ga_set_newton(s, fmin(1e-6, 1e-2 * rtol), 20);
             ga_init(s, 0.0, a7.q0, a7.v0);
             ga_status st = GA_OK;
             double t = 0.0;

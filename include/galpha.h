@@ -231,7 +231,10 @@ GA_API ga_status ga_get_params(const ga_solver *s, double *alpha_m, double *alph
 /* ------------------------------------------------------------------------------------------ */
 /** @name Newton iteration and linear algebra */
 /**@{*/
-/** Newton tolerance and iteration limit (defaults 1e-10 and 20).
+/** Newton tolerance and iteration limit (default 20). Without this call the tolerance is
+ *  1e-10 for ga_step, and 1e-2 rtol (not below 1e-10) for adaptive steps (ga_step_adaptive,
+ *  ga_advance): once an error tolerance is given, a Newton error far below it is wasted work.
+ *  A tolerance set here applies to both.
  *
  *  The test is on the Newton increments, relative and per quantity: a step is converged when
  *  the last increments satisfy |dq| <= tol |q|, |beta' dq| <= tol |qdd| and

@@ -90,6 +90,7 @@ ga_status Solver::step_adaptive(double t_stop)
         h = std::min(h, control.h_max);
     const double h_min = control.h_min > 0.0 ? control.h_min
                                              : 16.0 * kEps * std::max(std::fabs(t), 1.0);
+    const double tol = newton_tolerance(true);
     bool rejected = false;
     for (;;) {
         // Approaching t_stop, no sliver of a last step: up to 1.5 h take it all (the error
@@ -108,7 +109,7 @@ ga_status Solver::step_adaptive(double t_stop)
                              "step size %g fell below the minimum %g at t = %.17g (last error "
                              "estimate %.3g)",
                              h, h_min, t, control.err_last);
-        ga_status st = attempt_step(h);
+        ga_status st = attempt_step(h, tol);
         if (st == GA_OK) {
             const double err = error_norm(h);
             control.err_last = err;

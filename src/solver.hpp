@@ -43,7 +43,8 @@ public:
 
     // Options (validated by the C API before they get here).
     Params params;
-    double newton_tol = 1e-10;
+    // Newton tolerance (ga_set_newton); 0 = automatic, see newton_tolerance().
+    double newton_tol = 0.0;
     int max_iter = 20;
     bool scaling = true;
     ga_predictor predictor = GA_PREDICTOR_EXTRAPOLATE;
@@ -106,8 +107,9 @@ public:
 private:
     ga_status setup();  // chooses the backend and allocates everything; throws std::bad_alloc
     void setup_projection();
-    ga_status attempt_step(double h);
-    ga_status newton(double h, bool refresh, bool &converged, bool &used_stale);
+    double newton_tolerance(bool adaptive) const;
+    ga_status attempt_step(double h, double tol);
+    ga_status newton(double h, double tol, bool refresh, bool &converged, bool &used_stale);
     ga_status residual(double t, const State &x);
     ga_status factorize(double h, bool tangents_K, bool tangents_C, int iter);
     ga_status evaluate_mass(double t, const Vec &q);

@@ -424,6 +424,30 @@ static void slider_crank_runs_adaptively_to_its_end(void **state)
     }
 }
 
+/* Andrews' mechanism (7 angles) in adaptive mode to t = 0.03; newton_tol 0: the default. */
+static void andrews_adaptive(int formulation, double rtol, double newton_tol, double *err,
+                             long long *residuals)
+{
+    ga_solver *s = NULL;
+    double v0[7] = {0}, q[7];
+    assert_int_equal(ga_create(7, 6, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, an7_mass, an7_force, an7_constraint, an7_jacobian,
+                                      NULL),
+                     GA_OK);
+    assert_int_equal(ga_set_constraint_accel(s, an7_constraint_accel), GA_OK);
+    assert_int_equal(ga_set_rho_inf(s, 0.7), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    assert_int_equal(ga_set_tolerances(s, rtol, rtol), GA_OK);
+    if (newton_tol > 0.0)
+        assert_int_equal(ga_set_newton(s, newton_tol, 20), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, andrews_q0, v0), GA_OK);
+    assert_int_equal(ga_advance(s, andrews_t_end), GA_OK);
+    ga_get_q(s, q);
+    *err = andrews_angle_error(q);
+    ga_get_counter(s, GA_COUNT_RESIDUALS, residuals);
+    ga_free(s);
+}
+
 static void andrews_error_follows_the_tolerance(void **state)
 {
     (void)state;
@@ -432,29 +456,33 @@ static void andrews_error_follows_the_tolerance(void **state)
     long long res[K];
     for (int k = 0; k < K; ++k) {
         rtol[k] = pow(10.0, -2.0 - k);
-        ga_solver *s = NULL;
-        double v0[7] = {0}, q[7];
-        assert_int_equal(ga_create(7, 6, &s), GA_OK);
-        assert_int_equal(ga_set_callbacks(s, an7_mass, an7_force, an7_constraint,
-                                          an7_jacobian, NULL),
-                         GA_OK);
-        assert_int_equal(ga_set_constraint_accel(s, an7_constraint_accel), GA_OK);
-        assert_int_equal(ga_set_rho_inf(s, 0.7), GA_OK);
-        assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
-        assert_int_equal(ga_set_tolerances(s, rtol[k], rtol[k]), GA_OK);
-        assert_int_equal(ga_set_newton(s, fmin(1e-6, 1e-2 * rtol[k]), 20), GA_OK);
-        assert_int_equal(ga_init(s, 0.0, andrews_q0, v0), GA_OK);
-        assert_int_equal(ga_advance(s, andrews_t_end), GA_OK);
-        ga_get_q(s, q);
-        err[k] = andrews_angle_error(q);
-        ga_get_counter(s, GA_COUNT_RESIDUALS, &res[k]);
+        andrews_adaptive(GA_INDEX2_STABILIZED, rtol[k], 0.0, &err[k], &res[k]);
         printf("  Andrews, index-2, rtol %.0e: angle error %.2e, %lld residual evaluations\n",
                rtol[k], err[k], res[k]);
-        ga_free(s);
     }
     const double slope = fit_order(rtol, err, K);
     printf("  tolerance proportionality: slope of log(error) against log(rtol) = %.2f\n", slope);
     assert_true(slope >= 0.7 && slope <= 1.3);
+}
+
+/* The default Newton tolerance of adaptive steps follows rtol (1e-2 rtol): the same answer
+ * as a 1e-10 Newton tolerance to well within the error asked for, with less work. */
+static void adaptive_newton_tolerance_follows_rtol(void **state)
+{
+    (void)state;
+    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+        const double rtol = 1e-4;
+        double err_auto, err_tight;
+        long long res_auto, res_tight;
+        andrews_adaptive(formulation, rtol, 0.0, &err_auto, &res_auto);
+        andrews_adaptive(formulation, rtol, 1e-10, &err_tight, &res_tight);
+        printf("  Andrews, %s, rtol %.0e: Newton tol 1e-2 rtol: error %.3e, %lld residuals; "
+               "1e-10: error %.3e, %lld residuals\n",
+               formulation == GA_INDEX3 ? "index-3" : "index-2", rtol, err_auto, res_auto,
+               err_tight, res_tight);
+        assert_true(fabs(err_auto - err_tight) <= 0.1 * err_tight);
+        assert_true((double)res_auto <= 0.85 * (double)res_tight);
+    }
 }
 
 static void step_size_floor_is_reported(void **state)
@@ -489,6 +517,7 @@ int main(void)
         cmocka_unit_test(interpolation_agrees_with_a_step_ending_there),
         cmocka_unit_test(slider_crank_runs_adaptively_to_its_end),
         cmocka_unit_test(andrews_error_follows_the_tolerance),
+        cmocka_unit_test(adaptive_newton_tolerance_follows_rtol),
         cmocka_unit_test(step_size_floor_is_reported),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
