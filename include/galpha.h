@@ -251,8 +251,15 @@ GA_API ga_status ga_set_newton(ga_solver *s, double tol, int max_iter);
 /** Tangent matrices in the iteration matrix S_t = [beta' M + gamma' C_t + K_t, Phi_q^T;
  *  Phi_q, 0]. */
 typedef enum ga_tangent_mode {
-    GA_TANGENT_AUTO = 0,    /**< user callbacks where given, finite differences otherwise
-                                 (default): full Newton */
+    GA_TANGENT_AUTO = 0,    /**< user callbacks where given (default). A missing tangent is
+                                 left out (simplified Newton) while a fresh matrix without it
+                                 contracts at a rate <= 0.1, and computed by finite
+                                 differences from the first step where it does not (or where
+                                 the simplified iteration fails): finite differences cost a
+                                 residual per column group at every refactorization, and a
+                                 tangent that does not matter buys nothing with them. The
+                                 choice is made afresh whenever the matrix is dropped (ga_init,
+                                 options, failed steps, checkpoints). */
     GA_TANGENT_FD = 1,      /**< finite differences even where callbacks are given */
     GA_TANGENT_NEGLECT = 2  /**< K_t = C_t = 0: simplified Newton (cheaper iterations, linear
                                  convergence; only for non-stiff problems, omega_max h <~ 2) */

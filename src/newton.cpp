@@ -42,7 +42,9 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const Vec &dq, const
     ratio_ = eta;
 
     double theta = -1.0;
-    const bool measured = previous_ratio_ > 0.0;
+    // A rate needs two finite ratios: an increment of a quantity that was exactly zero has an
+    // infinite ratio, and eta / inf = 0 would claim convergence after any second increment.
+    const bool measured = previous_ratio_ > 0.0 && std::isfinite(previous_ratio_);
     if (measured) {
         theta = eta / previous_ratio_;
         rate_ = theta;

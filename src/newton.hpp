@@ -55,6 +55,7 @@ public:
 
     double ratio() const { return ratio_; }  // eta of the last update
     double rate() const { return rate_; }    // last measured theta (< 0: none yet)
+    int iterations_with_matrix() const { return with_matrix_; }
 
 private:
     int iteration_ = 0;

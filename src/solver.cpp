@@ -249,6 +249,12 @@ ga_status Solver::attempt_step(double h, double tol)
         if (auto st = newton(h, tol, true, converged, used_stale))
             return st;
     }
+    if (!converged && tangents_deferred_) {
+        // The simplified iteration failed or was too slow: again with the missing tangents.
+        fd_tangents_ = true;
+        if (auto st = newton(h, tol, true, converged, used_stale))
+            return st;
+    }
     if (!converged && predictor == GA_PREDICTOR_EXTRAPOLATE) {
         // An extrapolation through a rough a_n (after abrupt changes of h, or without
         // rescaling) can start Newton outside its basin: once more from a_{n+1} = a_n.
@@ -366,8 +372,18 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
                 Bd_(B_.row_index()[k], B_.col_index()[k]) += B_.data()[k];
     }
 
-    const bool tangents_K = model.stiffness_needed(K_);
-    const bool tangents_C = model.damping_needed(C_);
+    // Tangents the user gives are always in the matrix. Missing ones (GA_TANGENT_AUTO) cost
+    // finite differences, a residual per column group at every refactorization: they are
+    // left out (simplified Newton) until the iteration shows that they matter.
+    bool tangents_K = model.stiffness_needed(K_);
+    bool tangents_C = model.damping_needed(C_);
+    tangents_deferred_ = false;
+    if (model.tangent_mode == GA_TANGENT_AUTO && !fd_tangents_ &&
+        ((tangents_K && !model.cb.stiffness) || (tangents_C && !model.cb.damping))) {
+        tangents_deferred_ = true;
+        tangents_K = tangents_K && model.cb.stiffness;
+        tangents_C = tangents_C && model.cb.damping;
+    }
     convergence_.reset(refresh ? -1.0 : theta_prev_);
     converged = false;
     used_stale = false;
@@ -424,6 +440,16 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         const auto verdict = convergence_.check(tol, dq_, *dw, c.beta_prime, dlambda_,
                                                 x.q, x.qdd, x.lambda);
         converged = verdict == ConvergenceTest::Verdict::Converged;
+        if (!converged && tangents_deferred_ && refresh_done &&
+            convergence_.iterations_with_matrix() >= 2 &&
+            !(convergence_.rate() <= kDeferredTangentRate)) {
+            // A fresh matrix without the missing tangents contracts too slowly: from now on
+            // they come by finite differences. The step starts again from the predictor
+            // (attempt_step): the iterate may have diverged far enough that continuing from
+            // it would cost the step its precision.
+            fd_tangents_ = true;
+            return GA_OK;
+        }
         if (verdict == ConvergenceTest::Verdict::Slow && used_stale && reuse_attempted_ &&
             !refresh_done) {
             reuse_backoff_ = std::min(2 * reuse_backoff_, 32);

@@ -86,6 +86,7 @@ public:
         mass_valid_ = false;
         refresh_steps_left_ = 0;
         reuse_backoff_ = 1;
+        fd_tangents_ = false;
     }
 
     // For bench/: the unavoidable work of a step, done once at the current state -- one
@@ -147,6 +148,12 @@ private:
     mutable int reuse_backoff_ = 1;      // ... after the next failed attempt to reuse
     bool reuse_attempted_ = false;       // this step started with an old matrix
     double jacobian_h_ = 0.0;
+    // GA_TANGENT_AUTO with a tangent callback missing: finite differences for it only once a
+    // fresh matrix without it contracted slower than kDeferredTangentRate (or failed). The
+    // choice is made again whenever the matrix is dropped.
+    static constexpr double kDeferredTangentRate = 0.1;
+    mutable bool fd_tangents_ = false;
+    bool tangents_deferred_ = false;  // the last Newton iteration ran without them
 
     // Step workspace, sized once.
     ModelMatrix M_, J_, K_, C_, B_;

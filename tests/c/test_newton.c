@@ -147,11 +147,124 @@ static void paper_test_on_scaled_residual_would_accept_the_predictor(void **stat
     ga_free(s);
 }
 
+/* q'' = -q, one step of h = 1 with rho_inf = 0 from q = 1, v = 0, qdd = -1, a = 0. The
+ * simplified iteration (K_t neglected) contracts with rate 1/2, and its first increment moves
+ * qdd from exactly 0 (an infinite relative increment): a rate measured against that infinity
+ * would be 0 and accept the second iterate (q = 1/2; the discrete solution is q = 2/3). */
+static int sdof_mass(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    M[0] = 1.0;
+    return 0;
+}
+static int sdof_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)v, (void)u;
+    f[0] = -q[0];
+    return 0;
+}
+
+static int stiff_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)v, (void)u;
+    f[0] = -1e6 * q[0]; /* omega = 1e3 */
+    return 0;
+}
+
+static void no_rate_is_measured_against_an_infinite_increment(void **state)
+{
+    (void)state;
+    /* rho_inf = 0: alpha_m = -1, alpha_f = 0, beta = 1 (eq. 24). The step's equations are
+     * linear in qdd1: a1 = (alpha_f qdd0 - alpha_m a0 + (1 - alpha_f) qdd1) / (1 - alpha_m)
+     * (eq. 3), q1 = q0 + h v0 + h^2 ((1/2 - beta) a0 + beta a1) (eq. 4), qdd1 = -q1. */
+    const double am = -1.0, af = 0.0, beta = 1.0, h = 1.0;
+    const double q0 = 1.0, v0 = 0.0, qdd0 = -1.0, a0 = 0.0;
+    /* q1 = c0 + c1 qdd1 with */
+    const double c0 = q0 + h * v0 + h * h * ((0.5 - beta) * a0 +
+                                             beta * (af * qdd0 - am * a0) / (1.0 - am));
+    const double c1 = h * h * beta * (1.0 - af) / (1.0 - am);
+    const double q1 = c0 / (1.0 + c1); /* qdd1 = -q1 */
+    assert_true(fabs(q1 - 2.0 / 3.0) < 1e-15);
+    for (int mode = GA_TANGENT_AUTO; mode <= GA_TANGENT_NEGLECT; ++mode) {
+        ga_solver *s = NULL;
+        double buf[14] = {26465.0, 2.0, 1, 0, 0.0, h, 0.0, 1.0, 0.0, q0, v0, qdd0, a0, a0};
+        double q;
+        assert_int_equal(ga_create(1, 0, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, sdof_mass, sdof_force, NULL, NULL, NULL), GA_OK);
+        assert_int_equal(ga_set_rho_inf(s, 0.0), GA_OK);
+        assert_int_equal(ga_set_newton(s, 1e-12, 80), GA_OK);
+        assert_int_equal(ga_set_tangent_mode(s, mode), GA_OK);
+        size_t size = 0;
+        assert_int_equal(ga_state_size(s, &size), GA_OK);
+        assert_int_equal(size, 14);
+        assert_int_equal(ga_set_state(s, buf, size), GA_OK);
+        assert_int_equal(ga_step(s, h), GA_OK);
+        assert_int_equal(ga_get_q(s, &q), GA_OK);
+        assert_true(fabs(q - q1) < 1e-11);
+        ga_free(s);
+    }
+}
+
+/* GA_TANGENT_AUTO without tangent callbacks: finite-difference tangents only where they matter.
+ * Pendulum, h = 1e-3: beta' M dominates beta h^2 K_t, the simplified iteration contracts fast,
+ * and no tangent is evaluated. q'' = -omega^2 q with omega h = 10: it contracts at ~ (omega
+ * h)^2 beta > 1 without K_t, so the tangent comes in. Either way the step is the discrete
+ * solution: the same as with finite-difference tangents throughout (GA_TANGENT_FD). */
+static void run_tangents(int mode, int stiff, double *q_end, long long *tangent_evals)
+{
+    ga_solver *s = NULL;
+    double q[2], v[2] = {0.0, 0.0};
+    if (stiff) {
+        assert_int_equal(ga_create(1, 0, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, sdof_mass, stiff_force, NULL, NULL, NULL), GA_OK);
+        q[0] = 1.0;
+    } else {
+        assert_int_equal(ga_create(2, 1, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                          pendulum_jacobian, &P),
+                         GA_OK);
+        pendulum_state(&P, 1.0, 0.5, q, v);
+    }
+    assert_int_equal(ga_set_rho_inf(s, 0.9), GA_OK);
+    assert_int_equal(ga_set_newton(s, 1e-12, 40), GA_OK);
+    assert_int_equal(ga_set_tangent_mode(s, mode), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    const double h = stiff ? 1e-2 : 1e-3;
+    for (int k = 0; k < 50; ++k)
+        assert_int_equal(ga_step(s, h), GA_OK);
+    assert_int_equal(ga_get_q(s, q_end), GA_OK);
+    assert_int_equal(ga_get_counter(s, GA_COUNT_STIFFNESS_EVALS, tangent_evals), GA_OK);
+    ga_free(s);
+}
+
+static void missing_tangents_are_computed_only_where_they_matter(void **state)
+{
+    (void)state;
+    double q_auto[2], q_fd[2];
+    long long n_auto, n_fd;
+    run_tangents(GA_TANGENT_AUTO, 0, q_auto, &n_auto);
+    run_tangents(GA_TANGENT_FD, 0, q_fd, &n_fd);
+    printf("  pendulum, h = 1e-3: %lld tangent evaluations (finite differences throughout: "
+           "%lld), |dq| = %.2e\n",
+           n_auto, n_fd, max_abs_diff(q_auto, q_fd, 2));
+    assert_int_equal(n_auto, 0);
+    assert_true(n_fd > 0);
+    assert_true(max_abs_diff(q_auto, q_fd, 2) < 1e-10);
+    run_tangents(GA_TANGENT_AUTO, 1, q_auto, &n_auto);
+    run_tangents(GA_TANGENT_FD, 1, q_fd, &n_fd);
+    printf("  q'' = -omega^2 q, omega h = 10: %lld tangent evaluations (%lld), |dq| = %.2e\n",
+           n_auto, n_fd, fabs(q_auto[0] - q_fd[0]));
+    assert_true(n_auto > 0);
+    assert_true(fabs(q_auto[0] - q_fd[0]) < 1e-12);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(step_solution_is_converged_for_every_h),
         cmocka_unit_test(paper_test_on_scaled_residual_would_accept_the_predictor),
+        cmocka_unit_test(no_rate_is_measured_against_an_infinite_increment),
+        cmocka_unit_test(missing_tangents_are_computed_only_where_they_matter),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
