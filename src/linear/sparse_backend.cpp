@@ -20,15 +20,7 @@ namespace {
 
 class SparseBackend final : public LinearBackend {
 public:
-    SparseBackend()
-    {
-        klu_defaults(&common_);
-        // No row scaling: the iteration matrix is already balanced by the scaling of eq. (10),
-        // and the pattern is assembled here (sorted, no duplicates), so KLU's scaling pass and
-        // its input check are a scan of the whole matrix per factorization (a sixth of the
-        // step on Andrews-31) that buys nothing.
-        common_.scale = -1;
-    }
+    SparseBackend() { klu_defaults(&common_); }
     ~SparseBackend() override
     {
         if (numeric_)
