@@ -71,8 +71,8 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const Vec &dq, const
             return Verdict::Slow;
         if (theta >= 1.0)
             return Verdict::Slow;
-        // error predicted after the iterations left in the budget
-        if (theta > 0.0 &&
+        // error predicted after the iterations left in the budget (from a measured rate)
+        if (measured && theta > 0.0 &&
             eta * std::pow(theta, kIterationBudget - with_matrix_) / (1.0 - theta) > 1.0)
             return Verdict::Slow;
     }
