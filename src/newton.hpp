@@ -56,6 +56,8 @@ public:
     double ratio() const { return ratio_; }  // eta of the last update
     double rate() const { return rate_; }    // last measured theta (< 0: none yet)
     int iterations_with_matrix() const { return with_matrix_; }
+    // the last position increment was within a few ulps of |q|: rates measure noise
+    bool at_roundoff() const { return previous_dq_at_roundoff_; }
 
 private:
     int iteration_ = 0;

@@ -440,7 +440,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         const auto verdict = convergence_.check(tol, dq_, *dw, c.beta_prime, dlambda_,
                                                 x.q, x.qdd, x.lambda);
         converged = verdict == ConvergenceTest::Verdict::Converged;
-        if (!converged && tangents_deferred_ && refresh_done &&
+        if (!converged && tangents_deferred_ && refresh_done && !convergence_.at_roundoff() &&
             convergence_.iterations_with_matrix() >= 2 &&
             !(convergence_.rate() <= kDeferredTangentRate)) {
             // A fresh matrix without the missing tangents contracts too slowly: from now on

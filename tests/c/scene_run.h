@@ -29,7 +29,7 @@ typedef struct scene_result {
     double max_phi;      /* max over accepted steps of |Phi(q_n)|_inf */
     double max_q;        /* max over accepted steps of |q_n|_inf */
     double energy_drift; /* max over accepted steps of |E(t_n) - E(t_0)| */
-    long long steps, iters, residuals;
+    long long steps, iters, residuals, tangent_evals;
 } scene_result;
 
 static inline scene_result run_scene(const scene *sc, double h, double t_end, double rho_inf,
@@ -86,6 +86,7 @@ static inline scene_result run_scene(const scene *sc, double h, double t_end, do
         ga_get_counter(s, GA_COUNT_STEPS, &r.steps);
         ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &r.iters);
         ga_get_counter(s, GA_COUNT_RESIDUALS, &r.residuals);
+        ga_get_counter(s, GA_COUNT_STIFFNESS_EVALS, &r.tangent_evals);
     }
     ga_free(s);
     free(phi);
