@@ -206,10 +206,10 @@ static void no_rate_is_measured_against_an_infinite_increment(void **state)
 }
 
 /* GA_TANGENT_AUTO without tangent callbacks: finite-difference tangents only where they matter.
- * Pendulum, h = 1e-3: beta' M dominates beta h^2 K_t, the simplified iteration
- * contracts fast, and no tangent is evaluated. q'' = -omega^2 q with omega h = 10: it contracts at ~ (omega
- * h)^2 beta > 1 without K_t, so the tangent comes in. Either way the step is the discrete
- * solution: the same as with finite-difference tangents throughout (GA_TANGENT_FD). */
+ * Pendulum, h = 1e-3: beta' M dominates beta h^2 K_t, the simplified iteration contracts
+ * fast, and no tangent is evaluated. q'' = -omega^2 q with omega h = 10: it contracts at
+ * ~ (omega h)^2 beta > 1 without K_t, so the tangent comes in. Either way the step is the
+ * discrete solution: the same as with finite-difference tangents throughout (GA_TANGENT_FD). */
 static void run_tangents(int mode, int stiff, double h, double *q_end, long long *tangent_evals)
 {
     ga_solver *s = NULL;
