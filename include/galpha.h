@@ -504,7 +504,8 @@ typedef enum ga_counter {
     GA_COUNT_FAILED_STEPS = 1,   /**< step attempts that failed (Newton, callbacks, NaN,
                                       singular matrix), in ga_step or inside adaptive steps */
     GA_COUNT_NEWTON_ITERS = 2,   /**< Newton iterations (linear solves in ga_step) */
-    GA_COUNT_FACTORIZATIONS = 3, /**< LU factorizations (including ga_init's) */
+    GA_COUNT_FACTORIZATIONS = 3, /**< LU factorizations (including ga_init's and, in adaptive
+                                      mode, that of the error estimate's projection) */
     GA_COUNT_RESIDUALS = 4,      /**< evaluations of the residual (r^q, r^lambda) */
     GA_COUNT_MASS_EVALS = 5,     /**< mass matrix callback calls (finite differences included) */
     GA_COUNT_FORCE_EVALS = 6,    /**< force callback calls (finite differences included) */

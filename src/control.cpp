@@ -48,14 +48,16 @@ double Solver::error_norm(double h)
              ((x.a - a_n_) / h - (s.a - s.a_prev) / s.h_last);
     else
         ev.setZero();
-    if (m_ > 0 && P_.ready() && P_.factorize_kkt(M_, 1.0, J_)) {
-        for (Vec *e : {&eq, &ev}) {
-            // [M Phi_q^T; Phi_q 0] [x; y] = [M e; 0]: x = e - M^-1 Phi_q^T y, Phi_q x = 0
-            rq_.setZero();
-            M_.multiply_add(-1.0, *e, rq_);
-            phi_.setZero();
-            P_.solve(rq_, phi_, *e, lambda_tmp_);
-        }
+    if (m_ > 0 && P_.ready()) {
+        count(counters, GA_COUNT_FACTORIZATIONS);  // counted like every other
+        if (P_.factorize_kkt(M_, 1.0, J_))
+            for (Vec *e : {&eq, &ev}) {
+                // [M Phi_q^T; Phi_q 0] [x; y] = [M e; 0]: x = e - M^-1 Phi_q^T y, Phi_q x = 0
+                rq_.setZero();
+                M_.multiply_add(-1.0, *e, rq_);
+                phi_.setZero();
+                P_.solve(rq_, phi_, *e, lambda_tmp_);
+            }
     }
     const double rtol = control.rtol, atol = control.atol;
     double sum = 0.0;
