@@ -1,0 +1,53 @@
+// A square sparse matrix whose pattern is fixed once, factorized with SuiteSparse KLU:
+// symbolic analysis at setup (KLU's AMD ordering, or reverse Cuthill-McKee when it fills
+// little more), a numeric factorization the first time, then klu_refactor -- same pivot order,
+// no allocation. If a refactorization comes out poorly conditioned (pivots chosen for other
+// values), the matrix is factorized afresh with new pivots (this rare path allocates).
+// Shared by the sparse saddle-point backend and the sparse stabilized index-2 system.
+#pragma once
+
+#ifdef GALPHA_HAVE_KLU
+#include <klu.h>
+
+#include <utility>
+#include <vector>
+
+namespace ga {
+
+class KluSystem {
+public:
+    KluSystem();
+    ~KluSystem();
+    KluSystem(const KluSystem &) = delete;
+    KluSystem &operator=(const KluSystem &) = delete;
+
+    // The pattern: (row, column) of every structural entry of the N x N matrix, duplicates
+    // allowed. Throws std::bad_alloc.
+    void setup(int N, std::vector<std::pair<int, int>> entries);
+    // Position of entry (row, col) of the pattern in values() (setup time only).
+    int slot(int row, int col) const;
+    // The entries, in the order of the pattern: the caller assembles them before factorize().
+    std::vector<double> &values() { return values_; }
+
+    // false if singular or numerically singular. Throws std::bad_alloc.
+    bool factorize();
+    void solve(double *rhs);  // in place, length N
+    // min |U_ii| / max |U_ii| of the last factorization (KLU's estimate)
+    double rcond() const { return rcond_; }
+    const char *ordering() const { return ordering_; }
+
+private:
+    std::vector<int> reverse_cuthill_mckee() const;
+
+    int N_ = 0;
+    std::vector<int> colptr_, rowind_;
+    std::vector<double> values_;
+    klu_common common_;
+    klu_symbolic *symbolic_ = nullptr;
+    klu_numeric *numeric_ = nullptr;
+    double rcond_ = 0.0;
+    const char *ordering_ = "AMD";
+};
+
+}  // namespace ga
+#endif
