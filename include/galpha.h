@@ -372,11 +372,14 @@ typedef enum ga_formulation {
                                   second order across step-size changes (index 3: an O(h) burst
                                   after every change) and are far less sensitive to round-off
                                   for small h; recommended with adaptive steps. Same callbacks
-                                  (Phi_t by finite differences); dense linear algebra only. */
+                                  (Phi_t by finite differences), dense or sparse: with declared
+                                  patterns the system keeps the Newmark increment as extra
+                                  unknowns, so no block is a product of the user's matrices
+                                  (2n + 2m sparse unknowns instead of n + 2m dense ones). */
 } ga_formulation;
 
-/** formulation is a ::ga_formulation. Errors: GA_ERR_ARG (also: index-2 with a sparse solver
- *  already set up), GA_ERR_STATE. */
+/** formulation is a ::ga_formulation. Errors: GA_ERR_ARG, GA_ERR_STATE, GA_ERR_NOMEM (index-2
+ *  chosen after the workspace was set up, and its system does not fit). */
 GA_API ga_status ga_set_formulation(ga_solver *s, int formulation);
 
 /** Rescale the stored a_n to the size of the coming step, a_n <- qdd_n + (h/h_last)(a_n -

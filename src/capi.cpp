@@ -316,9 +316,8 @@ GA_API ga_status ga_set_formulation(ga_solver *s, int formulation)
     return guarded(s, [&](ga::Solver &c) {
         if (formulation != GA_INDEX3 && formulation != GA_INDEX2_STABILIZED)
             return c.diag.fail(GA_ERR_ARG, "unknown formulation %d", formulation);
-        if (formulation == GA_INDEX2_STABILIZED && !c.index2_available())
-            return c.diag.fail(GA_ERR_ARG, "the stabilized index-2 formulation needs a dense "
-                               "solver; this one was set up sparse");
+        if (formulation == GA_INDEX2_STABILIZED && c.setup_done())
+            c.setup_index2();  // may throw std::bad_alloc: the formulation stays as it was
         c.formulation = static_cast<ga_formulation>(formulation);
         c.invalidate_jacobian();
         return GA_OK;

@@ -97,10 +97,6 @@ ga_status Solver::setup()
     case GA_LINEAR_AUTO: sparse = sparse_possible && n_ + m_ >= kSparseMinSize; break;
     default: sparse = false;
     }
-    if (formulation == GA_INDEX2_STABILIZED && linear_solver == GA_LINEAR_SPARSE)
-        return diag.fail(GA_ERR_ARG, "the stabilized index-2 formulation needs a dense solver");
-    if (formulation == GA_INDEX2_STABILIZED)
-        sparse = false;
     std::unique_ptr<LinearBackend> backend;
     if (sparse) {
         backend = make_sparse_backend();
@@ -117,7 +113,6 @@ ga_status Solver::setup()
         backend = make_dense_backend(linear_solver == GA_LINEAR_DENSE_LAPACK ? DenseKind::Lapack
                                                                              : DenseKind::Eigen);
     }
-    const bool dense = !sparse || !backend;  // (before backend is moved)
     M_.allocate();
     J_.allocate();
     K_.allocate();
@@ -137,13 +132,18 @@ ga_status Solver::setup()
     model.allocate_workspace(M_, J_, K_, C_);
     sparse_backend_ = sparse && backend;
     S_.setup(std::move(backend), n_, m_, M_, J_, K_, C_);
-    if (dense) {  // the stabilized index-2 formulation is dense only
-        Bd_.setZero(m_, n_);
-        S2_.setup(n_, m_);
-        index2_ready_ = true;
-    }
     workspace_ready_ = true;
+    if (formulation == GA_INDEX2_STABILIZED)
+        setup_index2();
     return GA_OK;
+}
+
+// The stabilized index-2 system, dense or sparse like S_: set up with the workspace when that
+// formulation is chosen, or when it is chosen later (ga_set_formulation), never in a step.
+void Solver::setup_index2()
+{
+    if (!S2_.ready())
+        S2_.setup(n_, m_, sparse_backend_, M_, J_, K_, C_);
 }
 
 // The projection of error estimates (adaptive mode only): set up at the first adaptive call,
@@ -215,8 +215,8 @@ void Solver::commit(bool land_on, double t_land)
 // One step from accepted_ into trial_. accepted_ is only read.
 ga_status Solver::attempt_step(double h, double tol)
 {
-    if (formulation == GA_INDEX2_STABILIZED && !index2_ready_)
-        return diag.fail(GA_ERR_ARG, "the stabilized index-2 formulation needs a dense solver");
+    if (formulation == GA_INDEX2_STABILIZED && !S2_.ready())
+        return diag.fail(GA_ERR_INTERNAL, "the stabilized index-2 system was not set up");
     const State &s = accepted_;
     // The start of the step. a_n carries the shift delta_alpha h_last; rescaled to the h of
     // this step the scheme stays second order under any sequence of step sizes (ALGORITHMS.md
@@ -309,7 +309,7 @@ ga_status Solver::factorize(double h, bool tangents_K, bool tangents_C, int iter
     jacobian_valid_ = false;
     const ModelMatrix *C = tangents_C ? &C_ : nullptr, *K = tangents_K ? &K_ : nullptr;
     const bool ok = formulation == GA_INDEX2_STABILIZED
-                        ? S2_.factorize(M_, C, K, J_, Bd_, params, h)
+                        ? S2_.factorize(M_, C, K, J_, B_, params, h)
                         : S_.factorize_step(M_, C, K, J_, params, h, scaling);
     if (!ok)
         return diag.fail(GA_ERR_SINGULAR,
@@ -364,12 +364,6 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         // B = Phi_q(q_n): the direction of the position correction -h B^T eta (sec. 2.1)
         if (auto st = model.jacobian(s.t, s.q, B_))
             return st;
-        Bd_.setZero();
-        if (B_.dense())
-            Bd_ = B_.as_dense();
-        else
-            for (int k = 0; k < B_.nnz(); ++k)
-                Bd_(B_.row_index()[k], B_.col_index()[k]) += B_.data()[k];
     }
 
     // Tangents the user gives are always in the matrix. Missing ones (GA_TANGENT_AUTO) cost
@@ -416,10 +410,8 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         // [dq; dlambda] = -S_t^{-1} [r^q; r^lambda], in the scaled form (9)-(10)
         const Vec *dw = &dq_;
         if (index2) {
-            S2_.solve(rq_, phi_, phi_v_, p, h, dq_, dlambda_, deta_);
-            dw_ = dq_;
-            if (m_ > 0)
-                dw_.noalias() += Bd_.transpose() * deta_;  // the Newmark part of the update
+            // dw_: the Newmark part of the update, dq + B^T deta
+            S2_.solve(rq_, phi_, phi_v_, p, h, B_, dq_, dw_, dlambda_, deta_);
             dw = &dw_;
         } else {
             S_.solve(rq_, phi_, dq_, dlambda_, row_scale);
@@ -473,7 +465,7 @@ double Solver::last_rcond() const
 const char *Solver::linear_backend() const
 {
     if (workspace_ready_ && formulation == GA_INDEX2_STABILIZED)
-        return "dense Eigen LU (stabilized index-2)";
+        return S2_.name();
     return S_.backend_name();
 }
 

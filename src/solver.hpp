@@ -64,7 +64,9 @@ public:
     // Layout of the user's matrices (dense unless a pattern was declared); fixed at setup.
     ModelMatrix &matrix(ga_matrix which);
     bool setup_done() const { return workspace_ready_; }
-    bool index2_available() const { return !workspace_ready_ || index2_ready_; }
+    // Allocates the stabilized index-2 system if the workspace exists and it does not yet;
+    // throws std::bad_alloc.
+    void setup_index2();
     const char *linear_backend() const;
 
     bool initialized() const { return initialized_; }
@@ -126,7 +128,6 @@ private:
     int n_, m_;
     bool initialized_ = false;
     bool workspace_ready_ = false;
-    bool index2_ready_ = false;
     bool sparse_backend_ = false;
     int last_newton_iters_ = 0;
 
@@ -156,8 +157,7 @@ private:
     bool tangents_deferred_ = false;  // the last Newton iteration ran without them
 
     // Step workspace, sized once.
-    ModelMatrix M_, J_, K_, C_, B_;
-    Mat Bd_;  // index-2: Phi_q(q_n), dense
+    ModelMatrix M_, J_, K_, C_, B_;  // B_: index-2, Phi_q(q_n)
     Vec f_, phi_, phi_v_, rq_, dq_, dw_, dlambda_, deta_, c_, qdd_tmp_, lambda_tmp_;
     IterationMatrix S_;
     IterationMatrix P_;  // [I Phi_q^T; Phi_q 0]: tangent projection of error estimates

@@ -1,6 +1,13 @@
 #include "index2_matrix.hpp"
 
+#include <Eigen/LU>
+#include <algorithm>
 #include <limits>
+#include <new>
+#include <utility>
+#include <vector>
+
+#include "klu_system.hpp"
 
 namespace ga {
 
@@ -14,59 +21,210 @@ void add_block(Eigen::Ref<Mat> target, double c, const ModelMatrix &A)
     for (int k = 0; k < A.nnz(); ++k)
         target(A.row_index()[k], A.col_index()[k]) += c * A.data()[k];
 }
+
+// cM of the scaled system: (1 - alpha_m) / (1 - alpha_f), the factor of M in A
+double mass_factor(const Params &p) { return (1.0 - p.alpha_m) / (1.0 - p.alpha_f); }
 }  // namespace
 
-void Index2Matrix::setup(int n, int m)
+struct Index2Matrix::Dense {
+    int n = 0, m = 0;
+    Mat S, A, Bd;
+    Eigen::PartialPivLU<Mat> lu;
+    Vec rhs, x;
+    double pivot_ratio = 0.0;
+};
+
+#ifdef GALPHA_HAVE_KLU
+struct Index2Matrix::Sparse {
+    int n = 0, m = 0;
+    KluSystem S;
+    // slots of each block's entries, in the order of the block's pattern
+    std::vector<int> K, M, C, JT, J2, J3, BT, minus_I, plus_I;
+    Vec rhs;
+};
+#else
+struct Index2Matrix::Sparse {};
+#endif
+
+Index2Matrix::Index2Matrix() = default;
+Index2Matrix::~Index2Matrix() = default;
+
+void Index2Matrix::setup(int n, int m, bool sparse, const ModelMatrix &M, const ModelMatrix &J,
+                         const ModelMatrix &K, const ModelMatrix &C)
 {
-    n_ = n;
-    m_ = m;
+#ifdef GALPHA_HAVE_KLU
+    if (sparse) {
+        auto s = std::make_unique<Sparse>();
+        s->n = n;
+        s->m = m;
+        // columns: d [0, n), w [n, 2n), lambda_bar [2n, 2n + m), eta_bar [2n + m, 2n + 2m);
+        // rows: dynamics [0, n), w - d - B^T eta_bar [n, 2n), Phi [2n, 2n + m),
+        // velocity constraint [2n + m, 2n + 2m)
+        const int w0 = n, l0 = 2 * n, e0 = 2 * n + m;
+        std::vector<std::pair<int, int>> entries;
+        auto block = [&](const ModelMatrix &A, bool transposed, int row0, int col0) {
+            for (int k = 0; k < A.nnz(); ++k) {
+                const int i = A.row_index()[k], j = A.col_index()[k];
+                entries.emplace_back(transposed ? row0 + j : row0 + i,
+                                     transposed ? col0 + i : col0 + j);
+            }
+        };
+        block(K, false, 0, 0);
+        block(M, false, 0, w0);
+        block(C, false, 0, w0);
+        block(J, true, 0, l0);      // Phi_q^T
+        block(J, true, w0, e0);     // -B^T (B has the layout of Phi_q)
+        block(J, false, l0, 0);     // Phi_q d
+        block(J, false, e0, w0);    // Phi_q w
+        for (int i = 0; i < n; ++i) {
+            entries.emplace_back(w0 + i, i);       // -I
+            entries.emplace_back(w0 + i, w0 + i);  // I
+        }
+        s->S.setup(2 * n + 2 * m, std::move(entries));
+        auto slots = [&](const ModelMatrix &A, bool transposed, int row0, int col0) {
+            std::vector<int> out(A.nnz());
+            for (int k = 0; k < A.nnz(); ++k) {
+                const int i = A.row_index()[k], j = A.col_index()[k];
+                out[k] = transposed ? s->S.slot(row0 + j, col0 + i)
+                                    : s->S.slot(row0 + i, col0 + j);
+            }
+            return out;
+        };
+        s->K = slots(K, false, 0, 0);
+        s->M = slots(M, false, 0, w0);
+        s->C = slots(C, false, 0, w0);
+        s->JT = slots(J, true, 0, l0);
+        s->BT = slots(J, true, w0, e0);
+        s->J2 = slots(J, false, l0, 0);
+        s->J3 = slots(J, false, e0, w0);
+        for (int i = 0; i < n; ++i) {
+            s->minus_I.push_back(s->S.slot(w0 + i, i));
+            s->plus_I.push_back(s->S.slot(w0 + i, w0 + i));
+        }
+        s->rhs.setZero(2 * n + 2 * m);
+        sparse_ = std::move(s);
+        return;
+    }
+#else
+    (void)sparse, (void)M, (void)J, (void)K, (void)C;
+#endif
+    auto d = std::make_unique<Dense>();
+    d->n = n;
+    d->m = m;
     const int N = n + 2 * m;
-    S_.setZero(N, N);
-    A_.setZero(n, n);
-    lu_ = Eigen::PartialPivLU<Mat>(N);
-    rhs_.setZero(N);
-    x_.setZero(N);
+    d->S.setZero(N, N);
+    d->A.setZero(n, n);
+    d->Bd.setZero(m, n);
+    d->lu = Eigen::PartialPivLU<Mat>(N);
+    d->rhs.setZero(N);
+    d->x.setZero(N);
+    dense_ = std::move(d);
 }
 
 bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,
-                             const ModelMatrix &J, const Mat &B, const Params &p, double h)
+                             const ModelMatrix &J, const ModelMatrix &B, const Params &p,
+                             double h)
 {
-    const int n = n_, m = m_;
-    const double cM = (1.0 - p.alpha_m) / (1.0 - p.alpha_f);
-    S_.setZero();
-    A_.setZero();
-    add_block(A_, cM, M);  // cM M + gamma h C: also the block that multiplies B^T
+    const double cM = mass_factor(p);
+#ifdef GALPHA_HAVE_KLU
+    if (sparse_) {
+        Sparse &s = *sparse_;
+        std::vector<double> &v = s.S.values();
+        std::fill(v.begin(), v.end(), 0.0);
+        auto scatter = [&](const ModelMatrix &A, const std::vector<int> &slots, double c) {
+            const double *a = A.data();
+            for (std::size_t k = 0; k < slots.size(); ++k)
+                v[slots[k]] += c * a[k];
+        };
+        scatter(M, s.M, cM);
+        if (C)
+            scatter(*C, s.C, p.gamma * h);
+        if (K)
+            scatter(*K, s.K, p.beta * h * h);
+        scatter(J, s.JT, 1.0);
+        scatter(B, s.BT, -1.0);
+        scatter(J, s.J2, 1.0);
+        scatter(J, s.J3, 1.0);
+        for (int k : s.minus_I)
+            v[k] -= 1.0;
+        for (int k : s.plus_I)
+            v[k] += 1.0;
+        return s.S.factorize();
+    }
+#endif
+    Dense &d = *dense_;
+    const int n = d.n, m = d.m;
+    d.S.setZero();
+    d.A.setZero();
+    add_block(d.A, cM, M);  // cM M + gamma h C: also the block that multiplies B^T
     if (C)
-        add_block(A_, p.gamma * h, *C);
-    S_.block(0, n + m, n, m).noalias() = A_ * B.transpose();
-    auto top_left = S_.topLeftCorner(n, n);
-    top_left = A_;
+        add_block(d.A, p.gamma * h, *C);
+    d.Bd.setZero();
+    add_block(d.Bd, 1.0, B);
+    d.S.block(0, n + m, n, m).noalias() = d.A * d.Bd.transpose();
+    auto top_left = d.S.topLeftCorner(n, n);
+    top_left = d.A;
     if (K)
         add_block(top_left, p.beta * h * h, *K);
-    auto Jd = S_.block(n, 0, m, n);
+    auto Jd = d.S.block(n, 0, m, n);
     add_block(Jd, 1.0, J);
-    S_.block(0, n, n, m) = Jd.transpose();
-    S_.block(n + m, 0, m, n) = Jd;
-    S_.block(n + m, n + m, m, m).noalias() = Jd * B.transpose();
-    lu_.compute(S_);
-    const auto U = lu_.matrixLU().diagonal().cwiseAbs();
+    d.S.block(0, n, n, m) = Jd.transpose();
+    d.S.block(n + m, 0, m, n) = Jd;
+    d.S.block(n + m, n + m, m, m).noalias() = Jd * d.Bd.transpose();
+    d.lu.compute(d.S);
+    const auto U = d.lu.matrixLU().diagonal().cwiseAbs();
     const double umax = U.maxCoeff();
-    pivot_ratio_ = umax > 0.0 ? U.minCoeff() / umax : 0.0;
-    return pivot_ratio_ >= (n + 2 * m) * std::numeric_limits<double>::epsilon();
+    d.pivot_ratio = umax > 0.0 ? U.minCoeff() / umax : 0.0;
+    return d.pivot_ratio >= (n + 2 * m) * std::numeric_limits<double>::epsilon();
 }
 
 void Index2Matrix::solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const Params &p,
-                         double h, Vec &d, Vec &dlambda, Vec &eta_bar)
+                         double h, const ModelMatrix &B, Vec &d, Vec &w, Vec &dlambda,
+                         Vec &eta_bar)
 {
-    const int n = n_, m = m_;
     const double bh2 = p.beta * h * h;
-    rhs_.head(n) = -bh2 * rq;
-    rhs_.segment(n, m) = -phi;
-    rhs_.tail(m) = -(p.beta * h / p.gamma) * phi_v;
-    x_.noalias() = lu_.solve(rhs_);
-    d = x_.head(n);
-    dlambda = x_.segment(n, m) / bh2;
-    eta_bar = x_.tail(m);
+#ifdef GALPHA_HAVE_KLU
+    if (sparse_) {
+        Sparse &s = *sparse_;
+        const int n = s.n, m = s.m;
+        s.rhs.head(n) = -bh2 * rq;
+        s.rhs.segment(n, n).setZero();
+        s.rhs.segment(2 * n, m) = -phi;
+        s.rhs.tail(m) = -(p.beta * h / p.gamma) * phi_v;
+        s.S.solve(s.rhs.data());
+        d = s.rhs.head(n);
+        w = s.rhs.segment(n, n);
+        dlambda = s.rhs.segment(2 * n, m) / bh2;
+        eta_bar = s.rhs.tail(m);
+        return;
+    }
+#endif
+    Dense &x = *dense_;
+    const int n = x.n, m = x.m;
+    x.rhs.head(n) = -bh2 * rq;
+    x.rhs.segment(n, m) = -phi;
+    x.rhs.tail(m) = -(p.beta * h / p.gamma) * phi_v;
+    x.x.noalias() = x.lu.solve(x.rhs);
+    d = x.x.head(n);
+    dlambda = x.x.segment(n, m) / bh2;
+    eta_bar = x.x.tail(m);
+    w = d;
+    if (m > 0)
+        B.multiply_transpose_add(1.0, eta_bar, w);
+}
+
+double Index2Matrix::rcond() const
+{
+#ifdef GALPHA_HAVE_KLU
+    if (sparse_)
+        return sparse_->S.rcond();
+#endif
+    return dense_ ? dense_->pivot_ratio : 0.0;
+}
+
+const char *Index2Matrix::name() const
+{
+    return sparse_ ? "sparse KLU (stabilized index-2)" : "dense Eigen LU (stabilized index-2)";
 }
 
 }  // namespace ga

@@ -1,18 +1,28 @@
 // The iteration matrix of the stabilized index-2 formulation (ALGORITHMS.md sec. 2; Arnold &
 // Hante 2017), in the scaling of eq. (10) extended to the extra multiplier. Unknowns
-// (d, lambda_bar, eta_bar) = (dq, beta h^2 dlambda, h deta), with B = Phi_q(q_n):
+// (d, lambda_bar, eta_bar) = (dq, beta h^2 dlambda, h deta), with B = Phi_q(q_n) and
+// A = cM M + gamma h C:
 //
-//   [ cM M + gamma h C + beta h^2 K   Phi_q^T   (cM M + gamma h C) B^T ] [d         ]
-//   [ Phi_q                           0         0                      ] [lambda_bar]
-//   [ Phi_q                           0         Phi_q B^T              ] [eta_bar   ]
+//   [ A + beta h^2 K   Phi_q^T   A B^T       ] [d         ]
+//   [ Phi_q            0         0           ] [lambda_bar]
+//   [ Phi_q            0         Phi_q B^T   ] [eta_bar   ]
 //
 //   = -[ beta h^2 r^q ; Phi ; (beta h / gamma) (Phi_q v + Phi_t) ]
 //
 // (the curvature term d(Phi_q v)/dq of the third row is neglected, as gena does by default).
-// Dense: (n + 2m)^2, Eigen LU.
+// Dense: (n + 2m)^2, Eigen LU. Sparse (declared patterns, KLU): the products A B^T and
+// Phi_q B^T would fill, so the Newmark increment w = d + B^T eta_bar becomes an unknown of its
+// own and every block is one of the user's sparse matrices:
+//
+//   [ beta h^2 K   A       Phi_q^T   0     ] [d         ]   [ -beta h^2 r^q          ]
+//   [ -I           I       0         -B^T  ] [w         ] = [ 0                      ]
+//   [ Phi_q        0       0         0     ] [lambda_bar]   [ -Phi                   ]
+//   [ 0            Phi_q   0         0     ] [eta_bar   ]   [ -(beta h / gamma) Phi_v ]
+//
+// (eliminating w gives the first system back).
 #pragma once
 
-#include <Eigen/LU>
+#include <memory>
 
 #include "../matrix.hpp"
 #include "../params.hpp"
@@ -21,20 +31,29 @@ namespace ga {
 
 class Index2Matrix {
 public:
-    void setup(int n, int m);
+    Index2Matrix();
+    ~Index2Matrix();
+
+    // Allocates everything (patterns of M, J, K, C: their layouts; B has J's). Throws
+    // std::bad_alloc.
+    void setup(int n, int m, bool sparse, const ModelMatrix &M, const ModelMatrix &J,
+               const ModelMatrix &K, const ModelMatrix &C);
+    bool ready() const { return dense_ || sparse_; }
+    // false if singular or numerically singular
     bool factorize(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,
-                   const ModelMatrix &J, const Mat &B, const Params &p, double h);
-    // Solves for (d, dlambda, eta_bar) in natural units of d and lambda.
+                   const ModelMatrix &J, const ModelMatrix &B, const Params &p, double h);
+    // (d, dlambda, eta_bar) in natural units of d and lambda, and the Newmark part of the
+    // update, w = d + B^T eta_bar.
     void solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const Params &p, double h,
-               Vec &d, Vec &dlambda, Vec &eta_bar);
-    double rcond() const { return pivot_ratio_; }
+               const ModelMatrix &B, Vec &d, Vec &w, Vec &dlambda, Vec &eta_bar);
+    double rcond() const;
+    const char *name() const;
 
 private:
-    int n_ = 0, m_ = 0;
-    Mat S_, A_;
-    Eigen::PartialPivLU<Mat> lu_;
-    Vec rhs_, x_;
-    double pivot_ratio_ = 0.0;
+    struct Dense;
+    struct Sparse;
+    std::unique_ptr<Dense> dense_;
+    std::unique_ptr<Sparse> sparse_;
 };
 
 }  // namespace ga

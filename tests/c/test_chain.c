@@ -1,6 +1,7 @@
 /* The sparse path on the N-link chain: the sparse (KLU) and dense solvers give the same steps,
- * grouped finite differences reproduce the exact tangent at a few evaluations per matrix,
- * and the energy of the chain is kept to the order of the integration error. */
+ * in the index-3 and in the stabilized index-2 formulation, grouped finite differences
+ * reproduce the exact tangent at a few evaluations per matrix, and the energy of the chain is
+ * kept to the order of the integration error. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -17,8 +18,9 @@
 typedef struct chain_run {
     double *q, *lambda;
     double energy_drift;
+    double velocity_constraint; /* max over the steps of |Phi_q v|_inf */
     long long stiffness_evals, jacobian_evals, factorizations, steps;
-    char backend[32];
+    char backend[64];
 } chain_run;
 
 static double energy(const chain *c, const double *q, const double *v)
@@ -30,7 +32,28 @@ static double energy(const chain *c, const double *q, const double *v)
     return e;
 }
 
-static chain_run run(int links, int solver, int exact_tangent, double h, int steps)
+/* max |Phi_q(q) v|_inf, from the chain's Jacobian values in the order of its pattern */
+static double velocity_constraint(const chain *c, const double *q, const double *v)
+{
+    const int nnz = chain_pattern(c, GA_MATRIX_JACOBIAN, NULL, NULL);
+    int *rows = malloc(sizeof(int) * nnz), *cols = malloc(sizeof(int) * nnz);
+    double *J = malloc(sizeof(double) * nnz), *Jv = calloc(2 * c->links, sizeof(double));
+    chain_pattern(c, GA_MATRIX_JACOBIAN, rows, cols);
+    chain_jacobian(0.0, q, J, (void *)c);
+    for (int k = 0; k < nnz; ++k)
+        Jv[rows[k]] += J[k] * v[cols[k]];
+    double worst = 0.0;
+    for (int i = 0; i < 2 * c->links; ++i)
+        worst = fmax(worst, fabs(Jv[i]));
+    free(rows);
+    free(cols);
+    free(J);
+    free(Jv);
+    return worst;
+}
+
+static chain_run run_formulation(int links, int solver, int formulation, int exact_tangent,
+                                 double h, int steps)
 {
     chain c = chain_make(links);
     const int n = 3 * links, m = 2 * links;
@@ -48,10 +71,13 @@ static chain_run run(int links, int solver, int exact_tangent, double h, int ste
                      GA_OK);
     if (exact_tangent)
         assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
+    else /* grouped finite differences at every matrix, not only once they matter */
+        assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
     assert_int_equal(ga_set_constraint_accel(s, chain_constraint_accel), GA_OK);
     assert_int_equal(ga_set_constant_mass(s, 1), GA_OK);
     assert_int_equal(ga_set_linear_solver(s, solver), GA_OK);
     assert_int_equal(ga_set_newton(s, 1e-10, 20), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     snprintf(r.backend, sizeof r.backend, "%s", ga_linear_solver_name(s));
     const double e0 = energy(&c, q, v);
@@ -62,6 +88,7 @@ static chain_run run(int links, int solver, int exact_tangent, double h, int ste
         ga_get_q(s, q);
         ga_get_v(s, v);
         r.energy_drift = fmax(r.energy_drift, fabs(energy(&c, q, v) - e0));
+        r.velocity_constraint = fmax(r.velocity_constraint, velocity_constraint(&c, q, v));
     }
     ga_get_q(s, r.q);
     ga_get_lambda(s, r.lambda);
@@ -73,6 +100,11 @@ static chain_run run(int links, int solver, int exact_tangent, double h, int ste
     free(q);
     free(v);
     return r;
+}
+
+static chain_run run(int links, int solver, int exact_tangent, double h, int steps)
+{
+    return run_formulation(links, solver, GA_INDEX3, exact_tangent, h, steps);
 }
 
 static void release(chain_run *r)
@@ -101,6 +133,74 @@ static void sparse_and_dense_solvers_agree(void **state)
     release(&sp);
     release(&de);
     release(&la);
+}
+
+/* The sparse index-2 system (the Newmark increment as extra unknowns, index2_matrix.hpp) and
+ * the dense one solve the same equations: the same steps to round-off; both keep the velocity
+ * constraint Phi_q v = 0 at every step, which the index-3 formulation does not. */
+static void sparse_and_dense_index2_agree(void **state)
+{
+    (void)state;
+    const int links = 12;
+    chain_run sp = run_formulation(links, GA_LINEAR_SPARSE, GA_INDEX2_STABILIZED, 1, 2e-3, 100);
+    chain_run de =
+        run_formulation(links, GA_LINEAR_DENSE_EIGEN, GA_INDEX2_STABILIZED, 1, 2e-3, 100);
+    chain_run i3 = run(links, GA_LINEAR_SPARSE, 1, 2e-3, 100);
+    assert_string_equal(sp.backend, "sparse KLU (stabilized index-2)");
+    assert_string_equal(de.backend, "dense Eigen LU (stabilized index-2)");
+    const double dq = max_abs_diff(sp.q, de.q, 3 * links);
+    const double dl = max_abs_diff(sp.lambda, de.lambda, 2 * links);
+    printf("  index 2, KLU vs Eigen LU: |dq| = %.1e, |dlambda| = %.1e; max |Phi_q v|: %.1e "
+           "(sparse), %.1e (dense), %.1e (index 3)\n",
+           dq, dl, sp.velocity_constraint, de.velocity_constraint, i3.velocity_constraint);
+    assert_true(dq < 1e-9);
+    assert_true(dl < 1e-6);
+    assert_true(sp.velocity_constraint < 1e-9);
+    assert_true(de.velocity_constraint < 1e-9);
+    assert_true(i3.velocity_constraint > 1e3 * sp.velocity_constraint);
+    release(&sp);
+    release(&de);
+    release(&i3);
+}
+
+/* Chosen after the sparse workspace exists, the index-2 system is set up sparse too; and a
+ * large chain runs adaptively in it. */
+static void index2_on_a_sparse_solver_set_up_already(void **state)
+{
+    (void)state;
+    chain c = chain_make(2000);
+    const int n = 3 * c.links, m = 2 * c.links;
+    double *q = malloc(sizeof(double) * n), *v = malloc(sizeof(double) * n);
+    ga_solver *s = NULL;
+    chain_initial(&c, q, v);
+    assert_int_equal(ga_create(n, m, &s), GA_OK);
+    assert_int_equal(chain_declare_patterns(&c, s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
+                                      chain_jacobian, &c),
+                     GA_OK);
+    assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
+    assert_int_equal(ga_set_constraint_accel(s, chain_constraint_accel), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    assert_string_equal(ga_linear_solver_name(s), "sparse KLU");
+    assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
+    assert_string_equal(ga_linear_solver_name(s), "sparse KLU (stabilized index-2)");
+    assert_int_equal(ga_set_tolerances(s, 1e-4, 1e-4), GA_OK);
+    assert_int_equal(ga_advance(s, 0.2), GA_OK);
+    ga_get_q(s, q);
+    ga_get_v(s, v);
+    long long steps;
+    ga_get_counter(s, GA_COUNT_STEPS, &steps);
+    double vmax = 0.0;
+    for (int i = 0; i < n; ++i)
+        vmax = fmax(vmax, fabs(v[i]));
+    printf("  2000-link chain, adaptive index 2 to t = 0.2: %lld steps, |Phi_q v| = %.1e, "
+           "|v| = %.2f\n",
+           steps, velocity_constraint(&c, q, v), vmax);
+    /* to the Newton tolerance of adaptive steps, 1e-2 rtol, relative to the velocities */
+    assert_true(velocity_constraint(&c, q, v) < 1e-6 * vmax);
+    ga_free(s);
+    free(q);
+    free(v);
 }
 
 static void grouped_finite_differences_match_exact_tangent(void **state)
@@ -151,6 +251,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(sparse_and_dense_solvers_agree),
+        cmocka_unit_test(sparse_and_dense_index2_agree),
+        cmocka_unit_test(index2_on_a_sparse_solver_set_up_already),
         cmocka_unit_test(grouped_finite_differences_match_exact_tangent),
         cmocka_unit_test(auto_choice_is_sparse_for_large_chains),
         cmocka_unit_test(energy_is_kept_to_integration_error),
