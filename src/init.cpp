@@ -62,6 +62,8 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
     control.h_next = 0.0;
     control.err_prev = 1.0;
     control.grew = false;
+    if (formulation == GA_INDEX2_STABILIZED)
+        prefactor_index2();
     return GA_OK;
 }
 

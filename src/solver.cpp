@@ -144,6 +144,20 @@ void Solver::setup_index2()
 {
     if (!S2_.ready())
         S2_.setup(n_, m_, sparse_backend_, M_, J_, K_, C_);
+    if (initialized_)
+        prefactor_index2();
+}
+
+// KLU allocates its factors and picks its pivots in the first numeric factorization; for the
+// sparse index-2 system that happens here, with the matrices of the current state, and not in
+// the first step (which then refactorizes without allocating). Without C_t and K_t the matrix
+// does not depend on h. A failure here is no error: the step factorizes afresh.
+void Solver::prefactor_index2()
+{
+    if (!S2_.sparse())
+        return;
+    count(counters, GA_COUNT_FACTORIZATIONS);
+    S2_.factorize(M_, nullptr, nullptr, J_, J_, params, 1.0);
 }
 
 // The projection of error estimates (adaptive mode only): set up at the first adaptive call,

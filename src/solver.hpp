@@ -110,6 +110,7 @@ public:
 private:
     ga_status setup();  // chooses the backend and allocates everything; throws std::bad_alloc
     void setup_projection();
+    void prefactor_index2();
     double newton_tolerance(bool adaptive) const;
     ga_status attempt_step(double h, double tol);
     ga_status newton(double h, double tol, bool refresh, bool &converged, bool &used_stale);

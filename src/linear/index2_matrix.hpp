@@ -39,6 +39,7 @@ public:
     void setup(int n, int m, bool sparse, const ModelMatrix &M, const ModelMatrix &J,
                const ModelMatrix &K, const ModelMatrix &C);
     bool ready() const { return dense_ || sparse_; }
+    bool sparse() const { return sparse_ != nullptr; }
     // false if singular or numerically singular
     bool factorize(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,
                    const ModelMatrix &J, const ModelMatrix &B, const Params &p, double h);

@@ -77,7 +77,15 @@ static int force_maybe_failing(double t, const double *q, const double *v, doubl
     return fail_force;
 }
 
-static long count_step_allocations(ga_tangent_mode mode, int with_failures)
+/* The step functions take fixed steps, or adaptive ones (ga_step_adaptive: one warm-up call
+ * first, since the error projection's workspace is made at the first adaptive call). */
+static ga_status take_step(ga_solver *s, int adaptive)
+{
+    return adaptive ? ga_step_adaptive(s, 1e3) : ga_step(s, 1e-3);
+}
+
+static long count_step_allocations_in(ga_tangent_mode mode, int with_failures, int formulation,
+                                      int adaptive)
 {
     pendulum p = {1.0, 1.0, 9.81};
     double q[2], v[2];
@@ -88,19 +96,28 @@ static long count_step_allocations(ga_tangent_mode mode, int with_failures)
                                       pendulum_jacobian, &p),
                      GA_OK);
     assert_int_equal(ga_set_tangent_mode(s, mode), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    if (adaptive)
+        assert_int_equal(take_step(s, adaptive), GA_OK);
     allocations = 0;
     armed = 1;
     long ok = 0;
     for (int i = 0; i < 200; ++i) {
         fail_force = with_failures && i % 7 == 3 ? (i % 2 ? -1 : 1) : 0;
-        ok += ga_step(s, 1e-3) == GA_OK;
+        ok += take_step(s, adaptive) == GA_OK;
     }
     armed = 0;
     fail_force = 0;
     assert_true(ok >= (with_failures ? 170 : 200));
     ga_free(s);
     return allocations;
+}
+
+static long count_step_allocations(ga_tangent_mode mode, int with_failures)
+{
+    return count_step_allocations_in(mode, with_failures, GA_INDEX3, 0);
 }
 
 static void counting_works(void **state)
@@ -135,10 +152,14 @@ static void no_allocation_in_step(void **state)
     assert_int_equal(count_step_allocations(GA_TANGENT_AUTO, 0), 0);
     assert_int_equal(count_step_allocations(GA_TANGENT_FD, 0), 0);
     assert_int_equal(count_step_allocations(GA_TANGENT_NEGLECT, 0), 0);
+    /* stabilized index 2, and adaptive steps (error estimate, controller, rejections) */
+    assert_int_equal(count_step_allocations_in(GA_TANGENT_AUTO, 0, GA_INDEX2_STABILIZED, 0), 0);
+    assert_int_equal(count_step_allocations_in(GA_TANGENT_AUTO, 0, GA_INDEX3, 1), 0);
+    assert_int_equal(count_step_allocations_in(GA_TANGENT_AUTO, 0, GA_INDEX2_STABILIZED, 1), 0);
 }
 
 /* The sparse path (KLU refactorization, grouped finite differences): no allocation either. */
-static long count_sparse_step_allocations(int exact_tangent)
+static long count_sparse_step_allocations(int exact_tangent, int formulation, int adaptive)
 {
     chain c = chain_make(300);
     const int n = 3 * c.links, m = 2 * c.links;
@@ -152,12 +173,18 @@ static long count_sparse_step_allocations(int exact_tangent)
                      GA_OK);
     if (exact_tangent)
         assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
+    else /* grouped finite differences at every matrix */
+        assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
     assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    if (adaptive)
+        assert_int_equal(take_step(s, adaptive), GA_OK);
     allocations = 0;
     armed = 1;
     for (int i = 0; i < 30; ++i)
-        assert_int_equal(ga_step(s, 1e-3), GA_OK);
+        assert_int_equal(take_step(s, adaptive), GA_OK);
     armed = 0;
     long long factorizations = 0;
     ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &factorizations);
@@ -171,8 +198,11 @@ static long count_sparse_step_allocations(int exact_tangent)
 static void no_allocation_in_sparse_step(void **state)
 {
     (void)state;
-    assert_int_equal(count_sparse_step_allocations(1), 0);
-    assert_int_equal(count_sparse_step_allocations(0), 0);
+    assert_int_equal(count_sparse_step_allocations(1, GA_INDEX3, 0), 0);
+    assert_int_equal(count_sparse_step_allocations(0, GA_INDEX3, 0), 0);
+    assert_int_equal(count_sparse_step_allocations(1, GA_INDEX2_STABILIZED, 0), 0);
+    assert_int_equal(count_sparse_step_allocations(1, GA_INDEX3, 1), 0);
+    assert_int_equal(count_sparse_step_allocations(1, GA_INDEX2_STABILIZED, 1), 0);
 }
 
 static void no_allocation_in_failing_step(void **state)
