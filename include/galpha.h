@@ -30,7 +30,8 @@
  *
  *     ga_create -> ga_set_callbacks -> [ga_set_* options] -> ga_init -> ga_step ... -> ga_free
  *
- * All memory is allocated by ga_create and ga_init; ga_step never allocates.
+ * Memory is allocated by ga_create and ga_init (and by options that need more workspace once
+ * it exists: ga_set_formulation to index 2, the first adaptive step); ga_step never allocates.
  *
  * ## Conventions
  *  - Every function that can fail returns a ::ga_status (0 = GA_OK, negative = error);
