@@ -61,12 +61,12 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const Vec &dq, const
     // Round-off exit: positions no longer move. With q fixed the equations are linear in qdd
     // and lambda, so the iteration after the first such increment has already corrected them.
     const double roundoff = 64.0 * std::numeric_limits<double>::epsilon() * q_norm;
-    const bool at_roundoff = dq_norm <= roundoff;
-    const bool stop = at_roundoff && previous_dq_at_roundoff_;
-    previous_dq_at_roundoff_ = at_roundoff;
+    const bool dq_at_roundoff = dq_norm <= roundoff;
+    const bool stop = dq_at_roundoff && previous_dq_at_roundoff_;
+    previous_dq_at_roundoff_ = dq_at_roundoff;
     if (stop)
         return Verdict::Converged;
-    if (!at_roundoff) {
+    if (!dq_at_roundoff) {
         if (with_matrix_ >= kIterationBudget)
             return Verdict::Slow;
         if (theta >= 1.0)
