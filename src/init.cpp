@@ -1,6 +1,7 @@
 // Consistent initial values (ALGORITHMS.md sec. 3): positions and velocities onto the
 // constraint manifold by minimum-norm corrections, then qdd0 and lambda0 from the
 // saddle-point system with the acceleration-level constraint, and a0 = qdd0 (eq. 3).
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -89,12 +90,14 @@ ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v,
     if (mmax > 0.0 && jmax > 0.0)
         sigma = jmax / mmax;
     count(counters, GA_COUNT_FACTORIZATIONS);
-    if (!S_.factorize_kkt(M_, sigma, J_))
-        return diag.fail(GA_ERR_SINGULAR,
-                         "saddle-point matrix [M Phi_q^T; Phi_q 0] is singular at t = %.17g "
-                         "(rcond = %.3g): redundant constraints, or M singular on the null "
-                         "space of Phi_q",
-                         t, S_.rcond());
+    if (!S_.factorize_kkt(M_, sigma, J_)) {
+        diag.fail(GA_ERR_SINGULAR,
+                  "saddle-point matrix [M Phi_q^T; Phi_q 0] is singular at t = %.17g "
+                  "(rcond = %.3g)",
+                  t, S_.rcond());
+        explain_singular_saddle_point();
+        return GA_ERR_SINGULAR;
+    }
     rq_ = -sigma * f_;
     S_.solve(rq_, c_, qdd, lambda);
     if (m_ > 0)
@@ -103,6 +106,42 @@ ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v,
         return diag.fail(GA_ERR_NONFINITE, "consistent accelerations or multipliers are not "
                          "finite at t = %.17g", t);
     return GA_OK;
+}
+
+// Why [M Phi_q^T; Phi_q 0] is singular, appended to the message: either Phi_q has lower rank
+// than m (redundant constraints: the ones that depend on the others are named, from a
+// column-pivoted QR of Phi_q^T), or M is singular on the null space of Phi_q (a massless
+// coordinate that no constraint fixes). Dense QR, so only for moderate sizes; ga_init only.
+void Solver::explain_singular_saddle_point()
+{
+    constexpr double kMaxEntries = 4e6;
+    if (m_ == 0 || static_cast<double>(n_) * m_ > kMaxEntries) {
+        diag.append(": redundant constraints, or M singular on the null space of Phi_q");
+        return;
+    }
+    Mat Jt = Mat::Zero(n_, m_);
+    if (J_.dense())
+        Jt = J_.as_dense().transpose();
+    else
+        for (int k = 0; k < J_.nnz(); ++k)
+            Jt(J_.col_index()[k], J_.row_index()[k]) += J_.data()[k];
+    const Eigen::ColPivHouseholderQR<Mat> qr(Jt);
+    const int rank = static_cast<int>(qr.rank());
+    if (rank == m_) {
+        diag.append(": Phi_q has full rank %d, so M is singular on the null space of Phi_q (a "
+                    "coordinate without mass that no constraint fixes)",
+                    m_);
+        return;
+    }
+    constexpr int kListed = 8;
+    diag.append(": Phi_q has rank %d < m = %d, redundant constraints; these depend on the "
+                "others:",
+                rank, m_);
+    const auto &pivots = qr.colsPermutation().indices();
+    for (int k = rank; k < m_ && k < rank + kListed; ++k)
+        diag.append(" %d", static_cast<int>(pivots[k]));
+    if (m_ - rank > kListed)
+        diag.append(" ... (%d in all)", m_ - rank);
 }
 
 // Corrected starting values for the first step of size h (ALGORITHMS.md sec. 3.4-3.5):

@@ -125,6 +125,7 @@ private:
     ga_status consistent_accelerations(double t, const Vec &q, const Vec &v, Vec &qdd,
                                        Vec &lambda);
     ga_status starting_values(double h);
+    void explain_singular_saddle_point();
 
     int n_, m_;
     bool initialized_ = false;

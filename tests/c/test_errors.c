@@ -462,6 +462,33 @@ static void singular_saddle_point_matrix_at_init(void **state)
                      GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_SINGULAR);
     expect_message(s, "saddle-point matrix [M Phi_q^T; Phi_q 0] is singular");
+    /* the two rows of Phi_q are equal: rank 1, and the second depends on the first */
+    expect_message(s, "Phi_q has rank 1 < m = 2, redundant constraints; these depend on the "
+                      "others: 1");
+    ga_free(s);
+}
+
+static int massless(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    M[0] = M[1] = M[2] = M[3] = 0.0;
+    return 0;
+}
+
+/* A pendulum bob without mass: Phi_q has full rank, M is zero on its null space. */
+static void massless_coordinate_at_init(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = NULL;
+    double q[2], v[2];
+    pendulum_state(&p, 0.4, 0.0, q, v);
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, massless, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &p),
+                     GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_SINGULAR);
+    expect_message(s, "Phi_q has full rank 1, so M is singular on the null space of Phi_q");
     ga_free(s);
 }
 
@@ -542,6 +569,7 @@ int main(void)
         cmocka_unit_test(inconsistent_start_refused_when_asked),
         cmocka_unit_test(projection_that_cannot_converge),
         cmocka_unit_test(singular_saddle_point_matrix_at_init),
+        cmocka_unit_test(massless_coordinate_at_init),
         cmocka_unit_test(nan_in_initial_values),
         cmocka_unit_test(out_of_memory_is_reported),
         cmocka_unit_test(strerror_names_every_status),
