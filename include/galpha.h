@@ -383,6 +383,31 @@ typedef enum ga_formulation {
  *  chosen after the workspace was set up, and its system does not fit). */
 GA_API ga_status ga_set_formulation(ga_solver *s, int formulation);
 
+/** Redundant constraints: Phi_q of rank r < m, so that only Phi_q^T lambda is unique and the
+ *  saddle-point matrices are singular. */
+typedef enum ga_redundancy {
+    GA_REDUNDANT_REFUSE = 0, /**< (default) ga_init fails with GA_ERR_SINGULAR, and its
+                                  message names the constraints that depend on the others */
+    GA_REDUNDANT_DROP = 1    /**< ga_init (and ga_set_state) deactivates the constraints whose
+                                  gradients depend on those of the constraints before them
+                                  (Gram-Schmidt in index order on Phi_q at the initial
+                                  position, dense, n m <= 4e6): the others carry the whole
+                                  constraint force and a dropped constraint's multiplier is 0
+                                  (a basic solution; order the constraints so that the ones to
+                                  keep come first). A dropped constraint is kept through the
+                                  others and is not enforced on its own: if the redundancy
+                                  changes with the configuration, a later matrix is singular
+                                  and the step fails with GA_ERR_SINGULAR. */
+} ga_redundancy;
+
+/** mode is a ::ga_redundancy. Errors: GA_ERR_ARG, GA_ERR_STATE (after ga_init or
+ *  ga_set_state: the sparse layouts depend on it). */
+GA_API ga_status ga_set_redundant_constraints(ga_solver *s, int mode);
+
+/** The m flags of the constraints in use (1) or dropped as redundant (0). Errors: GA_ERR_ARG,
+ *  GA_ERR_STATE (before ga_init or ga_set_state). */
+GA_API ga_status ga_get_active_constraints(const ga_solver *s, int *active);
+
 /** Rescale the stored a_n to the size of the coming step, a_n <- qdd_n + (h/h_last)(a_n -
  *  qdd_n), when h changes (1, default), or not (0). Without it the method drops to first order
  *  when h changes often (ALGORITHMS.md sec. 1.1); the switch exists to show that.

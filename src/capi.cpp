@@ -311,6 +311,32 @@ GA_API const char *ga_linear_solver_name(const ga_solver *s)
     return s->core.linear_backend();
 }
 
+GA_API ga_status ga_set_redundant_constraints(ga_solver *s, int mode)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (mode != GA_REDUNDANT_REFUSE && mode != GA_REDUNDANT_DROP)
+            return c.diag.fail(GA_ERR_ARG, "unknown redundancy mode %d", mode);
+        if (c.setup_done())
+            return c.diag.fail(GA_ERR_STATE,
+                               "the treatment of redundant constraints is chosen before ga_init");
+        c.redundancy = static_cast<ga_redundancy>(mode);
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_get_active_constraints(const ga_solver *s, int *active)
+{
+    return reading(s, [&](const ga::Solver &c) {
+        if (!active)
+            return GA_ERR_ARG;
+        if (!c.initialized())
+            return GA_ERR_STATE;
+        for (int i = 0; i < c.m(); ++i)
+            active[i] = c.constraint_active(i) ? 1 : 0;
+        return GA_OK;
+    });
+}
+
 GA_API ga_status ga_set_formulation(ga_solver *s, int formulation)
 {
     return guarded(s, [&](ga::Solver &c) {

@@ -1,7 +1,6 @@
 // Consistent initial values (ALGORITHMS.md sec. 3): positions and velocities onto the
 // constraint manifold by minimum-norm corrections, then qdd0 and lambda0 from the
 // saddle-point system with the acceleration-level constraint, and a0 = qdd0 (eq. 3).
-#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -42,6 +41,9 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
     if (!x.q.allFinite() || !x.v.allFinite())
         return diag.fail(GA_ERR_ARG, "q0 or v0 contains NaN or Inf");
 
+    if (redundancy == GA_REDUNDANT_DROP && m_ > 0)
+        if (auto st = select_active_constraints(t0, x.q))
+            return st;
     if (m_ > 0) {
         if (auto st = project_positions(t0, x.q))
             return st;
@@ -108,25 +110,67 @@ ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v,
     return GA_OK;
 }
 
+namespace {
+constexpr double kMaxDenseEntries = 4e6;  // n m: the dense Gram-Schmidt below
+
+// Which constraints depend on the ones before them: Gram-Schmidt in index order on the columns
+// of Phi_q^T (each projected twice against the kept ones, for orthogonality in floating
+// point); a column whose remainder is below 1e-10 of its own norm depends on the kept ones.
+// active[i] = 0 for those; returns the rank.
+int independent_in_order(const ModelMatrix &J, int n, int m, unsigned char *active)
+{
+    constexpr double kDependence = 1e-10;
+    Mat Jt = Mat::Zero(n, m);
+    if (J.dense())
+        Jt = J.as_dense().transpose();
+    else
+        for (int k = 0; k < J.nnz(); ++k)
+            Jt(J.col_index()[k], J.row_index()[k]) += J.data()[k];
+    Mat basis(n, m);
+    int kept = 0;
+    for (int i = 0; i < m; ++i) {
+        Vec r = Jt.col(i);
+        const double norm = r.norm();
+        for (int pass = 0; pass < 2; ++pass)
+            for (int k = 0; k < kept; ++k)
+                r -= basis.col(k).dot(r) * basis.col(k);
+        const double rest = r.norm();
+        active[i] = norm > 0.0 && rest > kDependence * norm;
+        if (active[i])
+            basis.col(kept++) = r / rest;
+    }
+    return kept;
+}
+}  // namespace
+
+// GA_REDUNDANT_DROP: the constraints that depend on the ones before them are dropped.
+ga_status Solver::select_active_constraints(double t, const Vec &q)
+{
+    if (static_cast<double>(n_) * m_ > kMaxDenseEntries)
+        return diag.fail(GA_ERR_ARG,
+                         "dropping redundant constraints takes a dense Gram-Schmidt of Phi_q, "
+                         "and n m = %.0f exceeds %.0f",
+                         static_cast<double>(n_) * m_, kMaxDenseEntries);
+    if (auto st = model.jacobian(t, q, J_))
+        return st;
+    independent_in_order(J_, n_, m_, active_.data());
+    invalidate_jacobian();  // the matrices change with the set of active constraints
+    return GA_OK;
+}
+
 // Why [M Phi_q^T; Phi_q 0] is singular, appended to the message: either Phi_q has lower rank
-// than m (redundant constraints: the ones that depend on the others are named, from a
-// column-pivoted QR of Phi_q^T), or M is singular on the null space of Phi_q (a massless
-// coordinate that no constraint fixes). Dense QR, so only for moderate sizes; ga_init only.
+// than m (redundant constraints: the ones that depend on the constraints before them are
+// named -- those GA_REDUNDANT_DROP would drop), or M is singular on the null space of Phi_q
+// (a massless coordinate that no constraint fixes). Dense, so only for moderate sizes; ga_init
+// only.
 void Solver::explain_singular_saddle_point()
 {
-    constexpr double kMaxEntries = 4e6;
-    if (m_ == 0 || static_cast<double>(n_) * m_ > kMaxEntries) {
+    if (m_ == 0 || static_cast<double>(n_) * m_ > kMaxDenseEntries) {
         diag.append(": redundant constraints, or M singular on the null space of Phi_q");
         return;
     }
-    Mat Jt = Mat::Zero(n_, m_);
-    if (J_.dense())
-        Jt = J_.as_dense().transpose();
-    else
-        for (int k = 0; k < J_.nnz(); ++k)
-            Jt(J_.col_index()[k], J_.row_index()[k]) += J_.data()[k];
-    const Eigen::ColPivHouseholderQR<Mat> qr(Jt);
-    const int rank = static_cast<int>(qr.rank());
+    std::vector<unsigned char> independent(m_);
+    const int rank = independent_in_order(J_, n_, m_, independent.data());
     if (rank == m_) {
         diag.append(": Phi_q has full rank %d, so M is singular on the null space of Phi_q (a "
                     "coordinate without mass that no constraint fixes)",
@@ -134,12 +178,14 @@ void Solver::explain_singular_saddle_point()
         return;
     }
     constexpr int kListed = 8;
-    diag.append(": Phi_q has rank %d < m = %d, redundant constraints; these depend on the "
-                "others:",
+    diag.append(": Phi_q has rank %d < m = %d, redundant constraints (GA_REDUNDANT_DROP "
+                "drops them); these depend on the ones before them:",
                 rank, m_);
-    const auto &pivots = qr.colsPermutation().indices();
-    for (int k = rank; k < m_ && k < rank + kListed; ++k)
-        diag.append(" %d", static_cast<int>(pivots[k]));
+    for (int i = 0, listed = 0; i < m_ && listed < kListed; ++i)
+        if (!independent[i]) {
+            diag.append(" %d", i);
+            ++listed;
+        }
     if (m_ - rank > kListed)
         diag.append(" ... (%d in all)", m_ - rank);
 }

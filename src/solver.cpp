@@ -131,7 +131,9 @@ ga_status Solver::setup()
     lambda_tmp_.setZero(m_);
     model.allocate_workspace(M_, J_, K_, C_);
     sparse_backend_ = sparse && backend;
-    S_.setup(std::move(backend), n_, m_, M_, J_, K_, C_);
+    if (redundancy == GA_REDUNDANT_DROP)
+        active_.assign(m_, 1);
+    S_.setup(std::move(backend), n_, m_, M_, J_, K_, C_, active_ptr());
     workspace_ready_ = true;
     if (formulation == GA_INDEX2_STABILIZED)
         setup_index2();
@@ -143,7 +145,7 @@ ga_status Solver::setup()
 void Solver::setup_index2()
 {
     if (!S2_.ready())
-        S2_.setup(n_, m_, sparse_backend_, M_, J_, K_, C_);
+        S2_.setup(n_, m_, sparse_backend_, M_, J_, K_, C_, active_ptr());
     if (initialized_)
         prefactor_index2();
 }
@@ -166,7 +168,7 @@ void Solver::setup_projection()
 {
     if (m_ > 0 && !P_.ready())
         P_.setup(sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Eigen),
-                 n_, m_, M_, J_, K_, C_);
+                 n_, m_, M_, J_, K_, C_, active_ptr());
 }
 
 ga_status Solver::evaluate_mass(double t, const Vec &q)
@@ -548,6 +550,11 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
         return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
     if (auto st = setup())
         return st;
+    if (redundancy == GA_REDUNDANT_DROP && m_ > 0) {
+        const Vec q = Eigen::Map<const Vec>(buf + kStateHeader, n_);
+        if (auto st = select_active_constraints(buf[4], q))
+            return st;
+    }
     State &s = accepted_;
     s.t = buf[4];
     s.h_last = buf[5];
@@ -559,6 +566,7 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
         *x = Eigen::Map<const Vec>(p, x->size());
         p += x->size();
     }
+
     invalidate_jacobian();
     previous_valid_ = false;
     start_pending_ = false;

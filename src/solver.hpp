@@ -53,6 +53,7 @@ public:
     ga_reuse_mode reuse = GA_REUSE_AUTO;
     ga_linear_solver linear_solver = GA_LINEAR_AUTO;
     ga_formulation formulation = GA_INDEX3;
+    ga_redundancy redundancy = GA_REDUNDANT_REFUSE;
     bool rescale_a = true;
     bool corrected_start = true;
     Control control;
@@ -70,6 +71,8 @@ public:
     const char *linear_backend() const;
 
     bool initialized() const { return initialized_; }
+    // Constraints in use (1) or dropped as redundant (0); all 1 unless GA_REDUNDANT_DROP.
+    bool constraint_active(int i) const { return active_.empty() || active_[i] != 0; }
     const State &state() const { return accepted_; }
 
     ga_status init(double t0, const double *q0, const double *v0);  // init.cpp
@@ -126,8 +129,11 @@ private:
                                        Vec &lambda);
     ga_status starting_values(double h);
     void explain_singular_saddle_point();
+    ga_status select_active_constraints(double t, const Vec &q);
+    const unsigned char *active_ptr() const { return active_.empty() ? nullptr : active_.data(); }
 
     int n_, m_;
+    std::vector<unsigned char> active_;  // GA_REDUNDANT_DROP: constraints in use
     bool initialized_ = false;
     bool workspace_ready_ = false;
     bool sparse_backend_ = false;

@@ -32,6 +32,7 @@ module galpha
   integer(c_int), parameter, public :: GA_LINEAR_AUTO = 0, GA_LINEAR_DENSE = 1, &
        GA_LINEAR_SPARSE = 2, GA_LINEAR_DENSE_LAPACK = 3, GA_LINEAR_DENSE_EIGEN = 4
   integer(c_int), parameter, public :: GA_INDEX3 = 0, GA_INDEX2_STABILIZED = 1
+  integer(c_int), parameter, public :: GA_REDUNDANT_REFUSE = 0, GA_REDUNDANT_DROP = 1
   integer(c_int), parameter, public :: GA_INIT_PROJECT = 0, GA_INIT_REFUSE = 1
   integer(c_int), parameter, public :: GA_COUNT_STEPS = 0, GA_COUNT_FAILED_STEPS = 1, &
        GA_COUNT_NEWTON_ITERS = 2, GA_COUNT_FACTORIZATIONS = 3, GA_COUNT_RESIDUALS = 4, &
@@ -279,6 +280,18 @@ module galpha
        type(c_ptr), value :: s
        integer(c_int), value :: formulation
      end function ga_set_formulation
+     integer(c_int) function ga_set_redundant_constraints(s, mode) &
+          bind(C, name="ga_set_redundant_constraints")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: mode
+     end function ga_set_redundant_constraints
+     integer(c_int) function ga_get_active_constraints(s, active) &
+          bind(C, name="ga_get_active_constraints")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), intent(out) :: active(*)
+     end function ga_get_active_constraints
      integer(c_int) function ga_set_rescale(s, on) bind(C, name="ga_set_rescale")
        import :: c_int, c_ptr
        type(c_ptr), value :: s
@@ -334,7 +347,8 @@ module galpha
        ga_get_h_last, ga_get_q, ga_get_v, ga_get_qdd, ga_get_lambda, ga_get_a, &
        ga_state_size, ga_get_state, ga_set_state, ga_get_counter, ga_reset_counters, ga_get_info, &
        ga_set_jacobian_reuse, ga_set_constant_mass, ga_set_pattern, ga_set_linear_solver, &
-       ga_linear_solver_name, ga_set_formulation, ga_set_rescale, ga_set_corrected_start, &
+       ga_linear_solver_name, ga_set_formulation, ga_set_redundant_constraints, &
+       ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
        ga_interpolate
 
@@ -359,6 +373,8 @@ module galpha
      procedure :: step => solver_step
      procedure :: set_tolerances => solver_set_tolerances
      procedure :: set_formulation => solver_set_formulation
+     procedure :: set_redundant_constraints => solver_set_redundant_constraints
+     procedure :: get_active_constraints => solver_get_active_constraints
      procedure :: advance => solver_advance
      procedure :: t => solver_t
      procedure :: get_q => solver_get_q
@@ -506,6 +522,18 @@ contains
     integer(c_int), intent(in) :: formulation
     status = ga_set_formulation(this%handle, formulation)
   end function solver_set_formulation
+
+  integer(c_int) function solver_set_redundant_constraints(this, mode) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: mode
+    status = ga_set_redundant_constraints(this%handle, mode)
+  end function solver_set_redundant_constraints
+
+  integer(c_int) function solver_get_active_constraints(this, active) result(status)
+    class(galpha_solver), intent(in) :: this
+    integer(c_int), intent(out) :: active(:)
+    status = ga_get_active_constraints(this%handle, active)
+  end function solver_get_active_constraints
 
   integer(c_int) function solver_advance(this, t_out) result(status)
     class(galpha_solver), intent(inout) :: this

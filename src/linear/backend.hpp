@@ -5,6 +5,9 @@
 //         [ Phi_q                0       ]
 // The backend knows the layout of the blocks once (setup), assembles S in place from them
 // (factorize) and solves with the factors (solve). Neither allocates after setup.
+// Constraints can be inactive (redundant ones dropped, see solver.hpp): row and column n + i
+// of an inactive constraint i are replaced by those of the identity, so its multiplier is
+// whatever the right-hand side says (the callers pass 0).
 #pragma once
 
 #include <memory>
@@ -21,14 +24,17 @@ struct SaddleBlocks {
     const ModelMatrix *K = nullptr;  // null: neglected
     double cK = 0.0;
     const ModelMatrix *J = nullptr;
+    const unsigned char *active = nullptr;  // m flags; null: every constraint active
 };
 
 class LinearBackend {
 public:
     virtual ~LinearBackend() = default;
     // Layouts of the blocks (patterns for the sparse backend); allocates everything.
+    // with_inactive: constraints may be made inactive (the sparse pattern needs the diagonal
+    // of the lower-right block then).
     virtual void setup(int n, int m, const ModelMatrix &M, const ModelMatrix &J,
-                       const ModelMatrix &K, const ModelMatrix &C) = 0;
+                       const ModelMatrix &K, const ModelMatrix &C, bool with_inactive) = 0;
     // Assemble and factorize; false if singular or numerically singular.
     virtual bool factorize(const SaddleBlocks &b) = 0;
     virtual void solve(Vec &rhs) = 0;  // in place, length n + m

@@ -39,7 +39,7 @@ public:
     explicit DenseBackend(DenseKind kind) : kind_(kind) {}
 
     void setup(int n, int m, const ModelMatrix &, const ModelMatrix &, const ModelMatrix &,
-               const ModelMatrix &) override
+               const ModelMatrix &, bool) override
     {
         n_ = n;
         m_ = m;
@@ -67,6 +67,12 @@ public:
             add_block(A, b.cK, *b.K);
         if (m_ > 0) {
             add_block(S_.bottomLeftCorner(m_, n_), 1.0, *b.J);
+            if (b.active)
+                for (int i = 0; i < m_; ++i)
+                    if (!b.active[i]) {
+                        S_.row(n_ + i).setZero();
+                        S_(n_ + i, n_ + i) = 1.0;
+                    }
             S_.topRightCorner(n_, m_) = S_.bottomLeftCorner(m_, n_).transpose();
         }
         const int N = n_ + m_;

@@ -40,6 +40,7 @@ struct Index2Matrix::Sparse {
     KluSystem S;
     // slots of each block's entries, in the order of the block's pattern
     std::vector<int> K, M, C, JT, J2, J3, BT, minus_I, plus_I;
+    std::vector<int> J_rows, lambda_diag, eta_diag;  // inactive constraints
     Vec rhs;
 };
 #else
@@ -50,8 +51,9 @@ Index2Matrix::Index2Matrix() = default;
 Index2Matrix::~Index2Matrix() = default;
 
 void Index2Matrix::setup(int n, int m, bool sparse, const ModelMatrix &M, const ModelMatrix &J,
-                         const ModelMatrix &K, const ModelMatrix &C)
+                         const ModelMatrix &K, const ModelMatrix &C, const unsigned char *active)
 {
+    active_ = active;
 #ifdef GALPHA_HAVE_KLU
     if (sparse) {
         auto s = std::make_unique<Sparse>();
@@ -80,6 +82,11 @@ void Index2Matrix::setup(int n, int m, bool sparse, const ModelMatrix &M, const 
             entries.emplace_back(w0 + i, i);       // -I
             entries.emplace_back(w0 + i, w0 + i);  // I
         }
+        if (active)
+            for (int i = 0; i < m; ++i) {
+                entries.emplace_back(l0 + i, l0 + i);
+                entries.emplace_back(e0 + i, e0 + i);
+            }
         s->S.setup(2 * n + 2 * m, std::move(entries));
         auto slots = [&](const ModelMatrix &A, bool transposed, int row0, int col0) {
             std::vector<int> out(A.nnz());
@@ -100,6 +107,13 @@ void Index2Matrix::setup(int n, int m, bool sparse, const ModelMatrix &M, const 
         for (int i = 0; i < n; ++i) {
             s->minus_I.push_back(s->S.slot(w0 + i, i));
             s->plus_I.push_back(s->S.slot(w0 + i, w0 + i));
+        }
+        if (active) {
+            s->J_rows = J.row_index();
+            for (int i = 0; i < m; ++i) {
+                s->lambda_diag.push_back(s->S.slot(l0 + i, l0 + i));
+                s->eta_diag.push_back(s->S.slot(e0 + i, e0 + i));
+            }
         }
         s->rhs.setZero(2 * n + 2 * m);
         sparse_ = std::move(s);
@@ -149,6 +163,14 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
             v[k] -= 1.0;
         for (int k : s.plus_I)
             v[k] += 1.0;
+        if (active_) {
+            for (std::size_t k = 0; k < s.J_rows.size(); ++k)
+                if (!active_[s.J_rows[k]])
+                    v[s.JT[k]] = v[s.BT[k]] = v[s.J2[k]] = v[s.J3[k]] = 0.0;
+            for (int i = 0; i < s.m; ++i)
+                if (!active_[i])
+                    v[s.lambda_diag[i]] = v[s.eta_diag[i]] = 1.0;
+        }
         return s.S.factorize();
     }
 #endif
@@ -171,6 +193,14 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
     d.S.block(0, n, n, m) = Jd.transpose();
     d.S.block(n + m, 0, m, n) = Jd;
     d.S.block(n + m, n + m, m, m).noalias() = Jd * d.Bd.transpose();
+    if (active_)
+        for (int i = 0; i < m; ++i)
+            if (!active_[i])
+                for (const int k : {n + i, n + m + i}) {
+                    d.S.row(k).setZero();
+                    d.S.col(k).setZero();
+                    d.S(k, k) = 1.0;
+                }
     d.lu.compute(d.S);
     const auto U = d.lu.matrixLU().diagonal().cwiseAbs();
     const double umax = U.maxCoeff();
@@ -191,6 +221,10 @@ void Index2Matrix::solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const 
         s.rhs.segment(n, n).setZero();
         s.rhs.segment(2 * n, m) = -phi;
         s.rhs.tail(m) = -(p.beta * h / p.gamma) * phi_v;
+        if (active_)
+            for (int i = 0; i < m; ++i)
+                if (!active_[i])
+                    s.rhs[2 * n + i] = s.rhs[2 * n + m + i] = 0.0;
         s.S.solve(s.rhs.data());
         d = s.rhs.head(n);
         w = s.rhs.segment(n, n);
@@ -204,6 +238,10 @@ void Index2Matrix::solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const 
     x.rhs.head(n) = -bh2 * rq;
     x.rhs.segment(n, m) = -phi;
     x.rhs.tail(m) = -(p.beta * h / p.gamma) * phi_v;
+    if (active_)
+        for (int i = 0; i < m; ++i)
+            if (!active_[i])
+                x.rhs[n + i] = x.rhs[n + m + i] = 0.0;
     x.x.noalias() = x.lu.solve(x.rhs);
     d = x.x.head(n);
     dlambda = x.x.segment(n, m) / bh2;

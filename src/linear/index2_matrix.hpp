@@ -34,10 +34,12 @@ public:
     Index2Matrix();
     ~Index2Matrix();
 
-    // Allocates everything (patterns of M, J, K, C: their layouts; B has J's). Throws
-    // std::bad_alloc.
+    // Allocates everything (patterns of M, J, K, C: their layouts; B has J's). active: m
+    // flags owned by the caller (null: every constraint active); an inactive constraint's
+    // rows and columns (lambda_bar and eta_bar) are those of the identity, its right-hand side
+    // 0. Throws std::bad_alloc.
     void setup(int n, int m, bool sparse, const ModelMatrix &M, const ModelMatrix &J,
-               const ModelMatrix &K, const ModelMatrix &C);
+               const ModelMatrix &K, const ModelMatrix &C, const unsigned char *active);
     bool ready() const { return dense_ || sparse_; }
     bool sparse() const { return sparse_ != nullptr; }
     // false if singular or numerically singular
@@ -53,6 +55,7 @@ public:
 private:
     struct Dense;
     struct Sparse;
+    const unsigned char *active_ = nullptr;
     std::unique_ptr<Dense> dense_;
     std::unique_ptr<Sparse> sparse_;
 };

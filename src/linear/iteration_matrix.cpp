@@ -4,12 +4,13 @@ namespace ga {
 
 void IterationMatrix::setup(std::unique_ptr<LinearBackend> backend, int n, int m,
                             const ModelMatrix &M, const ModelMatrix &J, const ModelMatrix &K,
-                            const ModelMatrix &C)
+                            const ModelMatrix &C, const unsigned char *active)
 {
     n_ = n;
     m_ = m;
+    active_ = active;
     rhs_.setZero(n + m);
-    backend->setup(n, m, M, J, K, C);
+    backend->setup(n, m, M, J, K, C, active != nullptr);
     backend_ = std::move(backend);
 }
 
@@ -22,6 +23,7 @@ bool IterationMatrix::factorize_step(const ModelMatrix &M, const ModelMatrix *C,
     b.C = C;
     b.K = K;
     b.J = &J;
+    b.active = active_;
     if (scaled) {
         // D_L S_t D_R with D_L = diag(beta h^2 I, I), D_R = diag(I, I/(beta h^2)) (eq. 10):
         // the first block row is multiplied by beta h^2, the Phi_q^T block by
@@ -44,6 +46,7 @@ bool IterationMatrix::factorize_kkt(const ModelMatrix &M, double sigma, const Mo
     b.M = &M;
     b.cM = sigma;
     b.J = &J;
+    b.active = active_;
     return backend_->factorize(b);
 }
 
@@ -51,14 +54,20 @@ bool IterationMatrix::factorize_projection(const ModelMatrix &J)
 {
     SaddleBlocks b;  // M = null: identity
     b.J = &J;
+    b.active = active_;
     return backend_->factorize(b);
 }
 
 void IterationMatrix::solve(const Vec &r1, const Vec &r2, Vec &x1, Vec &x2, double row_scale)
 {
     rhs_.head(n_) = -row_scale * r1;  // D_L r
-    if (m_ > 0)
+    if (m_ > 0) {
         rhs_.tail(m_) = -r2;
+        if (active_)
+            for (int i = 0; i < m_; ++i)
+                if (!active_[i])
+                    rhs_[n_ + i] = 0.0;
+    }
     backend_->solve(rhs_);
     x1 = rhs_.head(n_);
     if (m_ > 0)

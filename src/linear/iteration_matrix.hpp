@@ -12,8 +12,11 @@ namespace ga {
 
 class IterationMatrix {
 public:
+    // active: m flags owned by the caller, fixed for the life of the matrix (null: no
+    // constraint is ever inactive).
     void setup(std::unique_ptr<LinearBackend> backend, int n, int m, const ModelMatrix &M,
-               const ModelMatrix &J, const ModelMatrix &K, const ModelMatrix &C);
+               const ModelMatrix &J, const ModelMatrix &K, const ModelMatrix &C,
+               const unsigned char *active = nullptr);
     bool ready() const { return backend_ != nullptr; }
     const char *backend_name() const { return backend_ ? backend_->name() : "none"; }
 
@@ -25,7 +28,8 @@ public:
     // [I, Phi_q^T; Phi_q, 0]: minimum-norm corrections.
     bool factorize_projection(const ModelMatrix &J);
 
-    // Solves S [x1; x2] = -[r1; r2]. For the scaled step matrix this is eq. (9):
+    // Solves S [x1; x2] = -[r1; r2] (r2 of inactive constraints taken as 0, so their x2 is 0).
+    // For the scaled step matrix this is eq. (9):
     // S_bar x_bar = -D_L r, x = D_R x_bar, i.e. x1 = dq and x2 = dlambda in natural units.
     // row_scale is beta h^2 of the step being solved (the factorization may be older).
     void solve(const Vec &r1, const Vec &r2, Vec &x1, Vec &x2, double row_scale = 1.0);
@@ -35,6 +39,7 @@ public:
 private:
     int n_ = 0, m_ = 0;
     std::unique_ptr<LinearBackend> backend_;
+    const unsigned char *active_ = nullptr;
     Vec rhs_;
 };
 

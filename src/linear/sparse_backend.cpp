@@ -17,7 +17,7 @@ namespace {
 class SparseBackend final : public LinearBackend {
 public:
     void setup(int n, int m, const ModelMatrix &M, const ModelMatrix &J, const ModelMatrix &K,
-               const ModelMatrix &C) override
+               const ModelMatrix &C, bool with_inactive) override
     {
         n_ = n;
         m_ = m;
@@ -36,7 +36,11 @@ public:
             entries.emplace_back(n + J.row_index()[k], J.col_index()[k]);  // Phi_q
             entries.emplace_back(J.col_index()[k], n + J.row_index()[k]);  // Phi_q^T
         }
+        if (with_inactive)
+            for (int i = 0; i < m; ++i)
+                entries.emplace_back(n + i, n + i);
         S_.setup(n + m, std::move(entries));
+        J_rows_ = J.row_index();
         auto map = [&](const ModelMatrix &A, bool phi_q_transposed, int row0) {
             std::vector<int> out(A.nnz());
             for (int k = 0; k < A.nnz(); ++k) {
@@ -53,6 +57,10 @@ public:
         diag_.resize(n);
         for (int i = 0; i < n; ++i)
             diag_[i] = S_.slot(i, i);
+        lower_diag_.clear();
+        if (with_inactive)
+            for (int i = 0; i < m; ++i)
+                lower_diag_.push_back(S_.slot(n + i, n + i));
     }
 
     bool factorize(const SaddleBlocks &b) override
@@ -76,6 +84,14 @@ public:
         if (m_ > 0) {
             scatter(*b.J, map_J_, 1.0);
             scatter(*b.J, map_JT_, 1.0);
+            if (b.active && !lower_diag_.empty()) {
+                for (std::size_t k = 0; k < map_J_.size(); ++k)
+                    if (!b.active[J_rows_[k]])
+                        values[map_J_[k]] = values[map_JT_[k]] = 0.0;
+                for (int i = 0; i < m_; ++i)
+                    if (!b.active[i])
+                        values[lower_diag_[i]] = 1.0;
+            }
         }
         return S_.factorize();
     }
@@ -88,7 +104,8 @@ public:
 private:
     int n_ = 0, m_ = 0;
     KluSystem S_;
-    std::vector<int> map_M_, map_K_, map_C_, map_J_, map_JT_, diag_;
+    std::vector<int> map_M_, map_K_, map_C_, map_J_, map_JT_, diag_, lower_diag_;
+    std::vector<int> J_rows_;  // row of each Phi_q entry
 };
 
 }  // namespace

@@ -463,8 +463,8 @@ static void singular_saddle_point_matrix_at_init(void **state)
     assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_SINGULAR);
     expect_message(s, "saddle-point matrix [M Phi_q^T; Phi_q 0] is singular");
     /* the two rows of Phi_q are equal: rank 1, and the second depends on the first */
-    expect_message(s, "Phi_q has rank 1 < m = 2, redundant constraints; these depend on the "
-                      "others: 1");
+    expect_message(s, "Phi_q has rank 1 < m = 2, redundant constraints (GA_REDUNDANT_DROP drops "
+                      "them); these depend on the ones before them: 1");
     ga_free(s);
 }
 

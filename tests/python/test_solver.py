@@ -210,3 +210,29 @@ def test_fortran_module_declares_every_c_function():
     fortran = open(os.path.join(root, "bindings", "fortran", "galpha.f90")).read()
     bound = set(re.findall(r'bind\(C, name="(ga_\w+)"\)', fortran))
     assert declared - bound == set()
+
+
+def test_redundant_constraint_dropped():
+    """The pendulum constraint twice: refused by default, dropped on request; the motion and
+    the constraint force are those of the pendulum with the constraint once."""
+    def twice(t, q, phi):
+        phi[:] = 0.5 * (q @ q - 1.0)
+
+    def twice_jacobian(t, q, J):
+        J[0, :] = q
+        J[1, :] = q
+
+    with galpha.Solver(2, 2, mass, force, twice, twice_jacobian) as s:
+        with pytest.raises(galpha.SingularMatrixError, match="depend on the ones before them: 1"):
+            s.init(0.0, Q0, V0)
+    with galpha.Solver(2, 2, mass, force, twice, twice_jacobian,
+                       redundant=galpha.GA_REDUNDANT_DROP) as s, pendulum() as one:
+        s.init(0.0, Q0, V0)
+        one.init(0.0, Q0, V0)
+        for _ in range(200):
+            s.step(1e-3)
+            one.step(1e-3)
+        assert list(s.active_constraints) == [True, False]
+        assert np.max(np.abs(s.q - one.q)) < 1e-12
+        assert s.lam[0] == pytest.approx(one.lam[0], rel=1e-9)
+        assert s.lam[1] == 0.0

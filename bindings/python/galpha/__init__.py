@@ -16,6 +16,7 @@ from ._ffi import (GA_INDEX2_STABILIZED, GA_INDEX3, GA_INFO_ERROR_ESTIMATE,  # n
                    GA_LINEAR_DENSE_EIGEN, GA_LINEAR_DENSE_LAPACK, GA_LINEAR_SPARSE,
                    GA_MATRIX_DAMPING, GA_MATRIX_JACOBIAN, GA_MATRIX_MASS, GA_MATRIX_STIFFNESS,
                    GA_PREDICTOR_CONSTANT_A, GA_PREDICTOR_EXTRAPOLATE, GA_PREDICTOR_ZERO,
+                   GA_REDUNDANT_DROP, GA_REDUNDANT_REFUSE,
                    GA_REUSE_AUTO, GA_REUSE_NEVER, GA_TANGENT_AUTO, GA_TANGENT_FD,
                    GA_TANGENT_NEGLECT)
 from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceError,  # noqa: F401

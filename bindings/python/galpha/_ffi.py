@@ -106,6 +106,7 @@ GA_MATRIX_MASS, GA_MATRIX_JACOBIAN, GA_MATRIX_STIFFNESS, GA_MATRIX_DAMPING = 0, 
 (GA_LINEAR_AUTO, GA_LINEAR_DENSE, GA_LINEAR_SPARSE, GA_LINEAR_DENSE_LAPACK,
  GA_LINEAR_DENSE_EIGEN) = 0, 1, 2, 3, 4
 GA_INDEX3, GA_INDEX2_STABILIZED = 0, 1
+GA_REDUNDANT_REFUSE, GA_REDUNDANT_DROP = 0, 1
 GA_INIT_PROJECT, GA_INIT_REFUSE = 0, 1
 (GA_INFO_RCOND, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_ERROR_ESTIMATE,
  GA_INFO_H_NEXT) = 0, 1, 2, 3, 4
@@ -158,6 +159,8 @@ _SIGNATURES = {
     "ga_set_linear_solver": (_I, [_S, _I]),
     "ga_linear_solver_name": (ctypes.c_char_p, [_S]),
     "ga_set_formulation": (_I, [_S, _I]),
+    "ga_set_redundant_constraints": (_I, [_S, _I]),
+    "ga_get_active_constraints": (_I, [_S, _P(_I)]),
     "ga_set_rescale": (_I, [_S, _I]),
     "ga_set_corrected_start": (_I, [_S, _I]),
     "ga_set_tolerances": (_I, [_S, _D, _D]),

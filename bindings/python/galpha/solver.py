@@ -45,7 +45,7 @@ class Solver:
     stiffness(t, q, v, qdd, lam, K), damping(t, q, v, C), constraint_accel(t, q, v, out)
         Optional exact tangents and constraint acceleration term (finite differences
         otherwise).
-    rho_inf, params, newton, tangent_mode, scaling, predictor, init_mode, formulation,
+    rho_inf, params, newton, tangent_mode, scaling, predictor, init_mode, formulation, redundant,
     tolerances, reuse, constant_mass, linear_solver, rescale, corrected_start, step_limits
         Options, as the C setters (ga_set_rho_inf, ga_set_params((alpha_m, alpha_f, beta,
         gamma)), ga_set_newton((tol, max_iter)), ga_set_tolerances((rtol, atol)),
@@ -59,7 +59,7 @@ class Solver:
     def __init__(self, n, m, mass, force=None, constraint=None, jacobian=None, *,
                  stiffness=None, damping=None, constraint_accel=None, rho_inf=None,
                  params=None, newton=None, tangent_mode=None, scaling=None, predictor=None,
-                 init_mode=None, formulation=None, tolerances=None, reuse=None,
+                 init_mode=None, formulation=None, redundant=None, tolerances=None, reuse=None,
                  constant_mass=None, linear_solver=None, rescale=None, corrected_start=None,
                  step_limits=None):
         self._ptr = None
@@ -130,7 +130,8 @@ class Solver:
         if init_mode is not None:
             self._check(_ffi.ga_set_init_mode(self._ptr, int(init_mode[0]), float(init_mode[1])))
         for value, setter in ((formulation, _ffi.ga_set_formulation), (reuse, _ffi.ga_set_jacobian_reuse),
-                              (linear_solver, _ffi.ga_set_linear_solver)):
+                              (linear_solver, _ffi.ga_set_linear_solver),
+                              (redundant, _ffi.ga_set_redundant_constraints)):
             if value is not None:
                 self._check(setter(self._ptr, int(value)))
         for value, setter in ((constant_mass, _ffi.ga_set_constant_mass), (rescale, _ffi.ga_set_rescale),
@@ -247,6 +248,13 @@ class Solver:
     @property
     def linear_solver_name(self):
         return _ffi.ga_linear_solver_name(self._handle()).decode()
+
+    @property
+    def active_constraints(self):
+        """Flags of the constraints in use (True) or dropped as redundant (False)."""
+        flags = (ctypes.c_int * max(self.m, 1))()
+        self._check(_ffi.ga_get_active_constraints(self._handle(), flags))
+        return np.array([bool(x) for x in flags[:self.m]], dtype=bool)
 
     # ---- state ------------------------------------------------------------------------------
     @property
