@@ -205,6 +205,46 @@ static void no_allocation_in_sparse_step(void **state)
     assert_int_equal(count_sparse_step_allocations(1, GA_INDEX2_STABILIZED, 1), 0);
 }
 
+/* Redundant constraints dropped (GA_REDUNDANT_DROP): the pendulum's constraint twice. */
+static int twice_constraint(double t, const double *q, double *phi, void *u)
+{
+    pendulum_constraint(t, q, phi, u);
+    phi[1] = phi[0];
+    return 0;
+}
+static int twice_jacobian(double t, const double *q, double *J, void *u)
+{
+    (void)t, (void)u;
+    J[0] = J[1] = q[0]; /* 2 x 2 column-major: both rows (x, y) */
+    J[2] = J[3] = q[1];
+    return 0;
+}
+
+static void no_allocation_with_dropped_constraints(void **state)
+{
+    (void)state;
+    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+        pendulum p = {1.0, 1.0, 9.81};
+        double q[2], v[2];
+        ga_solver *s = NULL;
+        pendulum_state(&p, 1.0, 0.5, q, v);
+        assert_int_equal(ga_create(2, 2, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, twice_constraint,
+                                          twice_jacobian, &p),
+                         GA_OK);
+        assert_int_equal(ga_set_redundant_constraints(s, GA_REDUNDANT_DROP), GA_OK);
+        assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        allocations = 0;
+        armed = 1;
+        for (int i = 0; i < 100; ++i)
+            assert_int_equal(ga_step(s, 1e-3), GA_OK);
+        armed = 0;
+        assert_int_equal(allocations, 0);
+        ga_free(s);
+    }
+}
+
 static void no_allocation_in_failing_step(void **state)
 {
     (void)state;
@@ -219,6 +259,7 @@ int main(void)
         cmocka_unit_test(no_allocation_in_step),
         cmocka_unit_test(no_allocation_in_failing_step),
         cmocka_unit_test(no_allocation_in_sparse_step),
+        cmocka_unit_test(no_allocation_with_dropped_constraints),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
