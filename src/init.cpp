@@ -171,6 +171,12 @@ void Solver::explain_singular_saddle_point()
     }
     std::vector<unsigned char> independent(m_);
     const int rank = independent_in_order(J_, n_, m_, independent.data());
+    if (redundancy == GA_REDUNDANT_DROP) {  // the dependent ones are out of the matrix already
+        diag.append(": with the %d redundant constraints dropped, M is singular on the null "
+                    "space of Phi_q (a coordinate without mass that no constraint fixes)",
+                    m_ - rank);
+        return;
+    }
     if (rank == m_) {
         diag.append(": Phi_q has full rank %d, so M is singular on the null space of Phi_q (a "
                     "coordinate without mass that no constraint fixes)",

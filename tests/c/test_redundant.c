@@ -269,6 +269,13 @@ static void checkpoint_restarts_bit_identically(void **state)
     ga_free(b);
 }
 
+static int massless(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    M[0] = M[1] = M[2] = M[3] = 0.0;
+    return 0;
+}
+
 static void errors(void **state)
 {
     (void)state;
@@ -296,6 +303,16 @@ static void errors(void **state)
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     assert_int_equal(ga_get_active_constraints(s, NULL), GA_ERR_ARG);
     assert_int_equal(ga_get_active_constraints(NULL, active), GA_ERR_ARG);
+    ga_free(s);
+    /* dropped, and still singular: a bob without mass */
+    assert_int_equal(ga_create(2, 2, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, massless, pendulum_force, twice_constraint,
+                                      twice_jacobian, &P),
+                     GA_OK);
+    assert_int_equal(ga_set_redundant_constraints(s, GA_REDUNDANT_DROP), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_SINGULAR);
+    assert_non_null(strstr(ga_last_error(s), "with the 1 redundant constraints dropped, M is "
+                                             "singular on the null space of Phi_q"));
     ga_free(s);
 }
 
