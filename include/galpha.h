@@ -390,8 +390,9 @@ typedef enum ga_redundancy {
                                   message names the constraints that depend on the others */
     GA_REDUNDANT_DROP = 1    /**< ga_init (and ga_set_state) deactivates the constraints whose
                                   gradients depend on those of the constraints before them
-                                  (Gram-Schmidt in index order on Phi_q at the initial
-                                  position, dense, n m <= 4e6): the others carry the whole
+                                  (in index order, on Phi_q at the initial position: a dense
+                                  Gram-Schmidt for a dense Phi_q, n m <= 4e6; a sparse QR,
+                                  SuiteSparseQR, for a declared pattern): the others carry the whole
                                   constraint force and a dropped constraint's multiplier is 0
                                   (a basic solution; order the constraints so that the ones to
                                   keep come first). A dropped constraint is kept through the
@@ -474,8 +475,9 @@ typedef enum ga_init_mode {
     GA_INIT_REFUSE = 1   /**< refuse inconsistent q0, v0 with GA_ERR_INCONSISTENT */
 } ga_init_mode;
 
-/** What ga_init does with inconsistent q0, v0 (mode is a ::ga_init_mode), and the tolerance init_tol (> 0, default 1e-10,
- *  in the units of Phi and of Phi_q v) beyond which they count as inconsistent. Projection
+/** What ga_init does with inconsistent q0, v0 (mode is a ::ga_init_mode), and the tolerance
+ *  init_tol (> 0, default 1e-10, in the units of Phi and of Phi_q v) beyond which they count as
+ *  inconsistent. Projection
  *  iterates to round-off, well below init_tol. Errors: GA_ERR_ARG, GA_ERR_STATE. */
 GA_API ga_status ga_set_init_mode(ga_solver *s, int mode, double init_tol);
 /**@}*/

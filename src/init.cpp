@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "redundancy.hpp"
 #include "solver.hpp"
 
 namespace ga {
@@ -110,50 +111,18 @@ ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v,
     return GA_OK;
 }
 
-namespace {
-constexpr double kMaxDenseEntries = 4e6;  // n m: the dense Gram-Schmidt below
-
-// Which constraints depend on the ones before them: Gram-Schmidt in index order on the columns
-// of Phi_q^T (each projected twice against the kept ones, for orthogonality in floating
-// point); a column whose remainder is below 1e-10 of its own norm depends on the kept ones.
-// active[i] = 0 for those; returns the rank.
-int independent_in_order(const ModelMatrix &J, int n, int m, unsigned char *active)
-{
-    constexpr double kDependence = 1e-10;
-    Mat Jt = Mat::Zero(n, m);
-    if (J.dense())
-        Jt = J.as_dense().transpose();
-    else
-        for (int k = 0; k < J.nnz(); ++k)
-            Jt(J.col_index()[k], J.row_index()[k]) += J.data()[k];
-    Mat basis(n, m);
-    int kept = 0;
-    for (int i = 0; i < m; ++i) {
-        Vec r = Jt.col(i);
-        const double norm = r.norm();
-        for (int pass = 0; pass < 2; ++pass)
-            for (int k = 0; k < kept; ++k)
-                r -= basis.col(k).dot(r) * basis.col(k);
-        const double rest = r.norm();
-        active[i] = norm > 0.0 && rest > kDependence * norm;
-        if (active[i])
-            basis.col(kept++) = r / rest;
-    }
-    return kept;
-}
-}  // namespace
-
-// GA_REDUNDANT_DROP: the constraints that depend on the ones before them are dropped.
+// GA_REDUNDANT_DROP: the constraints that depend on the ones before them are dropped
+// (redundancy.hpp).
 ga_status Solver::select_active_constraints(double t, const Vec &q)
 {
-    if (static_cast<double>(n_) * m_ > kMaxDenseEntries)
-        return diag.fail(GA_ERR_ARG,
-                         "dropping redundant constraints takes a dense Gram-Schmidt of Phi_q, "
-                         "and n m = %.0f exceeds %.0f",
-                         static_cast<double>(n_) * m_, kMaxDenseEntries);
     if (auto st = model.jacobian(t, q, J_))
         return st;
-    independent_in_order(J_, n_, m_, active_.data());
+    if (independent_in_order(J_, n_, m_, active_.data()) < 0)
+        return diag.fail(GA_ERR_ARG,
+                         "dropping redundant constraints of a dense Phi_q takes a dense "
+                         "Gram-Schmidt, and n m = %.0f is too large for it (declare the "
+                         "pattern of Phi_q)",
+                         static_cast<double>(n_) * m_);
     invalidate_jacobian();  // the matrices change with the set of active constraints
     return GA_OK;
 }
@@ -161,16 +130,15 @@ ga_status Solver::select_active_constraints(double t, const Vec &q)
 // Why [M Phi_q^T; Phi_q 0] is singular, appended to the message: either Phi_q has lower rank
 // than m (redundant constraints: the ones that depend on the constraints before them are
 // named -- those GA_REDUNDANT_DROP would drop), or M is singular on the null space of Phi_q
-// (a massless coordinate that no constraint fixes). Dense, so only for moderate sizes; ga_init
-// only.
+// (a massless coordinate that no constraint fixes). ga_init only (it allocates).
 void Solver::explain_singular_saddle_point()
 {
-    if (m_ == 0 || static_cast<double>(n_) * m_ > kMaxDenseEntries) {
+    std::vector<unsigned char> independent(m_);
+    const int rank = m_ > 0 ? independent_in_order(J_, n_, m_, independent.data()) : -1;
+    if (rank < 0) {
         diag.append(": redundant constraints, or M singular on the null space of Phi_q");
         return;
     }
-    std::vector<unsigned char> independent(m_);
-    const int rank = independent_in_order(J_, n_, m_, independent.data());
     if (redundancy == GA_REDUNDANT_DROP) {  // the dependent ones are out of the matrix already
         diag.append(": with the %d redundant constraints dropped, M is singular on the null "
                     "space of Phi_q (a coordinate without mass that no constraint fixes)",

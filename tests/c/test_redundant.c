@@ -230,6 +230,42 @@ static void chain_sparse(void **state)
     }
 }
 
+/* Beyond the size of a dense Gram-Schmidt (n m = 6e6): the pattern's sparse QR finds the copy;
+ * without dropping it, the message names it. */
+static void large_sparse_chain(void **state)
+{
+    (void)state;
+    enum { L = 1000, N = 3 * L, M = 2 * L };
+    double *q = malloc(sizeof(double) * N), *l = malloc(sizeof(double) * (M + 1));
+    int *active = malloc(sizeof(int) * (M + 1));
+    run_chain(L, 1, GA_INDEX3, q, l, active);
+    int dropped = 0;
+    for (int i = 0; i <= M; ++i)
+        dropped += !active[i];
+    assert_int_equal(dropped, 1);
+    assert_int_equal(active[M], 0);
+    /* refused by default, the copy named */
+    chain2 c2;
+    c2.c = chain_make(L);
+    double *v = malloc(sizeof(double) * N);
+    ga_solver *s = NULL;
+    chain_initial(&c2.c, q, v);
+    assert_int_equal(ga_create(N, M + 1, &s), GA_OK);
+    assert_int_equal(chain2_declare(&c2, s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain2_constraint,
+                                      chain2_jacobian, &c2),
+                     GA_OK);
+    assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_SINGULAR);
+    printf("  %.150s...\n", ga_last_error(s));
+    assert_non_null(strstr(ga_last_error(s), "these depend on the ones before them: 2000"));
+    ga_free(s);
+    free(q);
+    free(l);
+    free(v);
+    free(active);
+}
+
 /* A checkpoint restarts bit-identically: the dropped set is chosen again from the restored
  * positions, and it is the same. */
 static void checkpoint_restarts_bit_identically(void **state)
@@ -323,6 +359,7 @@ int main(void)
         cmocka_unit_test(pendulum_index2_fixed),
         cmocka_unit_test(pendulum_adaptive),
         cmocka_unit_test(chain_sparse),
+        cmocka_unit_test(large_sparse_chain),
         cmocka_unit_test(checkpoint_restarts_bit_identically),
         cmocka_unit_test(errors),
     };
