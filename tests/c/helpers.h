@@ -51,6 +51,21 @@ static inline pendulum_exact pendulum_reference(const pendulum *p, double theta0
     return r;
 }
 
+/* The pendulum with its constraint twice (m = 2, Phi_q of rank 1): redundant constraints. */
+static inline int pendulum_twice_constraint(double t, const double *q, double *phi, void *u)
+{
+    pendulum_constraint(t, q, phi, u);
+    phi[1] = phi[0];
+    return 0;
+}
+static inline int pendulum_twice_jacobian(double t, const double *q, double *J, void *u)
+{
+    (void)t, (void)u;
+    J[0] = J[1] = q[0]; /* 2 x 2 column-major: both rows (x, y) */
+    J[2] = J[3] = q[1];
+    return 0;
+}
+
 static inline double max_abs_diff(const double *a, const double *b, int n)
 {
     double d = 0.0;
