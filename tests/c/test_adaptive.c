@@ -163,6 +163,21 @@ static void without_rescaling_alternating_steps_lose_an_order(void **state)
     assert_true(err[0][K - 1] > 2.0 * err[1][K - 1]);
 }
 
+/* The largest |lambda - exact lambda| over `steps` steps of size h from the solver's state
+ * (the exact pendulum e advanced along). */
+static double max_lambda_error(ga_solver *s, exact_pendulum *e, double h, long steps)
+{
+    double worst = 0.0, t, lambda;
+    for (long k = 0; k < steps; ++k) {
+        assert_int_equal(ga_step(s, h), GA_OK);
+        ga_get_t(s, &t);
+        ga_get_lambda(s, &lambda);
+        exact_advance(e, t);
+        worst = fmax(worst, fabs(lambda - exact_lambda(e)));
+    }
+    return worst;
+}
+
 /* ---- multipliers across a step change (ALGORITHMS.md 1.4) ------------------------------------ */
 static double lambda_error_after_change(int formulation, double h)
 {
@@ -172,14 +187,7 @@ static double lambda_error_after_change(int formulation, double h)
     const long n1 = lround(0.5 / h), n2 = lround(0.1 / (2 * h));
     for (long k = 0; k < n1; ++k)
         assert_int_equal(ga_step(s, h), GA_OK);
-    double worst = 0.0, t, lambda;
-    for (long k = 0; k < n2; ++k) {
-        assert_int_equal(ga_step(s, 2 * h), GA_OK);
-        ga_get_t(s, &t);
-        ga_get_lambda(s, &lambda);
-        exact_advance(&e, t);
-        worst = fmax(worst, fabs(lambda - exact_lambda(&e)));
-    }
+    const double worst = max_lambda_error(s, &e, 2 * h, n2);
     ga_free(s);
     return worst;
 }
@@ -207,14 +215,7 @@ static double startup_lambda_error(int corrected, double h)
 {
     ga_solver *s = pendulum_solver(0.9, GA_INDEX3, 1, corrected);
     exact_pendulum e = {0.0, TH0, OM0};
-    double worst = 0.0, t, lambda;
-    for (long k = 0; k < lround(0.1 / h); ++k) {
-        assert_int_equal(ga_step(s, h), GA_OK);
-        ga_get_t(s, &t);
-        ga_get_lambda(s, &lambda);
-        exact_advance(&e, t);
-        worst = fmax(worst, fabs(lambda - exact_lambda(&e)));
-    }
+    const double worst = max_lambda_error(s, &e, h, lround(0.1 / h));
     ga_free(s);
     return worst;
 }
