@@ -1,8 +1,12 @@
-// Dense LU by Eigen against LAPACK's dgetrf/dgetrs, and both against the sparse KLU path, on
-// real iteration matrices: those of the paper's scenes (dense) and of the N-link chain (dense
-// and sparse, from the same declared pattern). Factorization includes the assembly of S_t from
-// its blocks, as in a step. CSV on stdout; scripts/bench.sh turns it into a chart.
+// The dense LUs (Eigen's blocked PartialPivLU, LAPACK's dgetrf/dgetrs, galpha's unblocked
+// kernel) against each other and against the sparse KLU path, on real iteration matrices:
+// those of the paper's scenes (dense) and of the N-link chain (dense and sparse, from the same
+// declared pattern); and, for the other end of the range, saddle-point matrices without zeros
+// (full mass matrix, full constraint Jacobian: "full"), where blocking pays. Factorization
+// includes the assembly of S_t from its blocks, as in a step. CSV on stdout; scripts/bench.sh
+// turns it into a chart.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <string>
@@ -39,6 +43,27 @@ Blocks dense_blocks(int n, int m, ga_mass_fn mass, ga_jacobian_fn jac, void *use
         A->allocate();
     mass(0.0, q, b.M.data(), user);
     jac(0.0, q, b.J.data(), user);
+    return b;
+}
+
+// A saddle-point system without zero entries but its m x m block: M = I + 0.05 (1 1^T), a full
+// Jacobian with m = n / 2.
+Blocks full_blocks(int n)
+{
+    Blocks b;
+    b.n = n;
+    b.m = n / 2;
+    b.M.set_dense(n, n);
+    b.J.set_dense(b.m, n);
+    b.K.set_dense(n, n);
+    b.C.set_dense(n, n);
+    for (auto *A : {&b.M, &b.J, &b.K, &b.C})
+        A->allocate();
+    b.M.as_dense().setConstant(0.05);
+    b.M.as_dense().diagonal().array() += 1.0;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < b.m; ++i)
+            b.J.as_dense()(i, j) = std::cos(1.0 + 0.7 * i + 1.3 * j) + (i == j ? 2.0 : 0.0);
     return b;
 }
 
@@ -171,12 +196,20 @@ int main()
     for (auto &s : scenes) {
         measure(s.name, s.b, "eigen", ga::make_dense_backend(ga::DenseKind::Eigen));
         measure(s.name, s.b, "lapack", ga::make_dense_backend(ga::DenseKind::Lapack));
+        measure(s.name, s.b, "unblocked", ga::make_dense_backend(ga::DenseKind::Unblocked));
+    }
+    for (int n : {8, 16, 24, 32, 48, 64, 96, 128}) {
+        Blocks full = full_blocks(n);
+        measure("full", full, "eigen", ga::make_dense_backend(ga::DenseKind::Eigen));
+        measure("full", full, "lapack", ga::make_dense_backend(ga::DenseKind::Lapack));
+        measure("full", full, "unblocked", ga::make_dense_backend(ga::DenseKind::Unblocked));
     }
     for (int links : {2, 4, 8, 16, 32, 64, 128, 256}) {
         const chain c = chain_make(links);
         Blocks dense = chain_blocks(c, false), sparse = chain_blocks(c, true);
         measure("chain", dense, "eigen", ga::make_dense_backend(ga::DenseKind::Eigen));
         measure("chain", dense, "lapack", ga::make_dense_backend(ga::DenseKind::Lapack));
+        measure("chain", dense, "unblocked", ga::make_dense_backend(ga::DenseKind::Unblocked));
         measure("chain", sparse, "klu", ga::make_sparse_backend());
         measure_eigen_sparse(sparse);
     }

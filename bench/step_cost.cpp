@@ -186,7 +186,8 @@ int main(int argc, char **argv)
                     "us_per_step,limit_us,ratio\n");
         for (const Scene &sc : paper_scenes()) {
             const bool sparse = sc.declare != nullptr;
-            for (int solver : {GA_LINEAR_DENSE_EIGEN, GA_LINEAR_DENSE_LAPACK, GA_LINEAR_SPARSE}) {
+            for (int solver : {GA_LINEAR_DENSE, GA_LINEAR_DENSE_EIGEN, GA_LINEAR_DENSE_LAPACK,
+                               GA_LINEAR_SPARSE}) {
                 if (sparse != (solver == GA_LINEAR_SPARSE))
                     continue;
                 const Result r = measure(sc, solver, tol, 7);

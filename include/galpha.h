@@ -345,18 +345,22 @@ GA_API ga_status ga_set_pattern(ga_solver *s, int which, int nnz, const int *row
 typedef enum ga_linear_solver {
     GA_LINEAR_AUTO = 0,         /**< sparse when the patterns allow it and n + m >= 10, dense
                                      otherwise (default; measured in bench/linear_algebra) */
-    GA_LINEAR_DENSE = 1,        /**< dense LU: Eigen's, faster than reference LAPACK's at every
-                                     size measured */
+    GA_LINEAR_DENSE = 1,        /**< dense LU, the kernel chosen at each factorization: the
+                                     unblocked one when n + m <= 40 or at most 10 % of the
+                                     matrix is nonzero, Eigen's otherwise */
     GA_LINEAR_SPARSE = 2,       /**< sparse LU (KLU); needs the patterns */
     GA_LINEAR_DENSE_LAPACK = 3, /**< dense LU by LAPACK dgetrf/dgetrs */
-    GA_LINEAR_DENSE_EIGEN = 4   /**< dense LU by Eigen's PartialPivLU */
+    GA_LINEAR_DENSE_EIGEN = 4,  /**< dense LU by Eigen's (blocked) PartialPivLU */
+    GA_LINEAR_DENSE_UNBLOCKED = 5 /**< dense LU by galpha's unblocked kernel, which skips the
+                                     zero entries of a saddle-point matrix */
 } ga_linear_solver;
 
 /** Choose the linear algebra (a ::ga_linear_solver) before ga_init / ga_set_state.
  *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
 GA_API ga_status ga_set_linear_solver(ga_solver *s, int solver);
 
-/** Name of the linear algebra in use ("dense Eigen LU", "dense LAPACK LU", "sparse KLU"), or
+/** Name of the linear algebra in use ("dense unblocked LU", "dense Eigen LU" - with
+ *  GA_LINEAR_DENSE the kernel of the last factorization -, "dense LAPACK LU", "sparse KLU"), or
  *  "none" before ga_init. Static string; never NULL. */
 GA_API const char *ga_linear_solver_name(const ga_solver *s);
 /**@}*/

@@ -97,22 +97,28 @@ if ch:
 # ---- linear algebra -------------------------------------------------------------------------
 la = rows("linear_algebra.csv")
 if la:
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    for backend, style in (("eigen", "o-"), ("lapack", "s-"), ("klu", "^-"),
-                           ("eigen_sparselu", "v-")):
-        pts = sorted((num(r["size"]), num(r["factorize_us"])) for r in la
-                     if r["backend"] == backend and r["matrix"] == "chain")
-        if pts:
-            ax.loglog(*zip(*pts), style, label="chain, " + backend)
-    for r in la:
-        if r["matrix"] != "chain":
-            ax.loglog(num(r["size"]), num(r["factorize_us"]),
-                      "o" if r["backend"] == "eigen" else "s", color="gray", ms=4)
-            ax.annotate(r["matrix"], (num(r["size"]), num(r["factorize_us"])), fontsize=6)
-    ax.set(xlabel="unknowns n + m", ylabel="assembly + factorization [us]",
-           title="dense: Eigen LU, reference LAPACK; sparse: KLU, Eigen SparseLU")
-    ax.legend()
-    ax.grid(True, which="both", lw=0.3)
+    fig, ax = plt.subplots(1, 2, figsize=(13, 4.8))
+    styles = (("unblocked", "d-"), ("eigen", "o-"), ("lapack", "s-"), ("klu", "^-"),
+              ("eigen_sparselu", "v-"))
+    for panel, matrix, title in ((0, "chain", "mechanism matrices: the chain (2-7 % nonzero)"),
+                                 (1, "full", "saddle-point matrices without zeros")):
+        for backend, style in styles:
+            pts = sorted((num(r["size"]), num(r["factorize_us"])) for r in la
+                         if r["backend"] == backend and r["matrix"] == matrix)
+            if pts:
+                ax[panel].loglog(*zip(*pts), style, label=backend)
+        ax[panel].set(xlabel="unknowns n + m", ylabel="assembly + factorization [us]",
+                      title=title)
+        ax[panel].grid(True, which="both", lw=0.3)
+    for r in la:  # the paper's scenes, dense
+        if r["matrix"] not in ("chain", "full"):
+            marker = {"unblocked": "d", "eigen": "o", "lapack": "s"}[r["backend"]]
+            ax[0].loglog(num(r["size"]), num(r["factorize_us"]), marker, color="gray", ms=4)
+            ax[0].annotate(r["matrix"], (num(r["size"]), num(r["factorize_us"])), fontsize=6)
+    ax[0].legend(title="gray: paper's scenes, dense")
+    ax[1].legend()
+    fig.suptitle("LU of the iteration matrix: galpha's unblocked kernel, Eigen, reference "
+                 "LAPACK (dense); KLU, Eigen SparseLU (sparse)")
     save(fig, "linear_algebra.png")
 
 

@@ -295,7 +295,7 @@ GA_API ga_status ga_set_pattern(ga_solver *s, int which, int nnz, const int *row
 GA_API ga_status ga_set_linear_solver(ga_solver *s, int solver)
 {
     return guarded(s, [&](ga::Solver &c) {
-        if (solver < GA_LINEAR_AUTO || solver > GA_LINEAR_DENSE_EIGEN)
+        if (solver < GA_LINEAR_AUTO || solver > GA_LINEAR_DENSE_UNBLOCKED)
             return c.diag.fail(GA_ERR_ARG, "unknown linear solver %d", solver);
         if (c.setup_done())
             return c.diag.fail(GA_ERR_STATE, "the linear solver is chosen before ga_init");

@@ -23,9 +23,24 @@ bool h_within_reuse_band(double h_matrix, double h)
 }
 
 // Automatic choices of the linear algebra, from bench/linear_algebra (docs/performance.md):
-// Eigen's LU beats Debian's reference LAPACK at every size measured (13 to 6400 unknowns), and
-// KLU beats both on a declared pattern from 10 unknowns on (2x there, 1000x at 1280 links).
+// among dense LUs, the unblocked kernel on small or mostly-zero matrices and Eigen's on full
+// ones (both beat Debian's reference LAPACK at every size measured); KLU beats them all on a
+// declared pattern from 10 unknowns on.
 constexpr int kSparseMinSize = 10;
+
+DenseKind dense_kind(ga_linear_solver choice)
+{
+    switch (choice) {
+    case GA_LINEAR_DENSE_LAPACK:
+        return DenseKind::Lapack;
+    case GA_LINEAR_DENSE_EIGEN:
+        return DenseKind::Eigen;
+    case GA_LINEAR_DENSE_UNBLOCKED:
+        return DenseKind::Unblocked;
+    default:
+        return DenseKind::Auto;
+    }
+}
 }  // namespace
 
 void State::allocate(int n, int m)
@@ -110,8 +125,7 @@ ga_status Solver::setup()
         if (N * N * sizeof(double) >
             static_cast<double>(std::numeric_limits<std::ptrdiff_t>::max()))
             throw std::bad_alloc();
-        backend = make_dense_backend(linear_solver == GA_LINEAR_DENSE_LAPACK ? DenseKind::Lapack
-                                                                             : DenseKind::Eigen);
+        backend = make_dense_backend(dense_kind(linear_solver));
     }
     M_.allocate();
     J_.allocate();
@@ -145,7 +159,7 @@ ga_status Solver::setup()
 void Solver::setup_index2()
 {
     if (!S2_.ready())
-        S2_.setup(n_, m_, sparse_backend_, M_, J_, K_, C_, active_ptr());
+        S2_.setup(n_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_, active_ptr());
     if (initialized_)
         prefactor_index2();
 }
@@ -167,7 +181,7 @@ void Solver::prefactor_index2()
 void Solver::setup_projection()
 {
     if (m_ > 0 && !P_.ready())
-        P_.setup(sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Eigen),
+        P_.setup(sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Auto),
                  n_, m_, M_, J_, K_, C_, active_ptr());
 }
 

@@ -30,7 +30,8 @@ module galpha
   integer(c_int), parameter, public :: GA_MATRIX_MASS = 0, GA_MATRIX_JACOBIAN = 1, &
        GA_MATRIX_STIFFNESS = 2, GA_MATRIX_DAMPING = 3
   integer(c_int), parameter, public :: GA_LINEAR_AUTO = 0, GA_LINEAR_DENSE = 1, &
-       GA_LINEAR_SPARSE = 2, GA_LINEAR_DENSE_LAPACK = 3, GA_LINEAR_DENSE_EIGEN = 4
+       GA_LINEAR_SPARSE = 2, GA_LINEAR_DENSE_LAPACK = 3, GA_LINEAR_DENSE_EIGEN = 4, &
+       GA_LINEAR_DENSE_UNBLOCKED = 5
   integer(c_int), parameter, public :: GA_INDEX3 = 0, GA_INDEX2_STABILIZED = 1
   integer(c_int), parameter, public :: GA_REDUNDANT_REFUSE = 0, GA_REDUNDANT_DROP = 1
   integer(c_int), parameter, public :: GA_INIT_PROJECT = 0, GA_INIT_REFUSE = 1

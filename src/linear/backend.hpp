@@ -44,7 +44,8 @@ public:
     virtual const char *name() const = 0;
 };
 
-enum class DenseKind { Lapack, Eigen };
+// Auto: per factorization, the unblocked kernel for small or mostly-zero S, Eigen's otherwise.
+enum class DenseKind { Lapack, Eigen, Unblocked, Auto };
 std::unique_ptr<LinearBackend> make_dense_backend(DenseKind kind);
 // nullptr when galpha was built without KLU.
 std::unique_ptr<LinearBackend> make_sparse_backend();

@@ -1,11 +1,14 @@
 // Dense backend: S as an (n+m) x (n+m) column-major matrix, LU with partial pivoting by
-// LAPACK (dgetrf/dgetrs) or Eigen (PartialPivLU), condition estimate by LAPACK's dgecon on
-// the factors either way. Which one is faster depends on the size: bench/dense_lu measures it.
+// LAPACK (dgetrf/dgetrs), Eigen (PartialPivLU) or galpha's unblocked kernel (unblocked_lu.hpp),
+// condition estimate by LAPACK's dgecon on the factors in every case. By default (Auto) each
+// factorization takes the unblocked kernel when S is small or mostly zero, Eigen's otherwise;
+// bench/linear_algebra measures all of them.
 #include <Eigen/LU>
 #include <cstddef>
 #include <limits>
 
 #include "backend.hpp"
+#include "unblocked_lu.hpp"
 
 extern "C" {
 // LAPACK (Fortran calling convention; gfortran passes CHARACTER lengths as trailing size_t).
@@ -49,8 +52,11 @@ public:
         iwork_.setZero(N);
         work_.setZero(4 * static_cast<Eigen::Index>(N));
         x_.setZero(N);
-        if (kind_ == DenseKind::Eigen)
+        if (kind_ == DenseKind::Eigen || kind_ == DenseKind::Auto)
             eigen_lu_ = Eigen::PartialPivLU<Mat>(N);
+        // (before the first factorization the name reports the choice for S = 0)
+        unblocked_ = kind_ == DenseKind::Unblocked ||
+                     (kind_ == DenseKind::Auto && unblocked_lu_preferred(N, S_.data()));
     }
 
     bool factorize(const SaddleBlocks &b) override
@@ -76,15 +82,22 @@ public:
             S_.topRightCorner(n_, m_) = S_.bottomLeftCorner(m_, n_).transpose();
         }
         const int N = n_ + m_;
-        // The condition estimate (dgecon, as expensive as the LU for small sizes) is computed
-        // only when asked for; it needs the 1-norm of S, which LAPACK's factors overwrite.
-        if (kind_ == DenseKind::Lapack)
-            anorm_ = dlange_("1", &N, &N, S_.data(), &N, work_.data(), 1);
         rcond_valid_ = false;
+        unblocked_ = kind_ == DenseKind::Unblocked ||
+                     (kind_ == DenseKind::Auto && unblocked_lu_preferred(N, S_.data()));
+        // The condition estimate (dgecon, as expensive as the LU for small sizes) is computed
+        // only when asked for; it needs the 1-norm of S, which in-place factors overwrite.
+        if (kind_ == DenseKind::Lapack || unblocked_)
+            anorm_ = S_.cwiseAbs().colwise().sum().maxCoeff();
         if (kind_ == DenseKind::Lapack) {
             int info = 0;
             dgetrf_(&N, &N, S_.data(), &N, ipiv_.data(), &info);
             if (info > 0) {  // exact zero pivot
+                pivot_ratio_ = 0.0;
+                return false;
+            }
+        } else if (unblocked_) {
+            if (!unblocked_lu(N, S_.data(), ipiv_.data())) {
                 pivot_ratio_ = 0.0;
                 return false;
             }
@@ -103,7 +116,7 @@ public:
         if (!rcond_valid_ && pivot_ratio_ > 0.0) {
             const int N = n_ + m_;
             int info = 0;
-            if (kind_ == DenseKind::Eigen)  // S is intact: Eigen factorizes a copy
+            if (in_eigen())  // S is intact: Eigen factorizes a copy
                 anorm_ = dlange_("1", &N, &N, S_.data(), &N, work_.data(), 1);
             dgecon_("1", &N, factors().data(), &N, &anorm_, &rcond_, work_.data(), iwork_.data(),
                     &info, 1);
@@ -114,7 +127,11 @@ public:
 
     void solve(Vec &rhs) override
     {
-        if (kind_ == DenseKind::Eigen) {
+        if (unblocked_) {
+            unblocked_lu_solve(n_ + m_, S_.data(), ipiv_.data(), rhs.data());
+            return;
+        }
+        if (in_eigen()) {
             x_.noalias() = eigen_lu_.solve(rhs);  // into scratch: in-place permutation allocates
             rhs = x_;
             return;
@@ -127,16 +144,16 @@ public:
 
     const char *name() const override
     {
-        return kind_ == DenseKind::Lapack ? "dense LAPACK LU" : "dense Eigen LU";
+        if (kind_ == DenseKind::Lapack)
+            return "dense LAPACK LU";
+        return unblocked_ ? "dense unblocked LU" : "dense Eigen LU";
     }
 
 private:
     DenseKind kind_;
     int n_ = 0, m_ = 0;
-    const Mat &factors() const
-    {
-        return kind_ == DenseKind::Lapack ? S_ : eigen_lu_.matrixLU();
-    }
+    bool in_eigen() const { return kind_ != DenseKind::Lapack && !unblocked_; }
+    const Mat &factors() const { return in_eigen() ? eigen_lu_.matrixLU() : S_; }
 
     Mat S_;
     mutable Eigen::VectorXi iwork_;
@@ -148,6 +165,7 @@ private:
     double pivot_ratio_ = 0.0;
     mutable double rcond_ = 0.0;
     mutable bool rcond_valid_ = false;
+    bool unblocked_ = false;  // the last factorization is the unblocked kernel's
 };
 
 }  // namespace

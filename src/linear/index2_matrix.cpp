@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "klu_system.hpp"
+#include "unblocked_lu.hpp"
 
 namespace ga {
 
@@ -28,8 +29,11 @@ double mass_factor(const Params &p) { return (1.0 - p.alpha_m) / (1.0 - p.alpha_
 
 struct Index2Matrix::Dense {
     int n = 0, m = 0;
+    DenseKind kind = DenseKind::Auto;
+    bool unblocked = true;  // the last factorization is the unblocked kernel's (in S)
     Mat S, A, Bd;
     Eigen::PartialPivLU<Mat> lu;
+    Eigen::VectorXi ipiv;
     Vec rhs, x;
     double pivot_ratio = 0.0;
 };
@@ -50,8 +54,9 @@ struct Index2Matrix::Sparse {};
 Index2Matrix::Index2Matrix() = default;
 Index2Matrix::~Index2Matrix() = default;
 
-void Index2Matrix::setup(int n, int m, bool sparse, const ModelMatrix &M, const ModelMatrix &J,
-                         const ModelMatrix &K, const ModelMatrix &C, const unsigned char *active)
+void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const ModelMatrix &M,
+                         const ModelMatrix &J, const ModelMatrix &K, const ModelMatrix &C,
+                         const unsigned char *active)
 {
     active_ = active;
 #ifdef GALPHA_HAVE_KLU
@@ -129,7 +134,14 @@ void Index2Matrix::setup(int n, int m, bool sparse, const ModelMatrix &M, const 
     d->S.setZero(N, N);
     d->A.setZero(n, n);
     d->Bd.setZero(m, n);
-    d->lu = Eigen::PartialPivLU<Mat>(N);
+    // Eigen's LU unless galpha's unblocked kernel is asked for or preferred (LAPACK's is not
+    // offered for this system)
+    d->kind = dense_kind;
+    d->unblocked = dense_kind == DenseKind::Unblocked ||
+                   (dense_kind == DenseKind::Auto && unblocked_lu_preferred(N, d->S.data()));
+    if (dense_kind != DenseKind::Unblocked)
+        d->lu = Eigen::PartialPivLU<Mat>(N);
+    d->ipiv.setZero(N);
     d->rhs.setZero(N);
     d->x.setZero(N);
     dense_ = std::move(d);
@@ -201,11 +213,21 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
                     d.S.col(k).setZero();
                     d.S(k, k) = 1.0;
                 }
-    d.lu.compute(d.S);
-    const auto U = d.lu.matrixLU().diagonal().cwiseAbs();
+    const int N = n + 2 * m;
+    d.unblocked = d.kind == DenseKind::Unblocked ||
+                  (d.kind == DenseKind::Auto && unblocked_lu_preferred(N, d.S.data()));
+    if (d.unblocked) {
+        if (!unblocked_lu(N, d.S.data(), d.ipiv.data())) {
+            d.pivot_ratio = 0.0;
+            return false;
+        }
+    } else {
+        d.lu.compute(d.S);
+    }
+    const auto U = (d.unblocked ? d.S : d.lu.matrixLU()).diagonal().cwiseAbs();
     const double umax = U.maxCoeff();
     d.pivot_ratio = umax > 0.0 ? U.minCoeff() / umax : 0.0;
-    return d.pivot_ratio >= (n + 2 * m) * std::numeric_limits<double>::epsilon();
+    return d.pivot_ratio >= N * std::numeric_limits<double>::epsilon();
 }
 
 void Index2Matrix::solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const Params &p,
@@ -242,7 +264,12 @@ void Index2Matrix::solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const 
         for (int i = 0; i < m; ++i)
             if (!active_[i])
                 x.rhs[n + i] = x.rhs[n + m + i] = 0.0;
-    x.x.noalias() = x.lu.solve(x.rhs);
+    if (x.unblocked) {
+        x.x = x.rhs;
+        unblocked_lu_solve(n + 2 * m, x.S.data(), x.ipiv.data(), x.x.data());
+    } else {
+        x.x.noalias() = x.lu.solve(x.rhs);
+    }
     d = x.x.head(n);
     dlambda = x.x.segment(n, m) / bh2;
     eta_bar = x.x.tail(m);
@@ -262,7 +289,10 @@ double Index2Matrix::rcond() const
 
 const char *Index2Matrix::name() const
 {
-    return sparse_ ? "sparse KLU (stabilized index-2)" : "dense Eigen LU (stabilized index-2)";
+    if (sparse_)
+        return "sparse KLU (stabilized index-2)";
+    return dense_ && !dense_->unblocked ? "dense Eigen LU (stabilized index-2)"
+                                        : "dense unblocked LU (stabilized index-2)";
 }
 
 }  // namespace ga

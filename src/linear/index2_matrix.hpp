@@ -26,6 +26,7 @@
 
 #include "../matrix.hpp"
 #include "../params.hpp"
+#include "backend.hpp"
 
 namespace ga {
 
@@ -37,9 +38,10 @@ public:
     // Allocates everything (patterns of M, J, K, C: their layouts; B has J's). active: m
     // flags owned by the caller (null: every constraint active); an inactive constraint's
     // rows and columns (lambda_bar and eta_bar) are those of the identity, its right-hand side
-    // 0. Throws std::bad_alloc.
-    void setup(int n, int m, bool sparse, const ModelMatrix &M, const ModelMatrix &J,
-               const ModelMatrix &K, const ModelMatrix &C, const unsigned char *active);
+    // 0. dense_kind: the dense LU (Lapack counts as Eigen). Throws std::bad_alloc.
+    void setup(int n, int m, bool sparse, DenseKind dense_kind, const ModelMatrix &M,
+               const ModelMatrix &J, const ModelMatrix &K, const ModelMatrix &C,
+               const unsigned char *active);
     bool ready() const { return dense_ || sparse_; }
     bool sparse() const { return sparse_ != nullptr; }
     // false if singular or numerically singular

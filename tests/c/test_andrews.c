@@ -170,7 +170,7 @@ static void sparse_model_matches_dense_model(void **state)
         for (int k = 0; k < 100; ++k)
             assert_int_equal(ga_step(s, 3e-4), GA_OK);
         assert_string_equal(ga_linear_solver_name(s),
-                            sparse ? "sparse KLU" : "dense Eigen LU");
+                            sparse ? "sparse KLU" : "dense unblocked LU");
         ga_get_q(s, q[sparse]);
         ga_get_lambda(s, lam[sparse]);
         ga_free(s);

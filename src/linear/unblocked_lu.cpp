@@ -1,0 +1,94 @@
+#include "unblocked_lu.hpp"
+
+#include <cmath>
+#include <cstddef>
+#include <utility>
+
+namespace ga {
+
+namespace {
+inline double *column(double *A, int N, int j) { return A + static_cast<std::ptrdiff_t>(j) * N; }
+inline const double *column(const double *A, int N, int j)
+{
+    return A + static_cast<std::ptrdiff_t>(j) * N;
+}
+
+// The unblocked kernel up to this many unknowns whatever the fill, and beyond while at most
+// this fraction of the matrix is nonzero. bench/linear_algebra: on matrices without zeros
+// Eigen's blocked LU is ahead from about 40 unknowns on; on mechanisms' matrices (Andrews in 31
+// coordinates: 4.5 % nonzero; the chain: 7 % at 8 links, less beyond) the unblocked kernel is
+// ahead at every size measured. In between the fill of the factors decides, which the matrix
+// does not show: random patterns with 15 % nonzero fill in and favour Eigen's from about 100
+// unknowns on.
+constexpr int kUnblockedAlways = 40;
+constexpr double kUnblockedMaxFill = 0.1;
+}  // namespace
+
+bool unblocked_lu_preferred(int N, const double *A)
+{
+    if (N <= kUnblockedAlways)
+        return true;
+    const std::ptrdiff_t entries = static_cast<std::ptrdiff_t>(N) * N;
+    std::ptrdiff_t nonzero = 0;
+    for (std::ptrdiff_t k = 0; k < entries; ++k)
+        nonzero += A[k] != 0.0;
+    return static_cast<double>(nonzero) <= kUnblockedMaxFill * static_cast<double>(entries);
+}
+
+bool unblocked_lu(int N, double *A, int *ipiv)
+{
+    for (int k = 0; k < N; ++k) {
+        double *ck = column(A, N, k);
+        int p = k;
+        double largest = std::abs(ck[k]);
+        for (int i = k + 1; i < N; ++i)
+            if (std::abs(ck[i]) > largest) {
+                largest = std::abs(ck[i]);
+                p = i;
+            }
+        ipiv[k] = p;
+        if (largest == 0.0)
+            return false;
+        if (p != k)  // whole rows, as dgetrf: the factors' rows stay in pivot order
+            for (int j = 0; j < N; ++j)
+                std::swap(column(A, N, j)[k], column(A, N, j)[p]);
+        const double inverse = 1.0 / ck[k];
+        for (int i = k + 1; i < N; ++i)
+            ck[i] *= inverse;
+        // rank-one update of the trailing matrix, column by column; a zero entry of row k
+        // leaves its column untouched (most of them in a saddle-point matrix)
+        for (int j = k + 1; j < N; ++j) {
+            double *cj = column(A, N, j);
+            const double u = cj[k];
+            if (u != 0.0)
+                for (int i = k + 1; i < N; ++i)
+                    cj[i] -= ck[i] * u;
+        }
+    }
+    return true;
+}
+
+void unblocked_lu_solve(int N, const double *LU, const int *ipiv, double *b)
+{
+    for (int k = 0; k < N; ++k)
+        if (ipiv[k] != k)
+            std::swap(b[k], b[ipiv[k]]);
+    for (int k = 0; k < N; ++k) {  // L y = P b, unit diagonal
+        const double y = b[k];
+        if (y != 0.0) {
+            const double *ck = column(LU, N, k);
+            for (int i = k + 1; i < N; ++i)
+                b[i] -= ck[i] * y;
+        }
+    }
+    for (int k = N - 1; k >= 0; --k) {  // U x = y
+        const double *ck = column(LU, N, k);
+        b[k] /= ck[k];
+        const double x = b[k];
+        if (x != 0.0)
+            for (int i = 0; i < k; ++i)
+                b[i] -= ck[i] * x;
+    }
+}
+
+}  // namespace ga
