@@ -49,6 +49,7 @@ public:
         const int N = n + m;
         S_.setZero(N, N);
         ipiv_.setZero(N);
+        extent_.setZero(2 * N);
         iwork_.setZero(N);
         work_.setZero(4 * static_cast<Eigen::Index>(N));
         x_.setZero(N);
@@ -97,7 +98,7 @@ public:
                 return false;
             }
         } else if (unblocked_) {
-            if (!unblocked_lu(N, S_.data(), ipiv_.data())) {
+            if (!unblocked_lu(N, S_.data(), ipiv_.data(), extent_.data())) {
                 pivot_ratio_ = 0.0;
                 return false;
             }
@@ -128,7 +129,7 @@ public:
     void solve(Vec &rhs) override
     {
         if (unblocked_) {
-            unblocked_lu_solve(n_ + m_, S_.data(), ipiv_.data(), rhs.data());
+            unblocked_lu_solve(n_ + m_, S_.data(), ipiv_.data(), extent_.data(), rhs.data());
             return;
         }
         if (in_eigen()) {
@@ -157,7 +158,7 @@ private:
 
     Mat S_;
     mutable Eigen::VectorXi iwork_;
-    Eigen::VectorXi ipiv_;
+    Eigen::VectorXi ipiv_, extent_;
     mutable Vec work_;
     Vec x_;
     Eigen::PartialPivLU<Mat> eigen_lu_;

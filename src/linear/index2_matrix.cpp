@@ -33,7 +33,7 @@ struct Index2Matrix::Dense {
     bool unblocked = true;  // the last factorization is the unblocked kernel's (in S)
     Mat S, A, Bd;
     Eigen::PartialPivLU<Mat> lu;
-    Eigen::VectorXi ipiv;
+    Eigen::VectorXi ipiv, extent;
     Vec rhs, x;
     double pivot_ratio = 0.0;
 };
@@ -142,6 +142,7 @@ void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const 
     if (dense_kind != DenseKind::Unblocked)
         d->lu = Eigen::PartialPivLU<Mat>(N);
     d->ipiv.setZero(N);
+    d->extent.setZero(2 * N);
     d->rhs.setZero(N);
     d->x.setZero(N);
     dense_ = std::move(d);
@@ -217,7 +218,7 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
     d.unblocked = d.kind == DenseKind::Unblocked ||
                   (d.kind == DenseKind::Auto && unblocked_lu_preferred(N, d.S.data()));
     if (d.unblocked) {
-        if (!unblocked_lu(N, d.S.data(), d.ipiv.data())) {
+        if (!unblocked_lu(N, d.S.data(), d.ipiv.data(), d.extent.data())) {
             d.pivot_ratio = 0.0;
             return false;
         }
@@ -266,7 +267,8 @@ void Index2Matrix::solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const 
                 x.rhs[n + i] = x.rhs[n + m + i] = 0.0;
     if (x.unblocked) {
         x.x = x.rhs;
-        unblocked_lu_solve(n + 2 * m, x.S.data(), x.ipiv.data(), x.x.data());
+        unblocked_lu_solve(n + 2 * m, x.S.data(), x.ipiv.data(), x.extent.data(),
+                           x.x.data());
     } else {
         x.x.noalias() = x.lu.solve(x.rhs);
     }

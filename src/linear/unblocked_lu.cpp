@@ -35,8 +35,9 @@ bool unblocked_lu_preferred(int N, const double *A)
     return static_cast<double>(nonzero) <= kUnblockedMaxFill * static_cast<double>(entries);
 }
 
-bool unblocked_lu(int N, double *A, int *ipiv)
+bool unblocked_lu(int N, double *A, int *ipiv, int *extent)
 {
+    int *l_end = extent, *u_begin = extent + N;
     for (int k = 0; k < N; ++k) {
         double *ck = column(A, N, k);
         int p = k;
@@ -52,8 +53,12 @@ bool unblocked_lu(int N, double *A, int *ipiv)
         if (p != k)  // whole rows, as dgetrf: the factors' rows stay in pivot order
             for (int j = 0; j < N; ++j)
                 std::swap(column(A, N, j)[k], column(A, N, j)[p]);
+        // the multipliers end at the last nonzero of the column (a band ends early)
+        int end = N;
+        while (end > k + 1 && ck[end - 1] == 0.0)
+            --end;
         const double inverse = 1.0 / ck[k];
-        for (int i = k + 1; i < N; ++i)
+        for (int i = k + 1; i < end; ++i)
             ck[i] *= inverse;
         // rank-one update of the trailing matrix, column by column; a zero entry of row k
         // leaves its column untouched (most of them in a saddle-point matrix)
@@ -61,15 +66,28 @@ bool unblocked_lu(int N, double *A, int *ipiv)
             double *cj = column(A, N, j);
             const double u = cj[k];
             if (u != 0.0)
-                for (int i = k + 1; i < N; ++i)
+                for (int i = k + 1; i < end; ++i)
                     cj[i] -= ck[i] * u;
         }
+    }
+    // The extent of the final factors, for the solves (later row exchanges move the
+    // multipliers of earlier columns: their ends are known only now).
+    for (int k = 0; k < N; ++k) {
+        const double *ck = column(A, N, k);
+        int begin = 0, end = N;
+        while (begin < k && ck[begin] == 0.0)
+            ++begin;
+        while (end > k + 1 && ck[end - 1] == 0.0)
+            --end;
+        u_begin[k] = begin;
+        l_end[k] = end;
     }
     return true;
 }
 
-void unblocked_lu_solve(int N, const double *LU, const int *ipiv, double *b)
+void unblocked_lu_solve(int N, const double *LU, const int *ipiv, const int *extent, double *b)
 {
+    const int *l_end = extent, *u_begin = extent + N;
     for (int k = 0; k < N; ++k)
         if (ipiv[k] != k)
             std::swap(b[k], b[ipiv[k]]);
@@ -77,7 +95,7 @@ void unblocked_lu_solve(int N, const double *LU, const int *ipiv, double *b)
         const double y = b[k];
         if (y != 0.0) {
             const double *ck = column(LU, N, k);
-            for (int i = k + 1; i < N; ++i)
+            for (int i = k + 1; i < l_end[k]; ++i)
                 b[i] -= ck[i] * y;
         }
     }
@@ -86,7 +104,7 @@ void unblocked_lu_solve(int N, const double *LU, const int *ipiv, double *b)
         b[k] /= ck[k];
         const double x = b[k];
         if (x != 0.0)
-            for (int i = 0; i < k; ++i)
+            for (int i = u_begin[k]; i < k; ++i)
                 b[i] -= ck[i] * x;
     }
 }

@@ -22,9 +22,11 @@ namespace ga {
 // from a checkpoint makes the same choices as the run it continues.
 bool unblocked_lu_preferred(int N, const double *A);
 
-// false on an exactly zero pivot column (the factors are then incomplete).
-bool unblocked_lu(int N, double *A, int *ipiv);
+// false on an exactly zero pivot column (the factors are then incomplete). extent (2N ints):
+// where the nonzeros of each column of L end and those of each column of U begin, so that
+// banded factors are walked over their band only.
+bool unblocked_lu(int N, double *A, int *ipiv, int *extent);
 // b <- A^-1 b with the factors of unblocked_lu.
-void unblocked_lu_solve(int N, const double *LU, const int *ipiv, double *b);
+void unblocked_lu_solve(int N, const double *LU, const int *ipiv, const int *extent, double *b);
 
 }  // namespace ga
