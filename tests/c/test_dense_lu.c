@@ -62,6 +62,7 @@ static int constraint_matrix(double t, const double *q, double *J, void *user)
 
 typedef struct run_result {
     double q[N_Q], lambda[N_C];
+    double rcond; /* GA_INFO_RCOND after the last step */
     char backend[64];
 } run_result;
 
@@ -85,6 +86,7 @@ static void run(int solver, run_result *out)
         assert_int_equal(ga_step(s, 0.05), GA_OK);
     assert_int_equal(ga_get_q(s, out->q), GA_OK);
     assert_int_equal(ga_get_lambda(s, out->lambda), GA_OK);
+    assert_int_equal(ga_get_info(s, GA_INFO_RCOND, &out->rcond), GA_OK);
     strncpy(out->backend, ga_linear_solver_name(s), sizeof out->backend - 1);
     out->backend[sizeof out->backend - 1] = '\0';
     ga_free(s);
@@ -127,6 +129,13 @@ static void three_dense_kernels_agree_on_a_full_matrix(void **state)
     assert_true(dq_unblocked < 1e-12);
     assert_true(dl_unblocked <= 10.0 * fmax(dl_lapack, 1e-12));
     assert_true(relative_difference(chosen.q, eigen.q, N_Q) == 0.0); /* the same kernel */
+    /* LAPACK's dgecon estimates the condition from the factors of each kernel: the same
+     * number if the unblocked factors have dgetrf's layout and pivots */
+    printf("  condition estimates: Eigen %.6e, LAPACK %.6e, unblocked %.6e\n", eigen.rcond,
+           lapack.rcond, unblocked.rcond);
+    assert_true(eigen.rcond > 0.0 && eigen.rcond < 1.0);
+    assert_true(fabs(lapack.rcond - eigen.rcond) <= 1e-8 * eigen.rcond);
+    assert_true(fabs(unblocked.rcond - eigen.rcond) <= 1e-8 * eigen.rcond);
 }
 
 int main(void)
