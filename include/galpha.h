@@ -377,7 +377,8 @@ typedef enum ga_formulation {
                                   second order across step-size changes (index 3: an O(h) burst
                                   after every change) and are far less sensitive to round-off
                                   for small h; recommended with adaptive steps. Same callbacks
-                                  (Phi_t by finite differences), dense or sparse: with declared
+                                  (Phi_t: ga_set_constraint_dt, or finite differences), dense
+                                  or sparse: with declared
                                   patterns the system keeps the Newmark increment as extra
                                   unknowns, so no block is a product of the user's matrices
                                   (2n + 2m sparse unknowns instead of n + 2m dense ones). */
@@ -474,6 +475,14 @@ GA_API ga_status ga_interpolate(const ga_solver *s, double t, double *q, double 
  *  otherwise). Errors: GA_ERR_ARG, GA_ERR_STATE. */
 GA_API ga_status ga_set_constraint_accel(ga_solver *s, ga_constraint_accel_fn fn);
 
+/** Optional callback for Phi_t(q, t), the partial time derivative of the constraints (length m,
+ *  same signature as the constraint callback), used by the consistent start (velocities) and by
+ *  the stabilized index-2 formulation (the velocity constraint Phi_q v + Phi_t, every Newton
+ *  iteration). NULL (default): central differences in t, two constraint calls per evaluation.
+ *  Constraints that do not depend on t have Phi_t = 0: a callback that writes zeros saves
+ *  those calls. Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_constraint_dt(ga_solver *s, ga_constraint_fn fn);
+
 typedef enum ga_init_mode {
     GA_INIT_PROJECT = 0, /**< project inconsistent q0, v0 (minimum-norm correction; default) */
     GA_INIT_REFUSE = 1   /**< refuse inconsistent q0, v0 with GA_ERR_INCONSISTENT */
@@ -549,11 +558,14 @@ typedef enum ga_counter {
     GA_COUNT_STIFFNESS_EVALS = 9, /**< K_t evaluations (callback or finite differences) */
     GA_COUNT_DAMPING_EVALS = 10, /**< C_t evaluations (callback or finite differences) */
     GA_COUNT_ACCEL_EVALS = 11,   /**< constraint acceleration term evaluations */
-    GA_COUNT_REJECTED_STEPS = 12 /**< adaptive mode: steps rejected by the error test (steps
+    GA_COUNT_REJECTED_STEPS = 12, /**< adaptive mode: steps rejected by the error test (steps
                                       whose Newton iteration or callbacks failed count in
                                       GA_COUNT_FAILED_STEPS) */
+    GA_COUNT_CONSTRAINT_DT_EVALS = 13 /**< Phi_t evaluations (callback, or finite differences:
+                                      their constraint calls count in
+                                      GA_COUNT_CONSTRAINT_EVALS too) */
 } ga_counter;
-#define GA_COUNTER_COUNT 13
+#define GA_COUNTER_COUNT 14
 
 /** Value of the counter `key` (a ::ga_counter). Errors: GA_ERR_ARG (NULL or unknown key),
  *  GA_ERR_STATE. */

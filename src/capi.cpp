@@ -184,6 +184,14 @@ GA_API ga_status ga_set_constraint_accel(ga_solver *s, ga_constraint_accel_fn fn
     });
 }
 
+GA_API ga_status ga_set_constraint_dt(ga_solver *s, ga_constraint_fn fn)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        c.model.cb.constraint_dt = fn;
+        return GA_OK;
+    });
+}
+
 GA_API ga_status ga_set_rho_inf(ga_solver *s, double rho_inf)
 {
     return guarded(s, [&](ga::Solver &c) {

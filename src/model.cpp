@@ -339,6 +339,13 @@ ga_status Model::constraint_dt(double t, const Vec &q, Vec &out)
 {
     if (m_ == 0)
         return GA_OK;
+    count(counters_, GA_COUNT_CONSTRAINT_DT_EVALS);
+    if (cb.constraint_dt) {
+        if (auto st = callback_status(cb.constraint_dt(t, q.data(), out.data(), cb.user),
+                                      "constraint_dt", t))
+            return st;
+        return check_finite(out.data(), m_, 0, "constraint time derivative Phi_t", t);
+    }
     // Central difference in t. For constraints that do not depend on t both evaluations are
     // identical and Phi_t = 0 exactly.
     const double d = std::cbrt(kEps) * std::max(std::fabs(t), 1.0);

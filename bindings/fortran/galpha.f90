@@ -39,7 +39,8 @@ module galpha
        GA_COUNT_NEWTON_ITERS = 2, GA_COUNT_FACTORIZATIONS = 3, GA_COUNT_RESIDUALS = 4, &
        GA_COUNT_MASS_EVALS = 5, GA_COUNT_FORCE_EVALS = 6, GA_COUNT_CONSTRAINT_EVALS = 7, &
        GA_COUNT_JACOBIAN_EVALS = 8, GA_COUNT_STIFFNESS_EVALS = 9, &
-       GA_COUNT_DAMPING_EVALS = 10, GA_COUNT_ACCEL_EVALS = 11, GA_COUNT_REJECTED_STEPS = 12
+       GA_COUNT_DAMPING_EVALS = 10, GA_COUNT_ACCEL_EVALS = 11, GA_COUNT_REJECTED_STEPS = 12, &
+       GA_COUNT_CONSTRAINT_DT_EVALS = 13
   integer(c_int), parameter, public :: GA_INFO_RCOND = 0, GA_INFO_NEWTON_ITERS = 1, &
        GA_INFO_NEWTON_RATIO = 2, GA_INFO_ERROR_ESTIMATE = 3, GA_INFO_H_NEXT = 4
 
@@ -130,6 +131,11 @@ module galpha
        type(c_ptr), value :: s
        type(c_funptr), value :: fn
      end function ga_set_constraint_accel
+     integer(c_int) function ga_set_constraint_dt(s, fn) bind(C, name="ga_set_constraint_dt")
+       import :: c_int, c_ptr, c_funptr
+       type(c_ptr), value :: s
+       type(c_funptr), value :: fn
+     end function ga_set_constraint_dt
      integer(c_int) function ga_set_rho_inf(s, rho_inf) bind(C, name="ga_set_rho_inf")
        import :: c_int, c_ptr, c_double
        type(c_ptr), value :: s
@@ -343,7 +349,8 @@ module galpha
   end interface
   public :: ga_version, ga_version_number, ga_strerror, ga_last_error, ga_create, ga_free, &
        ga_get_size, ga_set_callbacks, ga_set_tangents, ga_set_tangent_mode, &
-       ga_set_constraint_accel, ga_set_rho_inf, ga_set_params, ga_get_params, ga_set_newton, &
+       ga_set_constraint_accel, ga_set_constraint_dt, ga_set_rho_inf, ga_set_params, &
+       ga_get_params, ga_set_newton, &
        ga_set_scaling, ga_set_predictor, ga_set_init_mode, ga_init, ga_step, ga_get_t, &
        ga_get_h_last, ga_get_q, ga_get_v, ga_get_qdd, ga_get_lambda, ga_get_a, &
        ga_state_size, ga_get_state, ga_set_state, ga_get_counter, ga_reset_counters, ga_get_info, &
@@ -368,6 +375,7 @@ module galpha
      generic :: set_callbacks => solver_set_callbacks, solver_set_callbacks_funptr
      procedure :: set_tangents => solver_set_tangents
      procedure :: set_constraint_accel => solver_set_constraint_accel
+     procedure :: set_constraint_dt => solver_set_constraint_dt
      procedure :: set_rho_inf => solver_set_rho_inf
      procedure :: set_newton => solver_set_newton
      procedure :: init => solver_init
@@ -482,6 +490,12 @@ contains
     procedure(ga_force_fn) :: fn
     status = ga_set_constraint_accel(this%handle, c_funloc(fn))
   end function solver_set_constraint_accel
+
+  integer(c_int) function solver_set_constraint_dt(this, fn) result(status)
+    class(galpha_solver), intent(inout) :: this
+    procedure(ga_constraint_fn) :: fn
+    status = ga_set_constraint_dt(this%handle, c_funloc(fn))
+  end function solver_set_constraint_dt
 
   integer(c_int) function solver_set_rho_inf(this, rho_inf) result(status)
     class(galpha_solver), intent(inout) :: this

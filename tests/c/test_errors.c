@@ -19,7 +19,15 @@
 #include "helpers.h"
 
 /* The pendulum with switchable faults. */
-typedef enum fault_site { NONE, MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS } fault_site;
+typedef enum fault_site {
+    NONE,
+    MASS,
+    FORCE,
+    CONSTRAINT,
+    JACOBIAN,
+    STIFFNESS,
+    CONSTRAINT_DT
+} fault_site;
 typedef struct faulty {
     pendulum p;
     fault_site site;
@@ -80,6 +88,14 @@ static int f_stiffness(double t, const double *q, const double *v, const double 
     faulty *f = u;
     pendulum_stiffness(t, q, v, qdd, lambda, K, &f->p);
     return inject(f, STIFFNESS, K);
+}
+
+/* Phi_t of the pendulum: its constraint does not depend on t */
+static int f_constraint_dt(double t, const double *q, double *out, void *u)
+{
+    (void)t, (void)q;
+    out[0] = 0.0;
+    return inject(u, CONSTRAINT_DT, out);
 }
 
 typedef struct fixture {
@@ -332,6 +348,48 @@ static void nan_and_inf_in_callback_outputs(void **state)
     }
 }
 
+/* The Phi_t callback is called in every Newton iteration of a stabilized index-2 step: its
+ * failures (fatal, recoverable, NaN, Inf) are reported like any callback's, the state kept. */
+static void constraint_dt_failures_in_index2_steps(void **state)
+{
+    (void)state;
+    const struct {
+        int rc;
+        double value;
+        ga_status expected;
+        const char *part;
+    } cases[] = {
+        {-7, 0.0, GA_ERR_CALLBACK, "constraint_dt callback returned -7"},
+        {3, 0.0, GA_ERR_CALLBACK_RETRY, "constraint_dt callback returned 3 (recoverable)"},
+        {0, NAN, GA_ERR_NONFINITE, "constraint time derivative Phi_t[0]"},
+        {0, INFINITY, GA_ERR_NONFINITE, "constraint time derivative Phi_t[0]"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        faulty model = {{1.0, 1.0, 9.81}, NONE, 0, 0.0, 0, NULL, GA_OK, 0};
+        ga_solver *s = NULL;
+        double q[2], v[2], before[STATE_MAX], after[STATE_MAX];
+        pendulum_state(&model.p, 1.0, 0.5, q, v);
+        assert_int_equal(ga_create(2, 1, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, f_mass, f_force, f_constraint, f_jacobian, &model),
+                         GA_OK);
+        assert_int_equal(ga_set_constraint_dt(s, f_constraint_dt), GA_OK);
+        assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        assert_int_equal(ga_step(s, 0.01), GA_OK);
+        const size_t len = snapshot(s, before);
+        model.site = CONSTRAINT_DT;
+        model.rc = cases[k].rc;
+        model.value = cases[k].value;
+        assert_int_equal(ga_step(s, 0.01), cases[k].expected);
+        expect_message(s, cases[k].part);
+        snapshot(s, after);
+        assert_memory_equal(before, after, len * sizeof(double));
+        model.site = NONE; /* and the run goes on */
+        assert_int_equal(ga_step(s, 0.01), GA_OK);
+        ga_free(s);
+    }
+}
+
 static void singular_iteration_matrix(void **state)
 {
     fixture *x = *state;
@@ -561,6 +619,7 @@ int main(void)
         cmocka_unit_test(singular_saddle_point_matrix_at_init),
         cmocka_unit_test(massless_coordinate_at_init),
         cmocka_unit_test(nan_in_initial_values),
+        cmocka_unit_test(constraint_dt_failures_in_index2_steps),
         cmocka_unit_test(out_of_memory_is_reported),
         cmocka_unit_test(strerror_names_every_status),
     };

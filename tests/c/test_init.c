@@ -148,19 +148,29 @@ static int rh_accel(double t, const double *q, const double *v, double *out, voi
     return 0;
 }
 
+static int rh_dt(double t, const double *q, double *out, void *u)
+{
+    const rheonomic *r = u;
+    (void)q;
+    out[0] = -rl(r, t, 0) * rl(r, t, 1); /* Phi_t = -L L' */
+    return 0;
+}
+
 static void time_dependent_constraint_start(void **state)
 {
     (void)state;
     rheonomic r = {{1.0, 1.0, 9.81}, 1.0, 0.2, 3.0};
     const double t0 = 0.4;
-    double results[2][5];
-    for (int cb = 0; cb < 2; ++cb) {
+    double results[3][5];
+    for (int cb = 0; cb < 3; ++cb) {
         ga_solver *s = NULL;
         assert_int_equal(ga_create(2, 1, &s), GA_OK);
         assert_int_equal(ga_set_callbacks(s, rh_mass, rh_force, rh_constraint, rh_jacobian, &r),
                          GA_OK);
         if (cb)
             assert_int_equal(ga_set_constraint_accel(s, rh_accel), GA_OK);
+        if (cb == 2)
+            assert_int_equal(ga_set_constraint_dt(s, rh_dt), GA_OK);
         /* position on the circle of radius L(t0), velocity purely tangential: the projection
          * must add the radial rate L'(t0) (that is what Phi_t brings in) */
         const double L = rl(&r, t0, 0), th = 0.5;
@@ -168,7 +178,8 @@ static void time_dependent_constraint_start(void **state)
         assert_int_equal(ga_init(s, t0, q, v), GA_OK);
         ga_get_v(s, v);
         const double radial = (v[0] * q[0] + v[1] * q[1]) / L;
-        assert_true(fabs(radial - rl(&r, t0, 1)) < 1e-8);
+        /* Phi_t by central differences (error ~ eps^(2/3)) or exact */
+        assert_true(fabs(radial - rl(&r, t0, 1)) < (cb == 2 ? 1e-14 : 1e-8));
         ga_get_qdd(s, results[cb]);
         ga_get_lambda(s, results[cb] + 2);
         ga_free(s);
@@ -176,6 +187,59 @@ static void time_dependent_constraint_start(void **state)
     /* finite-difference term (nested differences in t) against the analytic callback */
     assert_true(fabs(results[0][2] - results[1][2]) < 1e-6 * fabs(results[1][2]));
     assert_true(max_abs_diff(results[0], results[1], 2) < 1e-5);
+    assert_true(max_abs_diff(results[2], results[1], 2) < 1e-8);
+}
+
+/* The stabilized index-2 formulation keeps Phi_q v + Phi_t = 0 at every step; with an exact
+ * Phi_t callback to round-off against the exact Phi_t, with central differences to their
+ * error (~ eps^(2/3) |Phi|), and the callback spares the two constraint calls per Newton
+ * iteration that the differences cost. */
+static void index2_velocity_constraint_with_exact_phi_t(void **state)
+{
+    (void)state;
+    rheonomic r = {{1.0, 1.0, 9.81}, 1.0, 0.2, 3.0};
+    const double t0 = 0.4, h = 1e-3;
+    double worst[2] = {0.0, 0.0}, qs[2][2];
+    long long cons[2], res[2], dt[2];
+    for (int cb = 0; cb < 2; ++cb) {
+        ga_solver *s = NULL;
+        assert_int_equal(ga_create(2, 1, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, rh_mass, rh_force, rh_constraint, rh_jacobian, &r),
+                         GA_OK);
+        assert_int_equal(ga_set_constraint_accel(s, rh_accel), GA_OK);
+        if (cb)
+            assert_int_equal(ga_set_constraint_dt(s, rh_dt), GA_OK);
+        assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
+        assert_int_equal(ga_set_newton(s, 1e-12, 20), GA_OK);
+        const double L = rl(&r, t0, 0), th = 0.5;
+        double q[2] = {L * sin(th), -L * cos(th)}, v[2] = {cos(th), sin(th)}, t = t0;
+        assert_int_equal(ga_init(s, t0, q, v), GA_OK);
+        for (int k = 0; k < 500; ++k) {
+            assert_int_equal(ga_step(s, h), GA_OK);
+            ga_get_t(s, &t);
+            ga_get_q(s, q);
+            ga_get_v(s, v);
+            const double velocity_constraint =
+                q[0] * v[0] + q[1] * v[1] - rl(&r, t, 0) * rl(&r, t, 1);
+            worst[cb] = fmax(worst[cb], fabs(velocity_constraint));
+        }
+        qs[cb][0] = q[0];
+        qs[cb][1] = q[1];
+        ga_get_counter(s, GA_COUNT_CONSTRAINT_EVALS, &cons[cb]);
+        ga_get_counter(s, GA_COUNT_RESIDUALS, &res[cb]);
+        ga_get_counter(s, GA_COUNT_CONSTRAINT_DT_EVALS, &dt[cb]);
+        ga_free(s);
+    }
+    printf("  max |Phi_q v + Phi_t| over 500 index-2 steps: %.1e with central differences, "
+           "%.1e with the callback; constraint calls %lld against %lld (%lld Phi_t "
+           "evaluations)\n",
+           worst[0], worst[1], cons[0], cons[1], dt[1]);
+    assert_true(worst[1] < 1e-13);
+    assert_true(worst[0] < 1e-8);
+    assert_true(max_abs_diff(qs[0], qs[1], 2) < 1e-8);
+    assert_true(dt[1] >= res[1]); /* one Phi_t per Newton iteration, and the start's */
+    /* the differences' calls are the whole difference */
+    assert_true(cons[0] - 2 * dt[0] - res[0] == cons[1] - res[1]);
 }
 
 int main(void)
@@ -186,6 +250,7 @@ int main(void)
         cmocka_unit_test(consistent_values_are_kept),
         cmocka_unit_test(failed_init_keeps_previous_state),
         cmocka_unit_test(time_dependent_constraint_start),
+        cmocka_unit_test(index2_velocity_constraint_with_exact_phi_t),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

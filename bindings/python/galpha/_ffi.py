@@ -112,7 +112,8 @@ GA_INIT_PROJECT, GA_INIT_REFUSE = 0, 1
  GA_INFO_H_NEXT) = 0, 1, 2, 3, 4
 COUNTERS = ("steps", "failed_steps", "newton_iters", "factorizations", "residuals",
             "mass_evals", "force_evals", "constraint_evals", "jacobian_evals",
-            "stiffness_evals", "damping_evals", "accel_evals", "rejected_steps")
+            "stiffness_evals", "damping_evals", "accel_evals", "rejected_steps",
+            "constraint_dt_evals")
 
 _S = ctypes.c_void_p  # ga_solver *
 _I = ctypes.c_int
@@ -131,6 +132,7 @@ _SIGNATURES = {
     "ga_set_tangents": (_I, [_S, STIFFNESS_FN, DAMPING_FN]),
     "ga_set_tangent_mode": (_I, [_S, _I]),
     "ga_set_constraint_accel": (_I, [_S, CONSTRAINT_ACCEL_FN]),
+    "ga_set_constraint_dt": (_I, [_S, CONSTRAINT_FN]),
     "ga_set_rho_inf": (_I, [_S, _D]),
     "ga_set_params": (_I, [_S, _D, _D, _D, _D]),
     "ga_get_params": (_I, [_S, _P(_D), _P(_D), _P(_D), _P(_D)]),

@@ -42,8 +42,9 @@ class Solver:
     mass(t, q, M), force(t, q, v, f), constraint(t, q, phi), jacobian(t, q, J) : callables
         The model. `force` may be None (no applied forces); `constraint` and `jacobian` are
         required when m > 0.
-    stiffness(t, q, v, qdd, lam, K), damping(t, q, v, C), constraint_accel(t, q, v, out)
-        Optional exact tangents and constraint acceleration term (finite differences
+    stiffness(t, q, v, qdd, lam, K), damping(t, q, v, C), constraint_accel(t, q, v, out),
+    constraint_dt(t, q, out)
+        Optional exact tangents, constraint acceleration term and Phi_t (finite differences
         otherwise).
     rho_inf, params, newton, tangent_mode, scaling, predictor, init_mode, formulation, redundant,
     tolerances, reuse, constant_mass, linear_solver, rescale, corrected_start, step_limits
@@ -57,7 +58,8 @@ class Solver:
     """
 
     def __init__(self, n, m, mass, force=None, constraint=None, jacobian=None, *,
-                 stiffness=None, damping=None, constraint_accel=None, rho_inf=None,
+                 stiffness=None, damping=None, constraint_accel=None, constraint_dt=None,
+                 rho_inf=None,
                  params=None, newton=None, tangent_mode=None, scaling=None, predictor=None,
                  init_mode=None, formulation=None, redundant=None, tolerances=None, reuse=None,
                  constant_mass=None, linear_solver=None, rescale=None, corrected_start=None,
@@ -75,7 +77,7 @@ class Solver:
         v = self._view
         self._user = {"mass": mass, "force": force, "constraint": constraint,
                       "jacobian": jacobian, "stiffness": stiffness, "damping": damping,
-                      "constraint_accel": constraint_accel}
+                      "constraint_accel": constraint_accel, "constraint_dt": constraint_dt}
 
         # Trampolines: views of the library's buffers, every exception caught and stored.
         def call(fn, *args):
@@ -103,8 +105,10 @@ class Solver:
                                                v(C, (n, n), True))) if damping else None,
             _FORCE(lambda t, q, qd, o, u: call(constraint_accel, t, v(q, (n,)), v(qd, (n,)),
                                                v(o, (m,), True))) if constraint_accel else None,
+            _CONSTRAINT(lambda t, q, o, u: call(constraint_dt, t, v(q, (n,)),
+                                                v(o, (m,), True))) if m and constraint_dt else None,
         ]
-        mc, fc, cc, jc, kc, dc, ac = self._cbs
+        mc, fc, cc, jc, kc, dc, ac, tc = self._cbs
         self._check(_ffi.ga_set_callbacks(self._ptr, _cast(mc, _ffi.MASS_FN),
                                           _cast(fc, _ffi.FORCE_FN),
                                           _cast(cc, _ffi.CONSTRAINT_FN),
@@ -115,6 +119,8 @@ class Solver:
         if ac:
             self._check(_ffi.ga_set_constraint_accel(self._ptr,
                                                      _cast(ac, _ffi.CONSTRAINT_ACCEL_FN)))
+        if tc:
+            self._check(_ffi.ga_set_constraint_dt(self._ptr, _cast(tc, _ffi.CONSTRAINT_FN)))
         if rho_inf is not None:
             self.set_rho_inf(rho_inf)
         if params is not None:
