@@ -43,6 +43,7 @@ typedef struct model {
     ga_jacobian_fn jacobian;
     ga_stiffness_fn stiffness;
     ga_constraint_accel_fn accel;
+    ga_constraint_fn dt; /* Phi_t (0: the scenes' constraints do not depend on t) */
     void *user;
     double q0[AN31_N], v0[AN31_N], t_end, h0;
     int constant_mass;
@@ -169,6 +170,7 @@ static run_result run_galpha_mode(const model *md, double h, double newton_tol, 
     ga_set_callbacks(s, md->mass, md->force, md->constraint, md->jacobian, md->user);
     ga_set_tangents(s, md->stiffness, NULL);
     ga_set_constraint_accel(s, md->accel);
+    ga_set_constraint_dt(s, md->dt);
     ga_set_constant_mass(s, md->constant_mass);
     ga_set_rho_inf(s, 0.7);
     if (newton_tol > 0.0) /* else the default: 1e-2 rtol in adaptive mode */
@@ -219,7 +221,8 @@ int main(int argc, char **argv)
     if (strcmp(which, "slider_crank") == 0) {
         SC = slider_crank_paper();
         md = (model){"slider_crank", SC_N, SC_M, sc_mass, sc_force, sc_constraint, sc_jacobian,
-                     sc_stiffness, sc_constraint_accel, &SC, {0}, {0}, 1.0, 5e-3, 1, NULL, 0,
+                     sc_stiffness, sc_constraint_accel, sc_constraint_dt, &SC, {0}, {0}, 1.0,
+                     5e-3, 1, NULL, 0,
                      0, NULL, NULL, NULL, NULL};
         sc_initial(&SC, M_PI / 2, md.q0, md.v0);
         /* reference: independent RK4 on the index-1 form, 400 000 steps */
@@ -233,7 +236,8 @@ int main(int argc, char **argv)
         md.compared = 1;
     } else {
         md = (model){"andrews7", AN7_N, AN7_M, an7_mass, an7_force, an7_constraint,
-                     an7_jacobian, NULL, an7_constraint_accel, NULL, {0}, {0}, andrews_t_end,
+                     an7_jacobian, NULL, an7_constraint_accel, an7_constraint_dt, NULL, {0},
+                     {0}, andrews_t_end,
                      3e-4, 0, andrews_q_ref, 0, 7, NULL, NULL, NULL, NULL};
         memcpy(md.q0, andrews_q0, sizeof andrews_q0);
     }

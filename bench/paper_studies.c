@@ -380,6 +380,7 @@ static void adaptive(const char *dir)
             ga_create(7, 6, &s);
             ga_set_callbacks(s, a7.mass, a7.force, a7.constraint, a7.jacobian, NULL);
             ga_set_constraint_accel(s, a7.accel);
+            ga_set_constraint_dt(s, an7_constraint_dt); /* Phi_t = 0, no differences in t */
             ga_set_rho_inf(s, 0.7);
             ga_set_formulation(s, form);
             ga_set_tolerances(s, rtol, rtol);

@@ -496,3 +496,17 @@ int an31_point(char name)
     default: return -1;
     }
 }
+
+int an7_constraint_dt(double t, const double *q, double *out, void *user)
+{
+    (void)t, (void)q, (void)user;
+    memset(out, 0, sizeof(double) * AN7_M);
+    return 0;
+}
+
+int an31_constraint_dt(double t, const double *q, double *out, void *user)
+{
+    (void)t, (void)q, (void)user;
+    memset(out, 0, sizeof(double) * AN31_M);
+    return 0;
+}

@@ -44,6 +44,8 @@ int an7_force(double t, const double *q, const double *v, double *f, void *user)
 int an7_constraint(double t, const double *q, double *phi, void *user);
 int an7_jacobian(double t, const double *q, double *Phi_q, void *user);
 int an7_constraint_accel(double t, const double *q, const double *v, double *out, void *user);
+/* Phi_t = 0: the mechanism's constraints do not depend on t */
+int an7_constraint_dt(double t, const double *q, double *out, void *user);
 /* Energy balance T + V - mom (beta - beta0). */
 double an7_energy(const double *q, const double *v);
 /* Position of point F (end of the crank) and its acceleration. */
@@ -55,6 +57,7 @@ int an31_force(double t, const double *q, const double *v, double *f, void *user
 int an31_constraint(double t, const double *q, double *phi, void *user);
 int an31_jacobian(double t, const double *q, double *Phi_q, void *user);
 int an31_constraint_accel(double t, const double *q, const double *v, double *out, void *user);
+int an31_constraint_dt(double t, const double *q, double *out, void *user); /* 0 */
 /* K_t = d(Phi_q^T lambda)/dq - df/dq (M is constant): rotation terms and the spring at D. */
 int an31_stiffness(double t, const double *q, const double *v, const double *qdd,
                    const double *lambda, double *K, void *user);

@@ -196,3 +196,11 @@ void chain_initial(const chain *c, double *q, double *v)
         q[Q(i, TH)] = 0.0;
     }
 }
+
+int chain_constraint_dt(double t, const double *q, double *out, void *user)
+{
+    const chain *c = user;
+    (void)t, (void)q;
+    memset(out, 0, sizeof(double) * 2 * (size_t)c->links);
+    return 0;
+}

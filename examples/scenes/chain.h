@@ -36,6 +36,8 @@ int chain_jacobian(double t, const double *q, double *J, void *user);
 int chain_stiffness(double t, const double *q, const double *v, const double *qdd,
                     const double *lambda, double *K, void *user);
 int chain_constraint_accel(double t, const double *q, const double *v, double *out, void *user);
+/* Phi_t = 0 (the pin is fixed) */
+int chain_constraint_dt(double t, const double *q, double *out, void *user);
 
 void chain_initial(const chain *c, double *q, double *v);
 

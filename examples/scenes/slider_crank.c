@@ -144,3 +144,10 @@ void sc_initial(const slider_crank *p, double theta1, double *q, double *v)
     q[SC_X3] = x5 + p->l2 * cos(theta2);
     q[SC_X4] = q[SC_X3] + p->rest_length;
 }
+
+int sc_constraint_dt(double t, const double *q, double *out, void *user)
+{
+    (void)t, (void)q, (void)user;
+    memset(out, 0, sizeof(double) * SC_M);
+    return 0;
+}

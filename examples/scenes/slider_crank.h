@@ -33,6 +33,8 @@ int sc_force(double t, const double *q, const double *v, double *f, void *user);
 int sc_constraint(double t, const double *q, double *phi, void *user);
 int sc_jacobian(double t, const double *q, double *Phi_q, void *user);
 int sc_constraint_accel(double t, const double *q, const double *v, double *out, void *user);
+/* Phi_t = 0: no driving constraint */
+int sc_constraint_dt(double t, const double *q, double *out, void *user);
 /* K_t = d(Phi_q^T lambda)/dq - df/dq (M is constant); C_t = 0 (f does not depend on v). */
 int sc_stiffness(double t, const double *q, const double *v, const double *qdd,
                  const double *lambda, double *K, void *user);
