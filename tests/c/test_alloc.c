@@ -209,6 +209,44 @@ static void no_allocation_in_sparse_step(void **state)
     assert_int_equal(count_sparse_step_allocations(1, GA_INDEX2_STABILIZED, 1), 0);
 }
 
+/* Every dense LU kernel, index 3 and 2, on a 12-link chain (declared patterns, dense solver
+ * forced; 60 unknowns: GA_LINEAR_DENSE measures the fill of each matrix before it chooses). */
+static long count_dense_step_allocations(int solver, int formulation)
+{
+    chain c = chain_make(12);
+    const int n = 3 * c.links, m = 2 * c.links;
+    double q[36], v[36];
+    ga_solver *s = NULL;
+    chain_initial(&c, q, v);
+    assert_int_equal(ga_create(n, m, &s), GA_OK);
+    assert_int_equal(chain_declare_patterns(&c, s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
+                                      chain_jacobian, &c),
+                     GA_OK);
+    assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
+    assert_int_equal(ga_set_linear_solver(s, solver), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    allocations = 0;
+    armed = 1;
+    for (int i = 0; i < 30; ++i)
+        assert_int_equal(ga_step(s, 2e-3), GA_OK);
+    armed = 0;
+    ga_free(s);
+    return allocations;
+}
+
+static void no_allocation_with_any_dense_kernel(void **state)
+{
+    (void)state;
+    const int solvers[] = {GA_LINEAR_DENSE, GA_LINEAR_DENSE_UNBLOCKED, GA_LINEAR_DENSE_EIGEN,
+                           GA_LINEAR_DENSE_LAPACK};
+    for (size_t k = 0; k < sizeof solvers / sizeof solvers[0]; ++k) {
+        assert_int_equal(count_dense_step_allocations(solvers[k], GA_INDEX3), 0);
+        assert_int_equal(count_dense_step_allocations(solvers[k], GA_INDEX2_STABILIZED), 0);
+    }
+}
+
 /* Redundant constraints dropped (GA_REDUNDANT_DROP): the pendulum's constraint twice. */
 static void no_allocation_with_dropped_constraints(void **state)
 {
@@ -233,6 +271,7 @@ int main(void)
         cmocka_unit_test(no_allocation_in_failing_step),
         cmocka_unit_test(no_allocation_in_sparse_step),
         cmocka_unit_test(no_allocation_with_dropped_constraints),
+        cmocka_unit_test(no_allocation_with_any_dense_kernel),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
