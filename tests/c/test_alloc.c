@@ -162,10 +162,12 @@ static void no_allocation_in_step(void **state)
     assert_int_equal(count_step_allocations_in(GA_TANGENT_AUTO, 0, GA_INDEX2_STABILIZED, 1, 0), 0);
 }
 
-/* The sparse path (KLU refactorization, grouped finite differences): no allocation either. */
-static long count_sparse_step_allocations(int exact_tangent, int formulation, int adaptive)
+/* A chain with declared patterns: the sparse path (KLU refactorization, grouped finite
+ * differences) or a dense LU kernel forced (solver). */
+static long count_chain_step_allocations(int links, int solver, int exact_tangent,
+                                         int formulation, int adaptive)
 {
-    chain c = chain_make(300);
+    chain c = chain_make(links);
     const int n = 3 * c.links, m = 2 * c.links;
     double *q = malloc(sizeof(double) * n), *v = malloc(sizeof(double) * n);
     ga_solver *s = NULL;
@@ -179,7 +181,7 @@ static long count_sparse_step_allocations(int exact_tangent, int formulation, in
         assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
     else /* grouped finite differences at every matrix */
         assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
-    assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    assert_int_equal(ga_set_linear_solver(s, solver), GA_OK);
     assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
     assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
@@ -199,6 +201,12 @@ static long count_sparse_step_allocations(int exact_tangent, int formulation, in
     return allocations;
 }
 
+static long count_sparse_step_allocations(int exact_tangent, int formulation, int adaptive)
+{
+    return count_chain_step_allocations(300, GA_LINEAR_SPARSE, exact_tangent, formulation,
+                                        adaptive);
+}
+
 static void no_allocation_in_sparse_step(void **state)
 {
     (void)state;
@@ -209,41 +217,17 @@ static void no_allocation_in_sparse_step(void **state)
     assert_int_equal(count_sparse_step_allocations(1, GA_INDEX2_STABILIZED, 1), 0);
 }
 
-/* Every dense LU kernel, index 3 and 2, on a 12-link chain (declared patterns, dense solver
- * forced; 60 unknowns: GA_LINEAR_DENSE measures the fill of each matrix before it chooses). */
-static long count_dense_step_allocations(int solver, int formulation)
-{
-    chain c = chain_make(12);
-    const int n = 3 * c.links, m = 2 * c.links;
-    double q[36], v[36];
-    ga_solver *s = NULL;
-    chain_initial(&c, q, v);
-    assert_int_equal(ga_create(n, m, &s), GA_OK);
-    assert_int_equal(chain_declare_patterns(&c, s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
-                                      chain_jacobian, &c),
-                     GA_OK);
-    assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
-    assert_int_equal(ga_set_linear_solver(s, solver), GA_OK);
-    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
-    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
-    allocations = 0;
-    armed = 1;
-    for (int i = 0; i < 30; ++i)
-        assert_int_equal(ga_step(s, 2e-3), GA_OK);
-    armed = 0;
-    ga_free(s);
-    return allocations;
-}
-
+/* Every dense LU kernel, index 3 and 2, on a 12-link chain (60 unknowns: GA_LINEAR_DENSE
+ * measures the fill of each matrix before it chooses). */
 static void no_allocation_with_any_dense_kernel(void **state)
 {
     (void)state;
     const int solvers[] = {GA_LINEAR_DENSE, GA_LINEAR_DENSE_UNBLOCKED, GA_LINEAR_DENSE_EIGEN,
                            GA_LINEAR_DENSE_LAPACK};
     for (size_t k = 0; k < sizeof solvers / sizeof solvers[0]; ++k) {
-        assert_int_equal(count_dense_step_allocations(solvers[k], GA_INDEX3), 0);
-        assert_int_equal(count_dense_step_allocations(solvers[k], GA_INDEX2_STABILIZED), 0);
+        assert_int_equal(count_chain_step_allocations(12, solvers[k], 1, GA_INDEX3, 0), 0);
+        assert_int_equal(
+            count_chain_step_allocations(12, solvers[k], 1, GA_INDEX2_STABILIZED, 0), 0);
     }
 }
 
