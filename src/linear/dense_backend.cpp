@@ -25,16 +25,25 @@ namespace ga {
 
 namespace {
 
-void add_block(Eigen::Ref<Mat> target, double c, const ModelMatrix &A)
+// S(row0 + i, col0 + j) += c A(i, j); S column-major with leading dimension ld. Plain loops:
+// at mechanism sizes Eigen's block expressions cost several times the additions.
+void add_block(double *S, int ld, int row0, int col0, double c, const ModelMatrix &A)
 {
+    const double *a = A.data();
     if (A.dense()) {
-        target += c * A.as_dense();
+        const int rows = A.rows();
+        for (int j = 0; j < A.cols(); ++j) {
+            double *s = S + static_cast<std::ptrdiff_t>(col0 + j) * ld + row0;
+            const double *aj = a + static_cast<std::ptrdiff_t>(j) * rows;
+            for (int i = 0; i < rows; ++i)
+                s[i] += c * aj[i];
+        }
         return;
     }
     const auto &ri = A.row_index();
     const auto &ci = A.col_index();
     for (int k = 0; k < A.nnz(); ++k)
-        target(ri[k], ci[k]) += c * A.data()[k];
+        S[static_cast<std::ptrdiff_t>(col0 + ci[k]) * ld + row0 + ri[k]] += c * a[k];
 }
 
 class DenseBackend final : public LinearBackend {
@@ -62,27 +71,30 @@ public:
 
     bool factorize(const SaddleBlocks &b) override
     {
+        const int N = n_ + m_;
+        double *S = S_.data();
         S_.setZero();
-        auto A = S_.topLeftCorner(n_, n_);
         if (b.M)
-            add_block(A, b.cM, *b.M);
+            add_block(S, N, 0, 0, b.cM, *b.M);
         else
-            A.diagonal().setOnes();
+            S_.topLeftCorner(n_, n_).diagonal().setOnes();
         if (b.C)
-            add_block(A, b.cC, *b.C);
+            add_block(S, N, 0, 0, b.cC, *b.C);
         if (b.K)
-            add_block(A, b.cK, *b.K);
+            add_block(S, N, 0, 0, b.cK, *b.K);
         if (m_ > 0) {
-            add_block(S_.bottomLeftCorner(m_, n_), 1.0, *b.J);
+            add_block(S, N, n_, 0, 1.0, *b.J);
             if (b.active)
                 for (int i = 0; i < m_; ++i)
                     if (!b.active[i]) {
                         S_.row(n_ + i).setZero();
                         S_(n_ + i, n_ + i) = 1.0;
                     }
-            S_.topRightCorner(n_, m_) = S_.bottomLeftCorner(m_, n_).transpose();
+            for (int j = 0; j < m_; ++j)  // Phi_q^T: column n + j is row n + j of the lower block
+                for (int i = 0; i < n_; ++i)
+                    S[static_cast<std::ptrdiff_t>(n_ + j) * N + i] =
+                        S[static_cast<std::ptrdiff_t>(i) * N + n_ + j];
         }
-        const int N = n_ + m_;
         rcond_valid_ = false;
         unblocked_ = kind_ == DenseKind::Unblocked ||
                      (kind_ == DenseKind::Auto && unblocked_lu_preferred(N, S_.data()));

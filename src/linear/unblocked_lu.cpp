@@ -7,6 +7,14 @@
 namespace ga {
 
 namespace {
+// y[i] -= a x[i] over [begin, end): distinct columns, so the compiler may assume no overlap
+inline void subtract_scaled(double *__restrict y, const double *__restrict x, double a,
+                            int begin, int end)
+{
+    for (int i = begin; i < end; ++i)
+        y[i] -= x[i] * a;
+}
+
 inline double *column(double *A, int N, int j) { return A + static_cast<std::ptrdiff_t>(j) * N; }
 inline const double *column(const double *A, int N, int j)
 {
@@ -66,8 +74,7 @@ bool unblocked_lu(int N, double *A, int *ipiv, int *extent)
             double *cj = column(A, N, j);
             const double u = cj[k];
             if (u != 0.0)
-                for (int i = k + 1; i < end; ++i)
-                    cj[i] -= ck[i] * u;
+                subtract_scaled(cj, ck, u, k + 1, end);
         }
     }
     // The extent of the final factors, for the solves (later row exchanges move the
@@ -93,19 +100,15 @@ void unblocked_lu_solve(int N, const double *LU, const int *ipiv, const int *ext
             std::swap(b[k], b[ipiv[k]]);
     for (int k = 0; k < N; ++k) {  // L y = P b, unit diagonal
         const double y = b[k];
-        if (y != 0.0) {
-            const double *ck = column(LU, N, k);
-            for (int i = k + 1; i < l_end[k]; ++i)
-                b[i] -= ck[i] * y;
-        }
+        if (y != 0.0)
+            subtract_scaled(b, column(LU, N, k), y, k + 1, l_end[k]);
     }
     for (int k = N - 1; k >= 0; --k) {  // U x = y
         const double *ck = column(LU, N, k);
         b[k] /= ck[k];
         const double x = b[k];
         if (x != 0.0)
-            for (int i = u_begin[k]; i < k; ++i)
-                b[i] -= ck[i] * x;
+            subtract_scaled(b, ck, x, u_begin[k], k);
     }
 }
 
