@@ -32,7 +32,7 @@
 
 /* CPU time of a setting: the best of this many runs, for IDA and galpha alike (this shared
  * virtual machine scatters single runs of a millisecond by up to 50 %). */
-#define REPEATS 11
+#define REPEATS 31
 
 typedef struct model {
     const char *name;

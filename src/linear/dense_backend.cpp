@@ -59,6 +59,7 @@ public:
         S_.setZero(N, N);
         ipiv_.setZero(N);
         extent_.setZero(2 * N);
+        inverse_diagonal_.setZero(N);
         iwork_.setZero(N);
         work_.setZero(4 * static_cast<Eigen::Index>(N));
         x_.setZero(N);
@@ -110,7 +111,7 @@ public:
                 return false;
             }
         } else if (unblocked_) {
-            if (!unblocked_lu(N, S_.data(), ipiv_.data(), extent_.data())) {
+            if (!unblocked_lu(N, S_.data(), ipiv_.data(), extent_.data(), inverse_diagonal_.data())) {
                 pivot_ratio_ = 0.0;
                 return false;
             }
@@ -141,7 +142,8 @@ public:
     void solve(Vec &rhs) override
     {
         if (unblocked_) {
-            unblocked_lu_solve(n_ + m_, S_.data(), ipiv_.data(), extent_.data(), rhs.data());
+            unblocked_lu_solve(n_ + m_, S_.data(), ipiv_.data(), extent_.data(),
+                               inverse_diagonal_.data(), rhs.data());
             return;
         }
         if (in_eigen()) {
@@ -172,7 +174,7 @@ private:
     mutable Eigen::VectorXi iwork_;
     Eigen::VectorXi ipiv_, extent_;
     mutable Vec work_;
-    Vec x_;
+    Vec x_, inverse_diagonal_;
     Eigen::PartialPivLU<Mat> eigen_lu_;
     mutable double anorm_ = 0.0;
     double pivot_ratio_ = 0.0;

@@ -34,7 +34,7 @@ struct Index2Matrix::Dense {
     Mat S, A, Bd;
     Eigen::PartialPivLU<Mat> lu;
     Eigen::VectorXi ipiv, extent;
-    Vec rhs, x;
+    Vec rhs, x, inverse_diagonal;
     double pivot_ratio = 0.0;
 };
 
@@ -143,6 +143,7 @@ void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const 
         d->lu = Eigen::PartialPivLU<Mat>(N);
     d->ipiv.setZero(N);
     d->extent.setZero(2 * N);
+    d->inverse_diagonal.setZero(N);
     d->rhs.setZero(N);
     d->x.setZero(N);
     dense_ = std::move(d);
@@ -218,7 +219,8 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
     d.unblocked = d.kind == DenseKind::Unblocked ||
                   (d.kind == DenseKind::Auto && unblocked_lu_preferred(N, d.S.data()));
     if (d.unblocked) {
-        if (!unblocked_lu(N, d.S.data(), d.ipiv.data(), d.extent.data())) {
+        if (!unblocked_lu(N, d.S.data(), d.ipiv.data(), d.extent.data(),
+                          d.inverse_diagonal.data())) {
             d.pivot_ratio = 0.0;
             return false;
         }
@@ -268,7 +270,7 @@ void Index2Matrix::solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const 
     if (x.unblocked) {
         x.x = x.rhs;
         unblocked_lu_solve(n + 2 * m, x.S.data(), x.ipiv.data(), x.extent.data(),
-                           x.x.data());
+                           x.inverse_diagonal.data(), x.x.data());
     } else {
         x.x.noalias() = x.lu.solve(x.rhs);
     }

@@ -43,7 +43,7 @@ bool unblocked_lu_preferred(int N, const double *A)
     return static_cast<double>(nonzero) <= kUnblockedMaxFill * static_cast<double>(entries);
 }
 
-bool unblocked_lu(int N, double *A, int *ipiv, int *extent)
+bool unblocked_lu(int N, double *A, int *ipiv, int *extent, double *inverse_diagonal)
 {
     int *l_end = extent, *u_begin = extent + N;
     for (int k = 0; k < N; ++k) {
@@ -66,6 +66,7 @@ bool unblocked_lu(int N, double *A, int *ipiv, int *extent)
         while (end > k + 1 && ck[end - 1] == 0.0)
             --end;
         const double inverse = 1.0 / ck[k];
+        inverse_diagonal[k] = inverse;  // the solves multiply: a division stalls their chain
         for (int i = k + 1; i < end; ++i)
             ck[i] *= inverse;
         // rank-one update of the trailing matrix, column by column; a zero entry of row k
@@ -92,7 +93,8 @@ bool unblocked_lu(int N, double *A, int *ipiv, int *extent)
     return true;
 }
 
-void unblocked_lu_solve(int N, const double *LU, const int *ipiv, const int *extent, double *b)
+void unblocked_lu_solve(int N, const double *LU, const int *ipiv, const int *extent,
+                        const double *inverse_diagonal, double *b)
 {
     const int *l_end = extent, *u_begin = extent + N;
     for (int k = 0; k < N; ++k)
@@ -105,7 +107,7 @@ void unblocked_lu_solve(int N, const double *LU, const int *ipiv, const int *ext
     }
     for (int k = N - 1; k >= 0; --k) {  // U x = y
         const double *ck = column(LU, N, k);
-        b[k] /= ck[k];
+        b[k] *= inverse_diagonal[k];
         const double x = b[k];
         if (x != 0.0)
             subtract_scaled(b, ck, x, u_begin[k], k);

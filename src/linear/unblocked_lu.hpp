@@ -24,9 +24,10 @@ bool unblocked_lu_preferred(int N, const double *A);
 
 // false on an exactly zero pivot column (the factors are then incomplete). extent (2N ints):
 // where the nonzeros of each column of L end and those of each column of U begin, so that
-// banded factors are walked over their band only.
-bool unblocked_lu(int N, double *A, int *ipiv, int *extent);
+// banded factors are walked over their band only; inverse_diagonal (N): 1 / U_kk.
+bool unblocked_lu(int N, double *A, int *ipiv, int *extent, double *inverse_diagonal);
 // b <- A^-1 b with the factors of unblocked_lu.
-void unblocked_lu_solve(int N, const double *LU, const int *ipiv, const int *extent, double *b);
+void unblocked_lu_solve(int N, const double *LU, const int *ipiv, const int *extent,
+                        const double *inverse_diagonal, double *b);
 
 }  // namespace ga
