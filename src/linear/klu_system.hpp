@@ -38,10 +38,14 @@ public:
 
 private:
     std::vector<int> reverse_cuthill_mckee() const;
+    void scale_rows();    // values_ <- D values_
+    void unscale_rows();  // and back
 
     int N_ = 0;
     std::vector<int> colptr_, rowind_;
     std::vector<double> values_;
+    std::vector<double> row_scale_;  // D: 1 / the largest entry of each row at the last full
+                                     // factorization
     klu_common common_;
     klu_symbolic *symbolic_ = nullptr;
     klu_numeric *numeric_ = nullptr;
