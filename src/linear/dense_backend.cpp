@@ -111,7 +111,8 @@ public:
                 return false;
             }
         } else if (unblocked_) {
-            if (!unblocked_lu(N, S_.data(), ipiv_.data(), extent_.data(), inverse_diagonal_.data())) {
+            if (!unblocked_lu(N, S_.data(), ipiv_.data(), extent_.data(),
+                              inverse_diagonal_.data())) {
                 pivot_ratio_ = 0.0;
                 return false;
             }

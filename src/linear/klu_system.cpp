@@ -24,9 +24,9 @@ KluSystem::KluSystem()
     // whole matrix; the chain's index-3 steps cost the same).
     common_.btf = 0;
     // Row scaling by the largest entry of each row, as KLU's default, but done here and kept
-    // from one full factorization to the next: a refactorization has its pivots already, and
-    // row scaling does not change what they do, only KLU's scaling pass (with its checks of
-    // the pattern) cost a quarter of each refactorization of a small system.
+    // from one full factorization to the next: a refactorization keeps its pivots, which a
+    // new scaling would not change, and KLU's scaling pass (with its checks of the pattern)
+    // cost a quarter of each refactorization of a small system.
     common_.scale = -1;
 }
 
