@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <limits>
 
+#include "assemble.hpp"
 #include "backend.hpp"
 #include "unblocked_lu.hpp"
 
@@ -24,27 +25,6 @@ void dgecon_(const char *norm, const int *n, const double *a, const int *lda, co
 namespace ga {
 
 namespace {
-
-// S(row0 + i, col0 + j) += c A(i, j); S column-major with leading dimension ld. Plain loops:
-// at mechanism sizes Eigen's block expressions cost several times the additions.
-void add_block(double *S, int ld, int row0, int col0, double c, const ModelMatrix &A)
-{
-    const double *a = A.data();
-    if (A.dense()) {
-        const int rows = A.rows();
-        for (int j = 0; j < A.cols(); ++j) {
-            double *s = S + static_cast<std::ptrdiff_t>(col0 + j) * ld + row0;
-            const double *aj = a + static_cast<std::ptrdiff_t>(j) * rows;
-            for (int i = 0; i < rows; ++i)
-                s[i] += c * aj[i];
-        }
-        return;
-    }
-    const auto &ri = A.row_index();
-    const auto &ci = A.col_index();
-    for (int k = 0; k < A.nnz(); ++k)
-        S[static_cast<std::ptrdiff_t>(col0 + ci[k]) * ld + row0 + ri[k]] += c * a[k];
-}
 
 class DenseBackend final : public LinearBackend {
 public:

@@ -7,21 +7,13 @@
 #include <utility>
 #include <vector>
 
+#include "assemble.hpp"
 #include "klu_system.hpp"
 #include "unblocked_lu.hpp"
 
 namespace ga {
 
 namespace {
-void add_block(Eigen::Ref<Mat> target, double c, const ModelMatrix &A)
-{
-    if (A.dense()) {
-        target += c * A.as_dense();
-        return;
-    }
-    for (int k = 0; k < A.nnz(); ++k)
-        target(A.row_index()[k], A.col_index()[k]) += c * A.data()[k];
-}
 
 // cM of the scaled system: (1 - alpha_m) / (1 - alpha_f), the factor of M in A
 double mass_factor(const Params &p) { return (1.0 - p.alpha_m) / (1.0 - p.alpha_f); }
@@ -192,18 +184,18 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
     const int n = d.n, m = d.m;
     d.S.setZero();
     d.A.setZero();
-    add_block(d.A, cM, M);  // cM M + gamma h C: also the block that multiplies B^T
+    add_block(d.A.data(), n, 0, 0, cM, M);  // cM M + gamma h C: also the block that multiplies B^T
     if (C)
-        add_block(d.A, p.gamma * h, *C);
+        add_block(d.A.data(), n, 0, 0, p.gamma * h, *C);
     d.Bd.setZero();
-    add_block(d.Bd, 1.0, B);
+    add_block(d.Bd.data(), m, 0, 0, 1.0, B);
     d.S.block(0, n + m, n, m).noalias() = d.A * d.Bd.transpose();
-    auto top_left = d.S.topLeftCorner(n, n);
-    top_left = d.A;
+    d.S.topLeftCorner(n, n) = d.A;
+    const int N = n + 2 * m;
     if (K)
-        add_block(top_left, p.beta * h * h, *K);
+        add_block(d.S.data(), N, 0, 0, p.beta * h * h, *K);
     auto Jd = d.S.block(n, 0, m, n);
-    add_block(Jd, 1.0, J);
+    add_block(d.S.data(), N, n, 0, 1.0, J);
     d.S.block(0, n, n, m) = Jd.transpose();
     d.S.block(n + m, 0, m, n) = Jd;
     d.S.block(n + m, n + m, m, m).noalias() = Jd * d.Bd.transpose();
@@ -215,7 +207,6 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
                     d.S.col(k).setZero();
                     d.S(k, k) = 1.0;
                 }
-    const int N = n + 2 * m;
     d.unblocked = d.kind == DenseKind::Unblocked ||
                   (d.kind == DenseKind::Auto && unblocked_lu_preferred(N, d.S.data()));
     if (d.unblocked) {
