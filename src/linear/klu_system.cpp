@@ -102,6 +102,7 @@ bool KluSystem::factorize()
     for (double &r : row_scale_)
         r = r > 0.0 ? 1.0 / r : 1.0;
     scale_rows();
+    ++full_factorizations_;
     numeric_ = klu_factor(colptr_.data(), rowind_.data(), values_.data(), symbolic_, &common_);
     if (!numeric_) {
         if (common_.status == KLU_OUT_OF_MEMORY)

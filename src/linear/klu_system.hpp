@@ -35,6 +35,8 @@ public:
     // min |U_ii| / max |U_ii| of the last factorization (KLU's estimate)
     double rcond() const { return rcond_; }
     const char *ordering() const { return ordering_; }
+    // Factorizations with new pivots so far (the others were refactorizations).
+    int full_factorizations() const { return full_factorizations_; }
 
 private:
     std::vector<int> reverse_cuthill_mckee() const;
@@ -51,6 +53,7 @@ private:
     klu_numeric *numeric_ = nullptr;
     double rcond_ = 0.0;
     const char *ordering_ = "AMD";
+    int full_factorizations_ = 0;
 };
 
 }  // namespace ga
