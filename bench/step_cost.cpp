@@ -130,6 +130,18 @@ Result measure(const Scene &sc, int solver, double tol, int repeats)
     return r;
 }
 
+// The chain at rest, h = 1e-3 for `steps` steps, declared patterns.
+Scene chain_scene(chain &c, int steps)
+{
+    const int links = c.links;
+    Scene sc{"chain", 3 * links, 2 * links, chain_mass, chain_force, chain_constraint,
+             chain_jacobian, chain_stiffness, chain_constraint_accel, &c,
+             std::vector<double>(3 * links), std::vector<double>(3 * links), 1e-3,
+             steps * 1e-3, 0.7, 1, declare_chain};
+    chain_initial(&c, sc.q0.data(), sc.v0.data());
+    return sc;
+}
+
 slider_crank g_sc;
 
 std::vector<Scene> paper_scenes()
@@ -207,11 +219,7 @@ int main(int argc, char **argv)
         const int links = std::atoi(argv[2]);
         const int steps = argc > 3 ? std::atoi(argv[3]) : 10;
         chain c = chain_make(links);
-        Scene sc{"chain", 3 * links, 2 * links, chain_mass, chain_force, chain_constraint,
-                 chain_jacobian, chain_stiffness, chain_constraint_accel, &c,
-                 std::vector<double>(3 * links), std::vector<double>(3 * links), 1e-3,
-                 steps * 1e-3, 0.7, 1, declare_chain};
-        chain_initial(&c, sc.q0.data(), sc.v0.data());
+        Scene sc = chain_scene(c, steps);
         ga_solver *s = make(sc, GA_LINEAR_SPARSE, 1e-10);
         ga_init(s, 0.0, sc.q0.data(), sc.v0.data());
         for (int k = 0; k < steps; ++k)
@@ -226,11 +234,7 @@ int main(int argc, char **argv)
         const double tol = argc > 4 ? std::atof(argv[4]) : 1e-10;
         const int formulation = argc > 5 ? std::atoi(argv[5]) : GA_INDEX3;
         chain c = chain_make(links);
-        Scene sc{"chain", 3 * links, 2 * links, chain_mass, chain_force, chain_constraint,
-                 chain_jacobian, chain_stiffness, chain_constraint_accel, &c,
-                 std::vector<double>(3 * links), std::vector<double>(3 * links), 1e-3,
-                 steps * 1e-3, 0.7, 1, declare_chain};
-        chain_initial(&c, sc.q0.data(), sc.v0.data());
+        Scene sc = chain_scene(c, steps);
         sc.formulation = formulation;
         sc.dt = chain_constraint_dt;  // Phi_t = 0: no differences in t in index-2 steps
         const Result r = measure(sc, GA_LINEAR_SPARSE, tol, links > 20000 ? 1 : 3);

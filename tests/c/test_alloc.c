@@ -13,7 +13,7 @@
 #include <galpha.h>
 
 #include "helpers.h"
-#include "scenes/chain.h"
+#include "chain_solver.h"
 
 static volatile int armed = 0;
 static volatile long allocations = 0;
@@ -168,19 +168,10 @@ static long count_chain_step_allocations(int links, int solver, int exact_tangen
                                          int formulation, int adaptive)
 {
     chain c = chain_make(links);
-    const int n = 3 * c.links, m = 2 * c.links;
+    const int n = 3 * c.links;
     double *q = malloc(sizeof(double) * n), *v = malloc(sizeof(double) * n);
-    ga_solver *s = NULL;
     chain_initial(&c, q, v);
-    assert_int_equal(ga_create(n, m, &s), GA_OK);
-    assert_int_equal(chain_declare_patterns(&c, s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
-                                      chain_jacobian, &c),
-                     GA_OK);
-    if (exact_tangent)
-        assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
-    else /* grouped finite differences at every matrix */
-        assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
+    ga_solver *s = chain_solver(&c, exact_tangent);
     assert_int_equal(ga_set_linear_solver(s, solver), GA_OK);
     assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
     assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);

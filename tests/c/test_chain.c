@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "helpers.h"
-#include "scenes/chain.h"
+#include "chain_solver.h"
 
 typedef struct chain_run {
     double *q, *lambda;
@@ -59,20 +59,11 @@ static chain_run run_formulation(int links, int solver, int formulation, int exa
     const int n = 3 * links, m = 2 * links;
     chain_run r;
     double *q = malloc(sizeof(double) * n), *v = malloc(sizeof(double) * n);
-    ga_solver *s = NULL;
     memset(&r, 0, sizeof r);
     r.q = malloc(sizeof(double) * n);
     r.lambda = malloc(sizeof(double) * m);
     chain_initial(&c, q, v);
-    assert_int_equal(ga_create(n, m, &s), GA_OK);
-    assert_int_equal(chain_declare_patterns(&c, s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
-                                      chain_jacobian, &c),
-                     GA_OK);
-    if (exact_tangent)
-        assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
-    else /* grouped finite differences at every matrix, not only once they matter */
-        assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
+    ga_solver *s = chain_solver(&c, exact_tangent);
     assert_int_equal(ga_set_constraint_accel(s, chain_constraint_accel), GA_OK);
     assert_int_equal(ga_set_constant_mass(s, 1), GA_OK);
     assert_int_equal(ga_set_linear_solver(s, solver), GA_OK);
@@ -176,16 +167,10 @@ static void index2_on_a_sparse_solver_set_up_already(void **state)
 {
     (void)state;
     chain c = chain_make(2000);
-    const int n = 3 * c.links, m = 2 * c.links;
+    const int n = 3 * c.links;
     double *q = malloc(sizeof(double) * n), *v = malloc(sizeof(double) * n);
-    ga_solver *s = NULL;
     chain_initial(&c, q, v);
-    assert_int_equal(ga_create(n, m, &s), GA_OK);
-    assert_int_equal(chain_declare_patterns(&c, s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
-                                      chain_jacobian, &c),
-                     GA_OK);
-    assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
+    ga_solver *s = chain_solver(&c, 1);
     assert_int_equal(ga_set_constraint_accel(s, chain_constraint_accel), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     assert_string_equal(ga_linear_solver_name(s), "sparse KLU");

@@ -1,0 +1,27 @@
+/* A solver for the N-link chain with its declared patterns and callbacks, shared by the suites
+ * that run it (include after cmocka.h). */
+#ifndef GALPHA_TEST_CHAIN_SOLVER_H
+#define GALPHA_TEST_CHAIN_SOLVER_H
+
+#include <galpha.h>
+
+#include "scenes/chain.h"
+
+/* exact_tangent: K_t by callback; otherwise grouped finite differences at every matrix, not
+ * only once they matter. */
+static inline ga_solver *chain_solver(chain *c, int exact_tangent)
+{
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(3 * c->links, 2 * c->links, &s), GA_OK);
+    assert_int_equal(chain_declare_patterns(c, s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
+                                      chain_jacobian, c),
+                     GA_OK);
+    if (exact_tangent)
+        assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
+    else
+        assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
+    return s;
+}
+
+#endif
