@@ -284,8 +284,9 @@ typedef enum ga_reuse_mode {
     GA_REUSE_AUTO = 0, /**< modified Newton (default): keep the factorization across iterations
                             and steps; rebuild it when there is none yet, when h changed by more
                             than the factor 5/3 in h^2 since it was built (IDA's band), when the
-                            iteration contracts slower than 0.5 per iteration, and after any
-                            failed step. A step that fails to converge with an old matrix is
+                            contraction measured with it says the tolerance cannot be reached
+                            within 4 iterations on that matrix (or the iteration diverges), and
+                            after any failed step. A step that fails to converge with an old matrix is
                             retried once with a fresh one before GA_ERR_NEWTON is reported. */
     GA_REUSE_NEVER = 1 /**< full Newton as printed in Algorithm 1: tangents and factorization
                             at every iteration */

@@ -506,6 +506,186 @@ static void step_size_floor_is_reported(void **state)
     ga_free(s);
 }
 
+/* ---- failures inside adaptive steps: retried smaller, or reported with the state kept ----- */
+/* The pendulum with a force callback that refuses (returns > 0, recoverable) to evaluate
+ * positions further than max_move from the last accepted ones, as a material model refuses
+ * too large a strain increment; or fails for good (< 0) from t_fatal on. */
+typedef struct guarded_pendulum {
+    pendulum p;
+    double q_accepted[2], max_move, t_fatal;
+    long long refusals;
+} guarded_pendulum;
+
+static int guarded_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    guarded_pendulum *g = u;
+    pendulum_force(t, q, v, f, &g->p);
+    if (t >= g->t_fatal)
+        return -2;
+    if (fmax(fabs(q[0] - g->q_accepted[0]), fabs(q[1] - g->q_accepted[1])) > g->max_move) {
+        ++g->refusals;
+        return 1;
+    }
+    return 0;
+}
+
+static ga_solver *guarded_solver(guarded_pendulum *g, double rtol)
+{
+    ga_solver *s = NULL;
+    double v[2];
+    pendulum_state(&g->p, TH0, OM0, g->q_accepted, v);
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, guarded_force, pendulum_constraint,
+                                      pendulum_jacobian, g),
+                     GA_OK);
+    assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
+    assert_int_equal(ga_set_tolerances(s, rtol, rtol), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, g->q_accepted, v), GA_OK);
+    return s;
+}
+
+static void adaptive_steps_retry_after_recoverable_failures(void **state)
+{
+    (void)state;
+    /* unguarded, rtol = 1e-5: the steps move the bob by up to this much */
+    guarded_pendulum free_run = {P, {0, 0}, INFINITY, INFINITY, 0};
+    ga_solver *s = guarded_solver(&free_run, 1e-5);
+    double largest = 0.0, q[2];
+    while (ga_step_adaptive(s, 1.0) == GA_OK) {
+        ga_get_q(s, q);
+        largest = fmax(largest, max_abs_diff(q, free_run.q_accepted, 2));
+        memcpy(free_run.q_accepted, q, sizeof q);
+        double t;
+        ga_get_t(s, &t);
+        if (t == 1.0)
+            break;
+    }
+    ga_free(s);
+    /* guarded at half of that: the controller's proposals are refused again and again */
+    guarded_pendulum g = {P, {0, 0}, 0.5 * largest, INFINITY, 0};
+    s = guarded_solver(&g, 1e-5);
+    double t = 0.0;
+    while (t < 1.0) {
+        assert_int_equal(ga_step_adaptive(s, 1.0), GA_OK);
+        ga_get_q(s, q);
+        assert_true(max_abs_diff(q, g.q_accepted, 2) <= g.max_move); /* an accepted step */
+        memcpy(g.q_accepted, q, sizeof q);
+        ga_get_t(s, &t);
+    }
+    assert_true(t == 1.0);
+    long long failed, steps;
+    ga_get_counter(s, GA_COUNT_FAILED_STEPS, &failed);
+    ga_get_counter(s, GA_COUNT_STEPS, &steps);
+    exact_pendulum e = {0.0, TH0, OM0};
+    double ex[2], dummy[2];
+    exact_advance(&e, 1.0);
+    pendulum_state(&P, e.th, e.om, ex, dummy);
+    printf("  largest move per step %.3f unguarded; guarded at %.3f: %lld steps, %lld failed "
+           "(%lld refusals), |q - q_exact| = %.1e\n",
+           largest, g.max_move, steps, failed, g.refusals, max_abs_diff(q, ex, 2));
+    assert_true(failed > 0);
+    assert_true(failed <= g.refusals); /* each failed attempt saw at least one refusal */
+    assert_true(max_abs_diff(q, ex, 2) < 1e-3);
+    ga_free(s);
+}
+
+/* A fatal failure ends ga_advance with the state of the last accepted step; once the cause is
+ * gone the run goes on. */
+static void adaptive_fatal_failure_keeps_the_last_accepted_step(void **state)
+{
+    (void)state;
+    guarded_pendulum g = {P, {0, 0}, INFINITY, 0.5, 0};
+    ga_solver *s = guarded_solver(&g, 1e-6);
+    double t, t_before, h_last, before[20], after[20];
+    assert_int_equal(ga_advance(s, 1.0), GA_ERR_CALLBACK);
+    assert_non_null(strstr(ga_last_error(s), "force callback returned -2"));
+    ga_get_t(s, &t);
+    ga_get_h_last(s, &h_last);
+    assert_true(t < 0.5 && t + h_last > 0.4); /* stopped at the last step before the fault */
+    long long failed;
+    ga_get_counter(s, GA_COUNT_FAILED_STEPS, &failed);
+    assert_int_equal(failed, 1);
+    assert_int_equal(ga_get_state(s, before, 20), GA_OK);
+    t_before = t;
+    assert_int_equal(ga_step_adaptive(s, 1.0), GA_ERR_CALLBACK); /* the same again */
+    assert_int_equal(ga_get_state(s, after, 20), GA_OK);
+    assert_memory_equal(before, after, sizeof before);
+    g.t_fatal = INFINITY;
+    assert_int_equal(ga_advance(s, 1.0), GA_OK);
+    ga_get_t(s, &t);
+    assert_true(t == 1.0 && t_before < 0.5);
+    ga_free(s);
+}
+
+/* Newton failures in adaptive mode: at most 2 iterations per step, and a first step of 0.5
+ * (a quarter swing): the step is retried smaller until the iteration converges. */
+static void adaptive_steps_retry_after_newton_failures(void **state)
+{
+    (void)state;
+    ga_solver *s = pendulum_solver(0.9, GA_INDEX2_STABILIZED, 1, 1);
+    assert_int_equal(ga_set_newton(s, 1e-8, 2), GA_OK);
+    assert_int_equal(ga_set_tolerances(s, 1e-4, 1e-4), GA_OK);
+    assert_int_equal(ga_set_initial_step(s, 0.5), GA_OK);
+    assert_int_equal(ga_advance(s, 1.0), GA_OK);
+    long long failed, steps;
+    ga_get_counter(s, GA_COUNT_FAILED_STEPS, &failed);
+    ga_get_counter(s, GA_COUNT_STEPS, &steps);
+    double q[2], ex[2], dummy[2];
+    ga_get_q(s, q);
+    exact_pendulum e = {0.0, TH0, OM0};
+    exact_advance(&e, 1.0);
+    pendulum_state(&P, e.th, e.om, ex, dummy);
+    printf("  Newton limited to 2 iterations, first step 0.5: %lld steps, %lld failed, "
+           "|q - q_exact| = %.1e\n", steps, failed, max_abs_diff(q, ex, 2));
+    assert_true(failed >= 1);
+    assert_true(max_abs_diff(q, ex, 2) < 1e-2);
+    ga_free(s);
+}
+
+/* h_max bounds every step, and the controller proposes no more (GA_INFO_H_NEXT); without the
+ * bound the same run takes longer steps. Each accepted step is the size proposed after the
+ * previous one unless a rejection or the approach to the end of the interval intervened. */
+static void step_size_ceiling_and_proposals(void **state)
+{
+    (void)state;
+    double h_top[2] = {0.0, 0.0};
+    for (int bounded = 0; bounded < 2; ++bounded) {
+        ga_solver *s = pendulum_solver(0.9, GA_INDEX2_STABILIZED, 1, 1);
+        assert_int_equal(ga_set_tolerances(s, 1e-3, 1e-3), GA_OK);
+        if (bounded)
+            assert_int_equal(ga_set_step_limits(s, 0.0, 0.01), GA_OK);
+        double t = 0.0, h, h_next = 0.0, t_prev;
+        long long seen = 0, kept = 0, rejected_before = 0;
+        while (t < 1.0) {
+            t_prev = t;
+            assert_int_equal(ga_step_adaptive(s, 1.0), GA_OK);
+            long long rejected, failed;
+            ga_get_counter(s, GA_COUNT_REJECTED_STEPS, &rejected);
+            ga_get_counter(s, GA_COUNT_FAILED_STEPS, &failed);
+            ga_get_t(s, &t);
+            ga_get_h_last(s, &h);
+            h_top[bounded] = fmax(h_top[bounded], h);
+            /* within 2 proposed steps of the end, the steps are stretched or split to land */
+            if (h_next > 0.0 && rejected == rejected_before && failed == 0 &&
+                t_prev + 2.0 * h_next < 1.0) {
+                ++seen;
+                kept += h == h_next;
+            }
+            rejected_before = rejected;
+            assert_int_equal(ga_get_info(s, GA_INFO_H_NEXT, &h_next), GA_OK);
+            assert_true(h_next > 0.0);
+            if (bounded)
+                assert_true(h <= 0.01 && h_next <= 0.01);
+        }
+        printf("  %s: longest step %.4f, %lld of %lld steps as proposed\n",
+               bounded ? "h_max = 0.01" : "no h_max", h_top[bounded], kept, seen);
+        assert_true(seen > 10 && kept == seen);
+        ga_free(s);
+    }
+    assert_true(h_top[0] > 0.02);
+    assert_true(h_top[1] > 0.0099);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -520,6 +700,10 @@ int main(void)
         cmocka_unit_test(andrews_error_follows_the_tolerance),
         cmocka_unit_test(adaptive_newton_tolerance_follows_rtol),
         cmocka_unit_test(step_size_floor_is_reported),
+        cmocka_unit_test(adaptive_steps_retry_after_recoverable_failures),
+        cmocka_unit_test(adaptive_fatal_failure_keeps_the_last_accepted_step),
+        cmocka_unit_test(adaptive_steps_retry_after_newton_failures),
+        cmocka_unit_test(step_size_ceiling_and_proposals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -26,6 +26,7 @@ typedef enum fault_site {
     CONSTRAINT,
     JACOBIAN,
     STIFFNESS,
+    DAMPING,
     CONSTRAINT_DT
 } fault_site;
 typedef struct faulty {
@@ -90,6 +91,15 @@ static int f_stiffness(double t, const double *q, const double *v, const double 
     return inject(f, STIFFNESS, K);
 }
 
+/* C_t of the pendulum: its force does not depend on v */
+static int f_damping(double t, const double *q, const double *v, double *C, void *u)
+{
+    (void)t, (void)q, (void)v;
+    for (int i = 0; i < 4; ++i)
+        C[i] = 0.0;
+    return inject(u, DAMPING, C);
+}
+
 /* Phi_t of the pendulum: its constraint does not depend on t */
 static int f_constraint_dt(double t, const double *q, double *out, void *u)
 {
@@ -103,22 +113,34 @@ typedef struct fixture {
     ga_solver *s;
 } fixture;
 
+/* The fixture's solver: the pendulum after ten steps of 0.01 (NULL on failure). */
+static ga_solver *pendulum_after_ten_steps(faulty *model)
+{
+    ga_solver *s = NULL;
+    double q[2], v[2];
+    if (ga_create(2, 1, &s) != GA_OK)
+        return NULL;
+    pendulum_state(&model->p, 1.0, 0.5, q, v);
+    int st = ga_set_callbacks(s, f_mass, f_force, f_constraint, f_jacobian, model) ||
+             ga_set_tangents(s, f_stiffness, f_damping) || ga_init(s, 0.0, q, v);
+    for (int i = 0; i < 10 && !st; ++i)
+        st = ga_step(s, 0.01);
+    if (st) {
+        ga_free(s);
+        return NULL;
+    }
+    return s;
+}
+
 static int setup(void **state)
 {
     fixture *x = calloc(1, sizeof *x);
-    double q[2], v[2];
     if (!x)
         return -1;
     x->model.p = (pendulum){1.0, 1.0, 9.81};
-    if (ga_create(2, 1, &x->s) != GA_OK)
+    x->s = pendulum_after_ten_steps(&x->model);
+    if (!x->s)
         return -1;
-    pendulum_state(&x->model.p, 1.0, 0.5, q, v);
-    if (ga_set_callbacks(x->s, f_mass, f_force, f_constraint, f_jacobian, &x->model) ||
-        ga_set_tangents(x->s, f_stiffness, NULL) || ga_init(x->s, 0.0, q, v))
-        return -1;
-    for (int i = 0; i < 10; ++i)
-        if (ga_step(x->s, 0.01) != GA_OK)
-            return -1;
     *state = x;
     return 0;
 }
@@ -147,6 +169,8 @@ static void expect_message(ga_solver *s, const char *part)
         fail_msg("message '%s' does not contain '%s'", ga_last_error(s), part);
 }
 
+static void continues_undisturbed(fixture *x, double *before, size_t len);
+
 /* Run a failing step; check status, message, bit-identical state, then clear the fault and
  * check that the run continues exactly like an undisturbed solver. */
 static void failing_step(fixture *x, ga_status expected, const char *part)
@@ -161,11 +185,19 @@ static void failing_step(fixture *x, ga_status expected, const char *part)
     /* recovery: the same step again, without the fault, equals the undisturbed run */
     x->model.site = NONE;
     x->model.zero_jacobian = 0;
+    continues_undisturbed(x, before, len);
+}
+
+/* The next step of x->s equals that of a fresh solver restored from the checkpoint `before`
+ * (default options, the fixture's callbacks): nothing x->s went through since left a trace. */
+static void continues_undisturbed(fixture *x, double *before, size_t len)
+{
+    double after[STATE_MAX];
     ga_solver *ref = NULL;
     assert_int_equal(ga_create(2, 1, &ref), GA_OK);
     assert_int_equal(ga_set_callbacks(ref, f_mass, f_force, f_constraint, f_jacobian, &x->model),
                      GA_OK);
-    assert_int_equal(ga_set_tangents(ref, f_stiffness, NULL), GA_OK);
+    assert_int_equal(ga_set_tangents(ref, f_stiffness, f_damping), GA_OK);
     assert_int_equal(ga_set_state(ref, before, len), GA_OK);
     assert_int_equal(ga_step(x->s, 0.01), GA_OK);
     assert_int_equal(ga_step(ref, 0.01), GA_OK);
@@ -269,9 +301,15 @@ static void calls_out_of_order_are_refused(void **state)
     ga_free(s);
 }
 
+/* Every refused option names what was wrong and changes nothing: the solver's next steps are
+ * those of a twin that was never asked. */
 static void bad_options_are_refused(void **state)
 {
     fixture *x = *state;
+    double d = 0.0;
+    int rows[1] = {0};
+    ga_solver *twin = pendulum_after_ten_steps(&x->model);
+    assert_non_null(twin);
     assert_int_equal(ga_set_newton(x->s, 0.0, 10), GA_ERR_ARG);
     assert_int_equal(ga_set_newton(x->s, 1.0, 10), GA_ERR_ARG);
     assert_int_equal(ga_set_newton(x->s, NAN, 10), GA_ERR_ARG);
@@ -282,6 +320,109 @@ static void bad_options_are_refused(void **state)
     assert_int_equal(ga_set_init_mode(x->s, 7, 1e-10), GA_ERR_ARG);
     assert_int_equal(ga_set_init_mode(x->s, GA_INIT_PROJECT, 0.0), GA_ERR_ARG);
     assert_int_equal(ga_set_init_mode(x->s, GA_INIT_PROJECT, INFINITY), GA_ERR_ARG);
+    assert_int_equal(ga_set_jacobian_reuse(x->s, 7), GA_ERR_ARG);
+    expect_message(x->s, "unknown reuse mode 7");
+    assert_int_equal(ga_set_constant_mass(x->s, 2), GA_ERR_ARG);
+    expect_message(x->s, "constant mass must be 0 or 1, got 2");
+    assert_int_equal(ga_set_formulation(x->s, 2), GA_ERR_ARG);
+    expect_message(x->s, "unknown formulation 2");
+    assert_int_equal(ga_set_rescale(x->s, 2), GA_ERR_ARG);
+    expect_message(x->s, "rescale must be 0 or 1, got 2");
+    assert_int_equal(ga_set_corrected_start(x->s, -1), GA_ERR_ARG);
+    expect_message(x->s, "corrected start must be 0 or 1, got -1");
+    assert_int_equal(ga_set_rho_inf(x->s, 1.5), GA_ERR_ARG);
+    assert_int_equal(ga_set_rho_inf(x->s, NAN), GA_ERR_ARG);
+    assert_int_equal(ga_set_tolerances(x->s, 0.0, 1e-6), GA_ERR_ARG);
+    assert_int_equal(ga_set_tolerances(x->s, 1e-6, INFINITY), GA_ERR_ARG);
+    assert_int_equal(ga_set_tolerances(x->s, NAN, 1e-6), GA_ERR_ARG);
+    expect_message(x->s, "must be positive and finite");
+    assert_int_equal(ga_set_initial_step(x->s, -1e-3), GA_ERR_ARG);
+    assert_int_equal(ga_set_initial_step(x->s, NAN), GA_ERR_ARG);
+    expect_message(x->s, "initial step");
+    assert_int_equal(ga_set_step_limits(x->s, -1.0, 0.0), GA_ERR_ARG);
+    assert_int_equal(ga_set_step_limits(x->s, 0.0, NAN), GA_ERR_ARG);
+    assert_int_equal(ga_set_linear_solver(x->s, 99), GA_ERR_ARG);
+    expect_message(x->s, "unknown linear solver 99");
+    /* choices the workspace was built for are refused after ga_init */
+    assert_int_equal(ga_set_linear_solver(x->s, GA_LINEAR_DENSE_EIGEN), GA_ERR_STATE);
+    expect_message(x->s, "chosen before ga_init");
+    assert_int_equal(ga_set_pattern(x->s, GA_MATRIX_MASS, 1, rows, rows), GA_ERR_STATE);
+    expect_message(x->s, "declared before ga_init");
+    /* queries with a bad key or no output */
+    assert_int_equal(ga_get_info(x->s, GA_INFO_COUNT, &d), GA_ERR_ARG);
+    assert_int_equal(ga_get_info(x->s, -1, &d), GA_ERR_ARG);
+    assert_int_equal(ga_get_info(x->s, GA_INFO_H_NEXT, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_set_jacobian_reuse(NULL, GA_REUSE_AUTO), GA_ERR_ARG);
+    assert_int_equal(ga_reset_counters(NULL), GA_ERR_ARG);
+    assert_string_equal(ga_linear_solver_name(NULL), "none");
+
+    double a[STATE_MAX], b[STATE_MAX];
+    for (int k = 0; k < 5; ++k) {
+        assert_int_equal(ga_step(x->s, 0.01), GA_OK);
+        assert_int_equal(ga_step(twin, 0.01), GA_OK);
+    }
+    const size_t len = snapshot(x->s, a);
+    snapshot(twin, b);
+    assert_memory_equal(a, b, len * sizeof(double));
+    ga_free(twin);
+}
+
+static void bad_patterns_are_refused(void **state)
+{
+    (void)state;
+    ga_solver *s = NULL, *u = NULL;
+    const int r[2] = {0, 1}, c[2] = {0, 1}, c_out[2] = {0, 2}, r_neg[2] = {0, -1};
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_pattern(s, 7, 2, r, c), GA_ERR_ARG);
+    expect_message(s, "unknown matrix 7");
+    assert_int_equal(ga_set_pattern(s, -1, 2, r, c), GA_ERR_ARG);
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_MASS, 2, NULL, c), GA_ERR_ARG);
+    expect_message(s, "needs rows and cols");
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_MASS, 2, r, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_MASS, -1, r, c), GA_ERR_ARG);
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_MASS, 2, r, c_out), GA_ERR_ARG);
+    expect_message(s, "pattern entry 1 = (1, 2) is outside the 2 x 2 matrix");
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_STIFFNESS, 2, r_neg, c), GA_ERR_ARG);
+    /* Phi_q has m = 1 row: row 1 is outside */
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_JACOBIAN, 2, r, c), GA_ERR_ARG);
+    expect_message(s, "outside the 1 x 2 matrix");
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_JACOBIAN, 2, c, r), GA_ERR_ARG);
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_JACOBIAN, 1, r, c), GA_OK);
+    /* without constraints there is no Jacobian to declare */
+    assert_int_equal(ga_create(2, 0, &u), GA_OK);
+    assert_int_equal(ga_set_pattern(u, GA_MATRIX_JACOBIAN, 1, r, c), GA_ERR_ARG);
+    expect_message(u, "m = 0: there is no constraint Jacobian");
+    ga_free(u);
+    ga_free(s);
+}
+
+/* Adaptive calls: before ga_init, and with end times that are not finite or lie behind. */
+static void bad_adaptive_calls_are_refused(void **state)
+{
+    fixture *x = *state;
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_step_adaptive(s, 1.0), GA_ERR_STATE);
+    expect_message(s, "ga_step_adaptive before ga_init");
+    assert_int_equal(ga_advance(s, 1.0), GA_ERR_STATE);
+    expect_message(s, "ga_advance before ga_init");
+    ga_free(s);
+
+    double before[STATE_MAX], after[STATE_MAX], t;
+    const size_t len = snapshot(x->s, before);
+    assert_int_equal(ga_get_t(x->s, &t), GA_OK);
+    assert_int_equal(ga_step_adaptive(x->s, NAN), GA_ERR_ARG);
+    expect_message(x->s, "t_stop = nan is not finite");
+    assert_int_equal(ga_step_adaptive(x->s, INFINITY), GA_ERR_ARG);
+    assert_int_equal(ga_step_adaptive(x->s, t), GA_ERR_ARG);
+    expect_message(x->s, "is not after t");
+    assert_int_equal(ga_advance(x->s, -INFINITY), GA_ERR_ARG);
+    expect_message(x->s, "t_out = -inf is not finite");
+    assert_int_equal(ga_advance(x->s, t - 0.05), GA_ERR_ARG);
+    expect_message(x->s, "is before t");
+    assert_int_equal(ga_advance(x->s, t), GA_OK); /* already there: nothing to do */
+    snapshot(x->s, after);
+    assert_memory_equal(before, after, len * sizeof(double));
 }
 
 static void bad_checkpoints_are_refused(void **state)
@@ -312,11 +453,11 @@ static void bad_checkpoints_are_refused(void **state)
 static void fatal_callback_failure(void **state)
 {
     fixture *x = *state;
-    const fault_site sites[] = {MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS};
+    const fault_site sites[] = {MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS, DAMPING};
     const char *names[] = {"mass callback returned -7", "force callback returned -7",
                            "constraint callback returned -7", "jacobian callback returned -7",
-                           "stiffness callback returned -7"};
-    for (int i = 0; i < 5; ++i) {
+                           "stiffness callback returned -7", "damping callback returned -7"};
+    for (int i = 0; i < 6; ++i) {
         x->model.site = sites[i];
         x->model.rc = -7;
         failing_step(x, GA_ERR_CALLBACK, names[i]);
@@ -337,10 +478,11 @@ static void recoverable_callback_failure(void **state)
 static void nan_and_inf_in_callback_outputs(void **state)
 {
     fixture *x = *state;
-    const fault_site sites[] = {MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS};
+    const fault_site sites[] = {MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS, DAMPING};
     const char *names[] = {"mass matrix M(0,0)", "force f[0]", "constraint Phi[0]",
-                           "constraint Jacobian Phi_q(0,0)", "tangent stiffness K_t(0,0)"};
-    for (int i = 0; i < 5; ++i) {
+                           "constraint Jacobian Phi_q(0,0)", "tangent stiffness K_t(0,0)",
+                           "tangent damping C_t(0,0)"};
+    for (int i = 0; i < 6; ++i) {
         x->model.site = sites[i];
         x->model.rc = 0;
         x->model.value = (i % 2) ? INFINITY : NAN;
@@ -591,10 +733,11 @@ static void out_of_memory_is_reported(void **state)
 static void strerror_names_every_status(void **state)
 {
     (void)state;
-    for (int st = GA_OK; st >= GA_ERR_INTERNAL; --st)
+    for (int st = GA_OK; st >= GA_ERR_STEP_SIZE; --st)
         assert_string_not_equal(ga_strerror(st), "unknown status");
     assert_string_equal(ga_strerror(-99), "unknown status");
     assert_string_equal(ga_strerror(GA_ERR_NEWTON), "Newton iteration did not converge");
+    assert_string_equal(ga_strerror(GA_ERR_STEP_SIZE), "step size below its minimum");
 }
 
 #define T(f) cmocka_unit_test_setup_teardown(f, setup, teardown)
@@ -606,6 +749,8 @@ int main(void)
         T(bad_step_sizes_are_refused),
         cmocka_unit_test(calls_out_of_order_are_refused),
         T(bad_options_are_refused),
+        cmocka_unit_test(bad_patterns_are_refused),
+        T(bad_adaptive_calls_are_refused),
         T(bad_checkpoints_are_refused),
         T(fatal_callback_failure),
         T(recoverable_callback_failure),

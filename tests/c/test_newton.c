@@ -257,6 +257,267 @@ static void missing_tangents_are_computed_only_where_they_matter(void **state)
     assert_true(fabs(q_auto[0] - q_fd[0]) < 1e-12);
 }
 
+/* Velocity-dependent forces: three damped oscillators q_i'' = -k_i q_i - c_i q_i' (m = 0) with
+ * c_i h up to 10, where the damping tangent C_t = diag(c) dominates the iteration matrix
+ * beta' M + gamma' C_t + K_t. The steps are linear, so their exact solution is the recurrence
+ * of eqs. (3)-(5) solved by hand below; galpha must reach it with C_t from the callback, from
+ * dense finite differences (one force call per column) and from sparse ones on a declared
+ * diagonal pattern (one force call for all columns; both computed only once the simplified
+ * iteration without C_t has failed, GA_TANGENT_AUTO), and cannot without C_t. */
+enum { NOSC = 3 };
+typedef struct oscillators {
+    double k[NOSC], c[NOSC];
+    int sparse; /* matrices as the values of diagonal patterns instead of dense n x n */
+} oscillators;
+
+static void write_diagonal(const oscillators *o, const double *d, double *out)
+{
+    for (int i = 0; i < NOSC * NOSC && !o->sparse; ++i)
+        out[i] = 0.0;
+    for (int i = 0; i < NOSC; ++i)
+        out[o->sparse ? i : i * (NOSC + 1)] = d[i];
+}
+static int osc_mass(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q;
+    const double one[NOSC] = {1.0, 1.0, 1.0};
+    write_diagonal(u, one, M);
+    return 0;
+}
+static int osc_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t;
+    const oscillators *o = u;
+    for (int i = 0; i < NOSC; ++i)
+        f[i] = -o->k[i] * q[i] - o->c[i] * v[i];
+    return 0;
+}
+static int osc_stiffness(double t, const double *q, const double *v, const double *qdd,
+                         const double *lambda, double *K, void *u)
+{
+    (void)t, (void)q, (void)v, (void)qdd, (void)lambda;
+    write_diagonal(u, ((const oscillators *)u)->k, K);
+    return 0;
+}
+static int osc_damping(double t, const double *q, const double *v, double *C, void *u)
+{
+    (void)t, (void)q, (void)v;
+    write_diagonal(u, ((const oscillators *)u)->c, C);
+    return 0;
+}
+
+typedef struct damped_run {
+    ga_status status;
+    double q[NOSC], v[NOSC];
+    long long newton, damping_evals, force_evals, residuals, steps;
+} damped_run;
+
+static damped_run run_damped(oscillators *o, ga_damping_fn damping, int mode, double h,
+                             int steps)
+{
+    damped_run r = {0};
+    ga_solver *s = NULL;
+    const double q0[NOSC] = {1.0, 1.0, 1.0}, v0[NOSC] = {0.0, 0.0, 0.0};
+    assert_int_equal(ga_create(NOSC, 0, &s), GA_OK);
+    if (o->sparse) {
+        const int diag[NOSC] = {0, 1, 2};
+        for (int w = GA_MATRIX_MASS; w <= GA_MATRIX_DAMPING; ++w)
+            if (w != GA_MATRIX_JACOBIAN)
+                assert_int_equal(ga_set_pattern(s, w, NOSC, diag, diag), GA_OK);
+        assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    }
+    assert_int_equal(ga_set_callbacks(s, osc_mass, osc_force, NULL, NULL, o), GA_OK);
+    assert_int_equal(ga_set_tangents(s, osc_stiffness, damping), GA_OK);
+    assert_int_equal(ga_set_tangent_mode(s, mode), GA_OK);
+    assert_int_equal(ga_set_rho_inf(s, 0.8), GA_OK);
+    assert_int_equal(ga_set_newton(s, 1e-12, 10), GA_OK);
+    assert_int_equal(ga_set_corrected_start(s, 0), GA_OK); /* a_0 = qdd_0, as below */
+    assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+    for (int k = 0; k < steps && !r.status; ++k)
+        r.status = ga_step(s, h);
+    ga_get_q(s, r.q);
+    ga_get_v(s, r.v);
+    ga_get_counter(s, GA_COUNT_STEPS, &r.steps);
+    ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &r.newton);
+    ga_get_counter(s, GA_COUNT_DAMPING_EVALS, &r.damping_evals);
+    ga_get_counter(s, GA_COUNT_FORCE_EVALS, &r.force_evals);
+    ga_get_counter(s, GA_COUNT_RESIDUALS, &r.residuals);
+    ga_free(s);
+    return r;
+}
+
+static void damping_tangent_from_callback_or_differences(void **state)
+{
+    (void)state;
+    oscillators o = {{100.0, 400.0, 2500.0}, {50.0, 200.0, 20.0}, 0};
+    const double h = 0.05;
+    const int steps = 40;
+    /* alpha_m, alpha_f, beta, gamma from rho_inf = 0.8 (eq. 24) */
+    const double rho = 0.8, am = (2 * rho - 1) / (rho + 1), af = rho / (rho + 1);
+    const double gamma = 0.5 + af - am, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
+    double q_ref[NOSC], v_ref[NOSC];
+    for (int i = 0; i < NOSC; ++i) {
+        double q = 1.0, v = 0.0, qdd = -o.k[i], a = qdd;
+        for (int n = 0; n < steps; ++n) {
+            /* a1 = A0 + A1 qdd1, q1 = Q0 + h^2 beta A1 qdd1, v1 = V0 + h gamma A1 qdd1 */
+            const double A0 = (af * qdd - am * a) / (1 - am), A1 = (1 - af) / (1 - am);
+            const double Q0 = q + h * v + h * h * ((0.5 - beta) * a + beta * A0);
+            const double V0 = v + h * ((1 - gamma) * a + gamma * A0);
+            const double qdd1 = (-o.k[i] * Q0 - o.c[i] * V0) /
+                                (1 + (o.k[i] * h * h * beta + o.c[i] * h * gamma) * A1);
+            const double a1 = A0 + A1 * qdd1;
+            q = Q0 + h * h * beta * A1 * qdd1;
+            v = V0 + h * gamma * A1 * qdd1;
+            qdd = qdd1;
+            a = a1;
+        }
+        q_ref[i] = q;
+        v_ref[i] = v;
+    }
+    const damped_run exact = run_damped(&o, osc_damping, GA_TANGENT_AUTO, h, steps);
+    const damped_run dense_fd = run_damped(&o, NULL, GA_TANGENT_AUTO, h, steps);
+    o.sparse = 1;
+    const damped_run sparse_fd = run_damped(&o, NULL, GA_TANGENT_AUTO, h, steps);
+    const damped_run sparse_exact = run_damped(&o, osc_damping, GA_TANGENT_AUTO, h, steps);
+    o.sparse = 0;
+    const damped_run neglected = run_damped(&o, osc_damping, GA_TANGENT_NEGLECT, h, steps);
+    const damped_run *runs[] = {&exact, &dense_fd, &sparse_fd, &sparse_exact};
+    const char *names[] = {"C_t by callback", "dense differences", "sparse differences",
+                           "sparse, by callback"};
+    for (int r = 0; r < 4; ++r) {
+        const damped_run *x = runs[r];
+        printf("  %-20s %lld Newton iterations, %lld C_t evaluations, %lld force calls, "
+               "%lld residuals, |q - q_ref| = %.1e, |v - v_ref| = %.1e\n",
+               names[r], x->newton, x->damping_evals, x->force_evals, x->residuals,
+               max_abs_diff(x->q, q_ref, NOSC), max_abs_diff(x->v, v_ref, NOSC));
+        assert_int_equal(x->status, GA_OK);
+        assert_true(max_abs_diff(x->q, q_ref, NOSC) < 1e-12);
+        assert_true(max_abs_diff(x->v, v_ref, NOSC) < 1e-10);
+        assert_true(x->damping_evals >= 1);
+        assert_true(x->newton <= 2 * steps + 2); /* a linear step: one correction, one check */
+        /* force calls: ga_init's one, one per residual, and those of the differences: a
+         * column at a time in a dense C_t, all three columns of the diagonal pattern at once */
+        const long long per_difference = r == 1 ? NOSC : r == 2 ? 1 : 0;
+        assert_int_equal(x->force_evals, 1 + x->residuals + per_difference * x->damping_evals);
+    }
+    printf("  C_t neglected: status %d after %lld steps\n", neglected.status, neglected.steps);
+    assert_int_equal(neglected.status, GA_ERR_NEWTON);
+}
+
+/* GA_REUSE_NEVER is Algorithm 1 as printed: a fresh tangent and factorization in every
+ * iteration. The default keeps the factorization and makes fewer; both reach the same
+ * discrete solution. GA_INFO_NEWTON_ITERS is the last step's share of the counter, and
+ * ga_reset_counters starts them all again from zero. */
+static void full_newton_factorizes_every_iteration(void **state)
+{
+    (void)state;
+    double q_end[2][2];
+    long long iters[2], facts[2];
+    for (int mode = GA_REUSE_AUTO; mode <= GA_REUSE_NEVER; ++mode) {
+        ga_solver *s = NULL;
+        double q[2], v[2], info;
+        pendulum_state(&P, 1.0, 0.5, q, v);
+        assert_int_equal(ga_create(2, 1, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                          pendulum_jacobian, &P),
+                         GA_OK);
+        assert_int_equal(ga_set_tangents(s, pendulum_stiffness, NULL), GA_OK);
+        assert_int_equal(ga_set_newton(s, 1e-12, 20), GA_OK);
+        assert_int_equal(ga_set_jacobian_reuse(s, mode), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        assert_int_equal(ga_reset_counters(s), GA_OK); /* drop ga_init's work */
+        for (int c = 0; c < GA_COUNTER_COUNT; ++c) {
+            long long value = -1;
+            assert_int_equal(ga_get_counter(s, c, &value), GA_OK);
+            assert_int_equal(value, 0);
+        }
+        long long it_before = 0, it_after, fa_before = 0, fa_after, stiff;
+        for (int k = 0; k < 100; ++k) {
+            assert_int_equal(ga_step(s, 1e-2), GA_OK);
+            ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &it_after);
+            ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &fa_after);
+            assert_int_equal(ga_get_info(s, GA_INFO_NEWTON_ITERS, &info), GA_OK);
+            assert_true(info == (double)(it_after - it_before));
+            assert_int_equal(ga_get_info(s, GA_INFO_NEWTON_RATIO, &info), GA_OK);
+            assert_true(info >= 0.0 && isfinite(info));
+            /* (the first step's corrected start factorizes for solves of its own) */
+            if (mode == GA_REUSE_NEVER && k > 0)
+                assert_int_equal(fa_after - fa_before, it_after - it_before);
+            it_before = it_after;
+            fa_before = fa_after;
+        }
+        ga_get_counter(s, GA_COUNT_STIFFNESS_EVALS, &stiff);
+        ga_get_q(s, q_end[mode]);
+        iters[mode] = it_before;
+        facts[mode] = fa_before;
+        if (mode == GA_REUSE_NEVER)
+            assert_int_equal(stiff, iters[mode]); /* a tangent in every iteration */
+        ga_free(s);
+    }
+    printf("  100 pendulum steps: reuse %lld factorizations / %lld iterations, full Newton "
+           "%lld / %lld, |dq| = %.1e\n",
+           facts[0], iters[0], facts[1], iters[1], max_abs_diff(q_end[0], q_end[1], 2));
+    assert_true(facts[0] < facts[1]);
+    assert_true(max_abs_diff(q_end[0], q_end[1], 2) < 1e-10);
+}
+
+/* The scaling (10): the condition number of the unscaled iteration matrix grows like h^-4,
+ * that of the scaled one stays bounded (pendulum, h from 1e-1 to 1e-3); both give the same
+ * steps where the unscaled matrix is still usable, and at h = 1e-6 only the scaled one is. */
+static double condition_after_a_step(int scaling, double h, double *q)
+{
+    ga_solver *s = NULL;
+    double v[2], rcond;
+    pendulum_state(&P, 1.0, 0.5, q, v);
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &P),
+                     GA_OK);
+    assert_int_equal(ga_set_tangents(s, pendulum_stiffness, NULL), GA_OK);
+    assert_int_equal(ga_set_scaling(s, scaling), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    assert_int_equal(ga_step(s, h), GA_OK);
+    assert_int_equal(ga_get_info(s, GA_INFO_RCOND, &rcond), GA_OK);
+    ga_get_q(s, q);
+    ga_free(s);
+    return 1.0 / rcond;
+}
+
+static void scaling_keeps_the_condition_bounded(void **state)
+{
+    (void)state;
+    enum { K = 5 };
+    double h[K], cond[2][K], q_on[2], q_off[2];
+    for (int k = 0; k < K; ++k) {
+        h[k] = pow(10.0, -1.0 - 0.5 * k);
+        cond[1][k] = condition_after_a_step(1, h[k], q_on);
+        cond[0][k] = condition_after_a_step(0, h[k], q_off);
+        printf("  h = %.0e: condition %.2e scaled, %.2e unscaled, |dq| = %.1e\n", h[k],
+               cond[1][k], cond[0][k], max_abs_diff(q_on, q_off, 2));
+        assert_true(max_abs_diff(q_on, q_off, 2) < 1e-12);
+    }
+    const double slope_on = fit_order(h, cond[1], K), slope_off = fit_order(h, cond[0], K);
+    printf("  log-log slope of the condition against h: %.2f scaled, %.2f unscaled\n", slope_on,
+           slope_off);
+    assert_true(fabs(slope_on) < 0.3);
+    assert_true(slope_off < -3.7 && slope_off > -4.3);
+    /* where the unscaled matrix is singular to working precision, the scaled one is fine */
+    const double cond_small_h = condition_after_a_step(1, 1e-6, q_on);
+    printf("  h = 1e-6: condition %.2e scaled\n", cond_small_h);
+    assert_true(cond_small_h < 10.0 * cond[1][0]);
+    ga_solver *s = NULL;
+    double q[2], v[2];
+    pendulum_state(&P, 1.0, 0.5, q, v);
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &P),
+                     GA_OK);
+    assert_int_equal(ga_set_scaling(s, 0), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    assert_int_equal(ga_step(s, 1e-6), GA_ERR_SINGULAR);
+    ga_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -264,6 +525,9 @@ int main(void)
         cmocka_unit_test(paper_test_on_scaled_residual_would_accept_the_predictor),
         cmocka_unit_test(no_rate_is_measured_against_an_infinite_increment),
         cmocka_unit_test(missing_tangents_are_computed_only_where_they_matter),
+        cmocka_unit_test(damping_tangent_from_callback_or_differences),
+        cmocka_unit_test(full_newton_factorizes_every_iteration),
+        cmocka_unit_test(scaling_keeps_the_condition_bounded),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
