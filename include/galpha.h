@@ -522,7 +522,8 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
 /** @name Checkpoint and restart
  *  The full state as a flat array of doubles, so a host simulator can save, restore and
  *  restart: a run restarted from a checkpoint continues bit-identically, in fixed-step and in
- *  adaptive mode. Layout 2: [magic, layout version, n, m, t, h_last, h_next, err_prev, grew,
+ *  adaptive mode (from a checkpoint taken before the first step too: that step still applies
+ *  the corrected start). Layout 2: [magic, layout version, n, m, t, h_last, h_next, err_prev, grew,
  *  q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n)] (h_next, err_prev, grew: the step-size
  *  controller; a_prev: the a of the step before, for the error estimate); treat it as opaque.
  *  The factorized iteration matrix is not part of it: taking a checkpoint makes the next step

@@ -583,7 +583,9 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
 
     invalidate_jacobian();
     previous_valid_ = false;
-    start_pending_ = false;
+    // A checkpoint from before the first step (h_last = 0) still owes that step its corrected
+    // starting values, as the solver it was taken from does.
+    start_pending_ = s.h_last == 0.0;
     initialized_ = true;
     return GA_OK;
 }

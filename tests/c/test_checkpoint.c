@@ -1,5 +1,6 @@
 /* Checkpoint and restart: a run restarted from ga_get_state / ga_set_state (in a new solver,
- * or in the same one rewound) continues bit-identically. */
+ * or in the same one rewound) continues bit-identically, with fixed or adaptive steps, and
+ * from a checkpoint taken before the first step too. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -25,37 +26,58 @@ static ga_solver *make(void)
     return s;
 }
 
+/* k fixed steps of 3e-3, or (adaptive) k adaptive steps at rtol = atol = 1e-6 */
 static void steps(ga_solver *s, int k)
 {
     for (int i = 0; i < k; ++i)
         assert_int_equal(ga_step(s, 3e-3), GA_OK);
 }
-
-static void restart_in_new_solver_is_bit_identical(void **state)
+static void adaptive_steps(ga_solver *s, int k)
 {
-    (void)state;
+    for (int i = 0; i < k; ++i)
+        assert_int_equal(ga_step_adaptive(s, 100.0), GA_OK);
+}
+
+/* Checkpoint after `before` steps (0: right after ga_init, where the first step still owes
+ * the corrected start), 150 more steps in the solver and in a new one restored from it. */
+static void restart_in_new_solver(int before, int adaptive)
+{
     double q[2], v[2], ckpt[LEN], a[LEN], b[LEN];
     size_t len = 0;
-    pendulum_state(&P, 1.2, 0.0, q, v);
+    void (*advance)(ga_solver *, int) = adaptive ? adaptive_steps : steps;
+    pendulum_state(&P, 1.2, 0.8, q, v); /* moving: at rest the start correction vanishes */
     ga_solver *s = make();
+    assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     assert_int_equal(ga_state_size(s, &len), GA_OK);
     assert_int_equal(len, LEN);
-    steps(s, 100);
+    advance(s, before);
     assert_int_equal(ga_get_state(s, ckpt, LEN), GA_OK);
-    steps(s, 150);
+    double h_before = -1.0;
+    assert_int_equal(ga_get_h_last(s, &h_before), GA_OK);
+    advance(s, 150);
     assert_int_equal(ga_get_state(s, a, LEN), GA_OK);
 
     ga_solver *r = make(); /* never initialized: set_state makes it ready */
+    assert_int_equal(ga_set_tolerances(r, 1e-6, 1e-6), GA_OK);
     assert_int_equal(ga_set_state(r, ckpt, LEN), GA_OK);
-    double h_last = 0.0;
+    double h_last = -1.0;
     assert_int_equal(ga_get_h_last(r, &h_last), GA_OK);
-    assert_true(h_last == 3e-3);
-    steps(r, 150);
+    assert_true(h_last == h_before && (before > 0) == (h_last > 0.0));
+    advance(r, 150);
     assert_int_equal(ga_get_state(r, b, LEN), GA_OK);
     assert_memory_equal(a, b, sizeof a);
     ga_free(s);
     ga_free(r);
+}
+
+static void restart_in_new_solver_is_bit_identical(void **state)
+{
+    (void)state;
+    for (int adaptive = 0; adaptive < 2; ++adaptive) {
+        restart_in_new_solver(100, adaptive);
+        restart_in_new_solver(0, adaptive);
+    }
 }
 
 static void rewind_same_solver_is_bit_identical(void **state)

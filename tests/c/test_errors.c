@@ -475,6 +475,32 @@ static void recoverable_callback_failure(void **state)
     assert_int_equal(failed, 1);
 }
 
+/* The first step after ga_init computes the corrected starting values (two more consistent
+ * accelerations, at t0 -+ h): a callback failing there fails the step like any other. */
+static void failure_in_the_corrected_start(void **state)
+{
+    (void)state;
+    const fault_site sites[] = {MASS, FORCE, CONSTRAINT, JACOBIAN};
+    const char *names[] = {"mass callback returned", "force callback returned",
+                           "constraint callback returned", "jacobian callback returned"};
+    for (int i = 0; i < 4; ++i)
+        for (int rc = -7; rc <= 7; rc += 14) {
+            fixture x = {.model.p = {1.0, 1.0, 9.81}};
+            double q[2], v[2];
+            pendulum_state(&x.model.p, 1.0, 0.5, q, v);
+            assert_int_equal(ga_create(2, 1, &x.s), GA_OK);
+            assert_int_equal(ga_set_callbacks(x.s, f_mass, f_force, f_constraint, f_jacobian,
+                                              &x.model),
+                             GA_OK);
+            assert_int_equal(ga_set_tangents(x.s, f_stiffness, f_damping), GA_OK);
+            assert_int_equal(ga_init(x.s, 0.0, q, v), GA_OK);
+            x.model.site = sites[i];
+            x.model.rc = rc;
+            failing_step(&x, rc < 0 ? GA_ERR_CALLBACK : GA_ERR_CALLBACK_RETRY, names[i]);
+            ga_free(x.s);
+        }
+}
+
 static void nan_and_inf_in_callback_outputs(void **state)
 {
     fixture *x = *state;
@@ -755,6 +781,7 @@ int main(void)
         T(fatal_callback_failure),
         T(recoverable_callback_failure),
         T(nan_and_inf_in_callback_outputs),
+        cmocka_unit_test(failure_in_the_corrected_start),
         T(singular_iteration_matrix),
         T(newton_not_converged_in_max_iter),
         T(newton_diverges_with_wrong_tangent),
