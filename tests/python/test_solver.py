@@ -257,3 +257,58 @@ def test_constraint_dt_callback_spares_the_differences():
     assert cb["constraint_dt_evals"] >= cb["residuals"]
     assert fd["constraint_evals"] - 2 * fd["constraint_dt_evals"] - fd["residuals"] == \
         cb["constraint_evals"] - cb["residuals"]
+
+
+def sparse_mass(t, q, M):
+    assert M.shape == (2,)  # the values of the declared diagonal, not a 2 x 2 matrix
+    M[:] = 1.0
+
+
+def sparse_jacobian(t, q, J):
+    assert J.shape == (2,)  # entries (0, 0), (0, 1)
+    J[:] = q
+
+
+def test_declared_patterns_take_the_sparse_path():
+    patterns = {"mass": ([0, 1], [0, 1]), "jacobian": ([0, 0], [0, 1]),
+                "stiffness": ([0, 1], [0, 1]), "damping": ([], [])}
+    runs = {}
+    for name, kw in (("dense", {}),
+                     ("sparse", dict(patterns=patterns, linear_solver=galpha.GA_LINEAR_SPARSE))):
+        sparse = name == "sparse"
+        with galpha.Solver(2, 1, sparse_mass if sparse else mass, force, constraint,
+                           sparse_jacobian if sparse else jacobian, **kw) as s:
+            s.init(0.0, Q0, V0)
+            for _ in range(200):
+                s.step(5e-3)
+            runs[name] = (s.q, s.lam, s.linear_solver_name, s.stats)
+    assert runs["sparse"][2] == "sparse KLU"
+    assert runs["dense"][2] != "sparse KLU"
+    # the same discrete solution through either linear algebra
+    assert np.max(np.abs(runs["sparse"][0] - runs["dense"][0])) < 1e-10
+    assert abs(runs["sparse"][1][0] - runs["dense"][1][0]) < 1e-8 * abs(runs["dense"][1][0])
+    # the empty damping pattern declares C_t = 0: never computed
+    assert runs["sparse"][3]["damping_evals"] == 0
+
+
+def test_bad_patterns_are_refused():
+    with pytest.raises(galpha.ArgumentError, match="outside the 2 x 2 matrix"):
+        galpha.Solver(2, 1, mass, force, constraint, jacobian, patterns={"mass": ([0, 2], [0, 1])})
+    with pytest.raises(ValueError, match="unknown matrix"):
+        galpha.Solver(2, 1, mass, force, constraint, jacobian, patterns={"masses": ([0], [0])})
+    with pytest.raises(ValueError, match="2 rows but 1 cols"):
+        galpha.Solver(2, 1, mass, force, constraint, jacobian, patterns={"mass": ([0, 1], [0])})
+
+
+def test_initial_step_and_counter_reset():
+    with pendulum(tolerances=(1e-6, 1e-6), initial_step=1e-4) as s:
+        s.init(0.0, Q0, V0)
+        s.step_adaptive(1.0)
+        assert s.h_last == 1e-4  # the first adaptive step is the one asked for
+        assert s.stats["steps"] == 1
+        s.reset_counters()
+        assert all(value == 0 for value in s.stats.values())
+        s.step(1e-3)
+        assert s.stats["steps"] == 1
+    with pytest.raises(galpha.ArgumentError, match="initial step"):
+        pendulum(initial_step=-1.0)

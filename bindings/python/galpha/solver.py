@@ -32,6 +32,10 @@ def _cast(fn, ctype):
     return ctypes.cast(fn, ctype) if fn is not None else ctype()
 
 
+_PATTERN_MATRICES = {"mass": _ffi.GA_MATRIX_MASS, "jacobian": _ffi.GA_MATRIX_JACOBIAN,
+                     "stiffness": _ffi.GA_MATRIX_STIFFNESS, "damping": _ffi.GA_MATRIX_DAMPING}
+
+
 class Solver:
     """A galpha solver for n coordinates and m constraints.
 
@@ -46,8 +50,14 @@ class Solver:
     constraint_dt(t, q, out)
         Optional exact tangents, constraint acceleration term and Phi_t (finite differences
         otherwise).
+    patterns : dict, optional
+        Sparsity patterns for the sparse path (ga_set_pattern): {"mass" | "jacobian" |
+        "stiffness" | "damping": (rows, cols)}, 0-based index arrays of equal length nnz. The
+        callback of a matrix with a pattern receives a 1-D array of its nnz values in that
+        order instead of the dense matrix; an empty pattern declares the matrix zero.
     rho_inf, params, newton, tangent_mode, scaling, predictor, init_mode, formulation, redundant,
-    tolerances, reuse, constant_mass, linear_solver, rescale, corrected_start, step_limits
+    tolerances, reuse, constant_mass, linear_solver, rescale, corrected_start, step_limits,
+    initial_step
         Options, as the C setters (ga_set_rho_inf, ga_set_params((alpha_m, alpha_f, beta,
         gamma)), ga_set_newton((tol, max_iter)), ga_set_tolerances((rtol, atol)),
         ga_set_step_limits((h_min, h_max)), ga_set_formulation(galpha.GA_INDEX2_STABILIZED),
@@ -63,7 +73,7 @@ class Solver:
                  params=None, newton=None, tangent_mode=None, scaling=None, predictor=None,
                  init_mode=None, formulation=None, redundant=None, tolerances=None, reuse=None,
                  constant_mass=None, linear_solver=None, rescale=None, corrected_start=None,
-                 step_limits=None):
+                 step_limits=None, initial_step=None, patterns=None):
         self._ptr = None
         self._pending = None          # exception raised inside a callback
         self._views = {}              # (address, shape, writeable) -> ndarray
@@ -75,6 +85,23 @@ class Solver:
         self._free = _ffi.ga_free
         n, m = self.n, self.m
         v = self._view
+        # declared patterns first: they decide the shape the callbacks see
+        nnz = {}
+        for name, (rows, cols) in (patterns or {}).items():
+            if name not in _PATTERN_MATRICES:
+                raise ValueError(f"unknown matrix {name!r} in patterns (one of "
+                                 f"{', '.join(_PATTERN_MATRICES)})")
+            rows = np.ascontiguousarray(rows, dtype=np.intc).ravel()
+            cols = np.ascontiguousarray(cols, dtype=np.intc).ravel()
+            if rows.size != cols.size:
+                raise ValueError(f"pattern of {name}: {rows.size} rows but {cols.size} cols")
+            ip = ctypes.POINTER(ctypes.c_int)
+            self._check(_ffi.ga_set_pattern(self._ptr, _PATTERN_MATRICES[name], rows.size,
+                                            rows.ctypes.data_as(ip), cols.ctypes.data_as(ip)))
+            nnz[name] = rows.size
+
+        def shape(name, dense):
+            return (nnz[name],) if name in nnz else dense
         self._user = {"mass": mass, "force": force, "constraint": constraint,
                       "jacobian": jacobian, "stiffness": stiffness, "damping": damping,
                       "constraint_accel": constraint_accel, "constraint_dt": constraint_dt}
@@ -91,18 +118,21 @@ class Solver:
                 return -1
 
         self._cbs = [
-            _MASS(lambda t, q, M, u: call(mass, t, v(q, (n,)), v(M, (n, n), True))),
+            _MASS(lambda t, q, M, u: call(mass, t, v(q, (n,)), v(M, shape("mass", (n, n)),
+                                                                True))),
             _FORCE(lambda t, q, qd, f, u: call(force, t, v(q, (n,)), v(qd, (n,)),
                                                v(f, (n,), True))) if force else None,
             _CONSTRAINT(lambda t, q, p, u: call(constraint, t, v(q, (n,)),
                                                 v(p, (m,), True))) if m and constraint else None,
             _CONSTRAINT(lambda t, q, J, u: call(jacobian, t, v(q, (n,)),
-                                                v(J, (m, n), True))) if m and jacobian else None,
+                                                v(J, shape("jacobian", (m, n)), True)))
+            if m and jacobian else None,
             _STIFFNESS(lambda t, q, qd, a, lam, K, u: call(
                 stiffness, t, v(q, (n,)), v(qd, (n,)), v(a, (n,)), v(lam, (m,)),
-                v(K, (n, n), True))) if stiffness else None,
+                v(K, shape("stiffness", (n, n)), True))) if stiffness else None,
             _FORCE(lambda t, q, qd, C, u: call(damping, t, v(q, (n,)), v(qd, (n,)),
-                                               v(C, (n, n), True))) if damping else None,
+                                               v(C, shape("damping", (n, n)), True)))
+            if damping else None,
             _FORCE(lambda t, q, qd, o, u: call(constraint_accel, t, v(q, (n,)), v(qd, (n,)),
                                                v(o, (m,), True))) if constraint_accel else None,
             _CONSTRAINT(lambda t, q, o, u: call(constraint_dt, t, v(q, (n,)),
@@ -148,6 +178,8 @@ class Solver:
             self._check(_ffi.ga_set_tolerances(self._ptr, float(tolerances[0]), float(tolerances[1])))
         if step_limits is not None:
             self._check(_ffi.ga_set_step_limits(self._ptr, float(step_limits[0]), float(step_limits[1])))
+        if initial_step is not None:
+            self._check(_ffi.ga_set_initial_step(self._ptr, float(initial_step)))
 
     # ---- plumbing ---------------------------------------------------------------------------
     def _view(self, address, shape, writeable=False):
@@ -290,6 +322,10 @@ class Solver:
             self._check(_ffi.ga_get_counter(self._handle(), key, ctypes.byref(x)))
             out[name] = x.value
         return out
+
+    def reset_counters(self):
+        """Set every work counter of `stats` to zero."""
+        self._check(_ffi.ga_reset_counters(self._handle()))
 
     def info(self, key):
         x = ctypes.c_double()
