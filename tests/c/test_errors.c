@@ -617,6 +617,60 @@ static void callback_calling_its_own_solver_is_refused(void **state)
 
 /* ---- initial values ---------------------------------------------------------------------- */
 
+/* Callback failures inside ga_init (projection of q0 and v0, consistent accelerations): the
+ * status and the callback are reported, the solver stays uninitialized, and a ga_init after
+ * the fault is gone succeeds. q0 off the constraint and v0 off the velocity constraint, so
+ * that the projections call every callback. */
+static void callback_failures_in_ga_init(void **state)
+{
+    (void)state;
+    const fault_site sites[] = {MASS, FORCE, CONSTRAINT, JACOBIAN, CONSTRAINT_DT};
+    const char *names[] = {"mass callback returned", "force callback returned",
+                           "constraint callback returned", "jacobian callback returned",
+                           "constraint_dt callback returned"};
+    for (int i = 0; i < 5; ++i)
+        for (int rc = -7; rc <= 7; rc += 14) {
+            faulty model = {.p = {1.0, 1.0, 9.81}, .site = sites[i], .rc = rc};
+            double q[2] = {0.3, -1.0}, v[2] = {0.2, 0.4}, t;
+            ga_solver *s = NULL;
+            assert_int_equal(ga_create(2, 1, &s), GA_OK);
+            assert_int_equal(ga_set_callbacks(s, f_mass, f_force, f_constraint, f_jacobian,
+                                              &model),
+                             GA_OK);
+            assert_int_equal(ga_set_constraint_dt(s, f_constraint_dt), GA_OK);
+            assert_int_equal(ga_init(s, 0.0, q, v),
+                             rc < 0 ? GA_ERR_CALLBACK : GA_ERR_CALLBACK_RETRY);
+            expect_message(s, names[i]);
+            assert_int_equal(ga_get_t(s, &t), GA_ERR_STATE);
+            assert_int_equal(ga_step(s, 0.01), GA_ERR_STATE);
+            model.site = NONE;
+            assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+            assert_int_equal(ga_step(s, 0.01), GA_OK);
+            ga_free(s);
+        }
+}
+
+/* Projections with a rank-deficient Phi_q (the pendulum's constraint twice): position and
+ * velocity projection report a singular matrix instead of dividing by zero. */
+static void rank_deficient_projections_at_init(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = NULL;
+    double q[2] = {0.3, -1.0}, v[2] = {0.0, 0.0};
+    assert_int_equal(ga_create(2, 2, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_twice_constraint,
+                                      pendulum_twice_jacobian, &p),
+                     GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_SINGULAR);
+    expect_message(s, "cannot project q0: Phi_q is rank deficient");
+    q[0] = 0.0; /* on the circle, moving off it */
+    v[1] = 0.2;
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_SINGULAR);
+    expect_message(s, "cannot project v0: Phi_q is rank deficient");
+    ga_free(s);
+}
+
 static void inconsistent_start_refused_when_asked(void **state)
 {
     (void)state;
@@ -787,6 +841,8 @@ int main(void)
         T(newton_diverges_with_wrong_tangent),
         T(callback_calling_its_own_solver_is_refused),
         cmocka_unit_test(inconsistent_start_refused_when_asked),
+        cmocka_unit_test(callback_failures_in_ga_init),
+        cmocka_unit_test(rank_deficient_projections_at_init),
         cmocka_unit_test(projection_that_cannot_converge),
         cmocka_unit_test(singular_saddle_point_matrix_at_init),
         cmocka_unit_test(massless_coordinate_at_init),
