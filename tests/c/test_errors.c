@@ -388,6 +388,16 @@ static void bad_patterns_are_refused(void **state)
     expect_message(s, "outside the 1 x 2 matrix");
     assert_int_equal(ga_set_pattern(s, GA_MATRIX_JACOBIAN, 2, c, r), GA_ERR_ARG);
     assert_int_equal(ga_set_pattern(s, GA_MATRIX_JACOBIAN, 1, r, c), GA_OK);
+    /* the sparse solver asked for without the pattern of M (K_t and C_t by differences need
+     * theirs too) */
+    pendulum p = {1.0, 1.0, 9.81};
+    double q[2] = {0.0, -1.0}, v[2] = {0.0, 0.0};
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &p),
+                     GA_OK);
+    assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_ARG);
+    expect_message(s, "the sparse solver needs the patterns of M and Phi_q");
     /* without constraints there is no Jacobian to declare */
     assert_int_equal(ga_create(2, 0, &u), GA_OK);
     assert_int_equal(ga_set_pattern(u, GA_MATRIX_JACOBIAN, 1, r, c), GA_ERR_ARG);
