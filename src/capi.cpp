@@ -160,7 +160,7 @@ GA_API ga_status ga_set_tangents(ga_solver *s, ga_stiffness_fn stiffness, ga_dam
     return guarded(s, [&](ga::Solver &c) {
         c.model.cb.stiffness = stiffness;
         c.model.cb.damping = damping;
-        c.invalidate_jacobian();
+        c.tangent_options_changed();
         return GA_OK;
     });
 }
@@ -171,7 +171,7 @@ GA_API ga_status ga_set_tangent_mode(ga_solver *s, int mode)
         if (mode != GA_TANGENT_AUTO && mode != GA_TANGENT_FD && mode != GA_TANGENT_NEGLECT)
             return c.diag.fail(GA_ERR_ARG, "unknown tangent mode %d", mode);
         c.model.tangent_mode = static_cast<ga_tangent_mode>(mode);
-        c.invalidate_jacobian();
+        c.tangent_options_changed();
         return GA_OK;
     });
 }
@@ -273,7 +273,7 @@ GA_API ga_status ga_set_constant_mass(ga_solver *s, int on)
         if (on != 0 && on != 1)
             return c.diag.fail(GA_ERR_ARG, "constant mass must be 0 or 1, got %d", on);
         c.model.constant_mass = on == 1;
-        c.invalidate_jacobian();
+        c.tangent_options_changed();
         return GA_OK;
     });
 }

@@ -102,15 +102,20 @@ void Model::allocate_workspace(const ModelMatrix &M, const ModelMatrix &J, const
     phi_minus_.setZero(m_);
     g_plus_.setZero(m_);
     g_minus_.setZero(m_);
-    // n x n scratch only where finite differences may be needed: the Jacobian scratch also
-    // serves the constraint acceleration term
+    J_pert_.copy_layout(J);  // also serves the constraint acceleration term
+    prepare_differences(M, K, C);
+}
+
+// n x n scratch only where finite differences may be needed.
+void Model::prepare_differences(const ModelMatrix &M, const ModelMatrix &K, const ModelMatrix &C)
+{
     const bool fd_stiffness = !cb.stiffness || tangent_mode == GA_TANGENT_FD;
-    if (fd_stiffness && !constant_mass)
+    const bool fd_damping = !cb.damping || tangent_mode == GA_TANGENT_FD;
+    if (fd_stiffness && !constant_mass && M_pert_.size() != M.size())
         M_pert_.copy_layout(M);
-    J_pert_.copy_layout(J);
-    if (!K.dense() && fd_stiffness)
+    if (fd_stiffness && !K.dense() && K.nnz() > 0 && k_groups_.count() == 0)
         k_groups_.build(K);
-    if (!C.dense() && (!cb.damping || tangent_mode == GA_TANGENT_FD))
+    if (fd_damping && !C.dense() && C.nnz() > 0 && c_groups_.count() == 0)
         c_groups_.build(C);
 }
 
@@ -224,8 +229,8 @@ ga_status Model::perturbed_residual(double t, const Vec &qp, const Vec &v, const
                                     const Vec &lambda, const ModelMatrix &M, Vec &r)
 {
     if (!constant_mass) {
-        if (M_pert_.size() != M.size())
-            M_pert_.copy_layout(M);  // options changed after setup: allocate once, here
+        if (M_pert_.size() != M.size())  // prepare_differences was not called: a bug
+            return diag_.fail(GA_ERR_INTERNAL, "finite-difference workspace for M missing");
         if (auto st = mass(t, qp, M_pert_))
             return st;
     }
@@ -264,8 +269,8 @@ ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
         return GA_OK;
     }
     K.set_zero();
-    if (k_groups_.count() == 0 && K.nnz() > 0)
-        k_groups_.build(K);  // options changed after setup: built once, here
+    if (k_groups_.count() == 0 && K.nnz() > 0)  // prepare_differences was not called: a bug
+        return diag_.fail(GA_ERR_INTERNAL, "finite-difference column groups for K_t missing");
     const auto &ri = K.row_index();
     const auto &ci = K.col_index();
     for (int g = 0; g < k_groups_.count(); ++g) {
@@ -313,8 +318,8 @@ ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, Mod
         return GA_OK;
     }
     C.set_zero();
-    if (c_groups_.count() == 0 && C.nnz() > 0)
-        c_groups_.build(C);  // options changed after setup: built once, here
+    if (c_groups_.count() == 0 && C.nnz() > 0)  // prepare_differences was not called: a bug
+        return diag_.fail(GA_ERR_INTERNAL, "finite-difference column groups for C_t missing");
     const auto &ri = C.row_index();
     const auto &ci = C.col_index();
     for (int g = 0; g < c_groups_.count(); ++g) {

@@ -46,6 +46,10 @@ public:
     // Scratch for finite differences, shaped like the solver's matrices (setup only).
     void allocate_workspace(const ModelMatrix &M, const ModelMatrix &J, const ModelMatrix &K,
                             const ModelMatrix &C);
+    // The part of it that depends on the options (tangent callbacks and mode, constant mass):
+    // built at setup, and again by the option setters when an option change needs more, so
+    // that steps never allocate. Builds only what is missing.
+    void prepare_differences(const ModelMatrix &M, const ModelMatrix &K, const ModelMatrix &C);
 
     bool ready() const { return cb.mass != nullptr && (m_ == 0 || (cb.constraint && cb.jacobian)); }
     bool uses_tangents() const { return tangent_mode != GA_TANGENT_NEGLECT; }

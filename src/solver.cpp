@@ -487,6 +487,13 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
     return GA_OK;
 }
 
+void Solver::tangent_options_changed()
+{
+    invalidate_jacobian();
+    if (workspace_ready_)
+        model.prepare_differences(M_, K_, C_);  // may throw std::bad_alloc (GA_ERR_NOMEM)
+}
+
 double Solver::last_rcond() const
 {
     return formulation == GA_INDEX2_STABILIZED ? S2_.rcond() : S_.rcond();

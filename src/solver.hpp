@@ -94,6 +94,11 @@ public:
         fd_tangents_ = false;
     }
 
+    // An option or callback that shapes the tangents changed (ga_set_tangents,
+    // ga_set_tangent_mode, ga_set_constant_mass): a fresh matrix, and after setup the
+    // finite-difference scratch the new choice needs, allocated here rather than in a step.
+    void tangent_options_changed();
+
     // For bench/: the unavoidable work of a step, done once at the current state -- one
     // residual evaluation (callbacks and r^q, r^lambda) and one solve with the factorization
     // at hand (made first if there is none). The per-step cost is measured against it.

@@ -237,6 +237,63 @@ static void no_allocation_in_failing_step(void **state)
     assert_int_equal(count_step_allocations(GA_TANGENT_AUTO, 1), 0);
 }
 
+/* Options that call for finite-difference tangents changed after ga_init (the setter builds
+ * what they need, not the next step): exact K_t first, then differences (GA_TANGENT_FD), then
+ * a mass matrix no longer constant, then no tangent callback at all. Sparse (chain) and dense
+ * (pendulum). */
+static long steps_after_option_changes(ga_solver *s, double h)
+{
+    long total = 0;
+    for (int change = 0; change < 3; ++change) {
+        if (change == 0)
+            assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
+        if (change == 1)
+            assert_int_equal(ga_set_constant_mass(s, 0), GA_OK);
+        if (change == 2) {
+            assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_AUTO), GA_OK);
+            assert_int_equal(ga_set_tangents(s, NULL, NULL), GA_OK);
+        }
+        long long before = 0, after = 0;
+        ga_get_counter(s, GA_COUNT_STIFFNESS_EVALS, &before);
+        allocations = 0;
+        armed = 1;
+        for (int i = 0; i < 10; ++i)
+            assert_int_equal(ga_step(s, h), GA_OK);
+        armed = 0;
+        total += allocations;
+        ga_get_counter(s, GA_COUNT_STIFFNESS_EVALS, &after);
+        if (change < 2)
+            assert_true(after > before); /* the differences were computed in these steps */
+    }
+    return total;
+}
+
+static void no_allocation_after_tangent_options_change(void **state)
+{
+    (void)state;
+    chain c = chain_make(50);
+    double q[150], v[150];
+    chain_initial(&c, q, v);
+    ga_solver *s = chain_solver(&c, 1);
+    assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    assert_int_equal(ga_set_constant_mass(s, 1), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    assert_int_equal(steps_after_option_changes(s, 1e-3), 0);
+    ga_free(s);
+
+    pendulum p = {1.0, 1.0, 9.81};
+    pendulum_state(&p, 1.0, 0.5, q, v);
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &p),
+                     GA_OK);
+    assert_int_equal(ga_set_tangents(s, pendulum_stiffness, NULL), GA_OK);
+    assert_int_equal(ga_set_constant_mass(s, 1), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    assert_int_equal(steps_after_option_changes(s, 1e-2), 0);
+    ga_free(s);
+}
+
 int main(void)
 {
     install();
@@ -247,6 +304,7 @@ int main(void)
         cmocka_unit_test(no_allocation_in_sparse_step),
         cmocka_unit_test(no_allocation_with_dropped_constraints),
         cmocka_unit_test(no_allocation_with_any_dense_kernel),
+        cmocka_unit_test(no_allocation_after_tangent_options_change),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
