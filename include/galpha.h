@@ -580,9 +580,13 @@ GA_API ga_status ga_reset_counters(ga_solver *s);
  *  Double-valued facts about the most recent Newton solve, for studies and tuning. */
 /**@{*/
 typedef enum ga_info {
-    GA_INFO_RCOND = 0,        /**< reciprocal condition number (LAPACK 1-norm estimate) of the
+    GA_INFO_RCOND = 0,        /**< reciprocal condition number (1-norm estimate) of the
                                    iteration matrix factorized last, as solved: scaled by
-                                   eq. (10) or not; 1/value is its condition number */
+                                   eq. (10) or not; 1/value is its condition number. Dense:
+                                   LAPACK's dgecon on the LU factors; sparse: KLU's
+                                   klu_condest, of the matrix with its rows equilibrated as
+                                   KLU factorizes it. Computed when asked for (a few solves),
+                                   never in steps; 0 if the matrix was singular. */
     GA_INFO_NEWTON_ITERS = 1, /**< Newton iterations of the last ga_step (accepted or not) */
     GA_INFO_NEWTON_RATIO = 2, /**< last increment / tolerance ratio of that step's stopping
                                    test (<= 1 means converged by the relative test) */

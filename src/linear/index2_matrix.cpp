@@ -9,6 +9,7 @@
 
 #include "assemble.hpp"
 #include "klu_system.hpp"
+#include "lapack.hpp"
 #include "unblocked_lu.hpp"
 
 namespace ga {
@@ -28,6 +29,13 @@ struct Index2Matrix::Dense {
     Eigen::VectorXi ipiv, extent;
     Vec rhs, x, inverse_diagonal;
     double pivot_ratio = 0.0;
+    // condition estimate on demand (dgecon on the factors, LAPACK layout from either LU): the
+    // 1-norm of S is taken before the unblocked kernel overwrites it
+    double anorm = 0.0;
+    mutable double rcond = 0.0;
+    mutable bool rcond_valid = false;
+    mutable Vec work;
+    mutable Eigen::VectorXi iwork;
 };
 
 #ifdef GALPHA_HAVE_KLU
@@ -138,6 +146,8 @@ void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const 
     d->inverse_diagonal.setZero(N);
     d->rhs.setZero(N);
     d->x.setZero(N);
+    d->work.setZero(4 * static_cast<Eigen::Index>(N));
+    d->iwork.setZero(N);
     dense_ = std::move(d);
 }
 
@@ -209,7 +219,9 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
                 }
     d.unblocked = d.kind == DenseKind::Unblocked ||
                   (d.kind == DenseKind::Auto && unblocked_lu_preferred(N, d.S.data()));
+    d.rcond_valid = false;
     if (d.unblocked) {
+        d.anorm = d.S.cwiseAbs().colwise().sum().maxCoeff();
         if (!unblocked_lu(N, d.S.data(), d.ipiv.data(), d.extent.data(),
                           d.inverse_diagonal.data())) {
             d.pivot_ratio = 0.0;
@@ -277,9 +289,23 @@ double Index2Matrix::rcond() const
 {
 #ifdef GALPHA_HAVE_KLU
     if (sparse_)
-        return sparse_->S.rcond();
+        return sparse_->S.rcond_estimate();
 #endif
-    return dense_ ? dense_->pivot_ratio : 0.0;
+    if (!dense_ || !(dense_->pivot_ratio > 0.0))
+        return 0.0;
+    const Dense &d = *dense_;
+    if (!d.rcond_valid) {
+        const int N = static_cast<int>(d.S.rows());
+        int info = 0;
+        const Mat &factors = d.unblocked ? d.S : d.lu.matrixLU();
+        double anorm = d.anorm;
+        if (!d.unblocked)  // S is intact: Eigen factorized a copy
+            anorm = dlange_("1", &N, &N, d.S.data(), &N, d.work.data(), 1);
+        dgecon_("1", &N, factors.data(), &N, &anorm, &d.rcond, d.work.data(), d.iwork.data(),
+                &info, 1);
+        d.rcond_valid = true;
+    }
+    return d.rcond;
 }
 
 const char *Index2Matrix::name() const

@@ -115,6 +115,19 @@ bool KluSystem::factorize()
     return rcond_ >= std::numeric_limits<double>::epsilon();
 }
 
+double KluSystem::rcond_estimate() const
+{
+    if (!numeric_ || rcond_ <= 0.0)
+        return 0.0;
+    // values_ still holds the scaled matrix of the last factorization
+    // (klu_condest does not write to the matrix; its prototype is not const-correct)
+    if (!klu_condest(const_cast<int *>(colptr_.data()), const_cast<double *>(values_.data()),
+                     symbolic_, numeric_, &common_) ||
+        !(common_.condest > 0.0))
+        return 0.0;
+    return 1.0 / common_.condest;
+}
+
 void KluSystem::scale_rows()
 {
     for (std::size_t k = 0; k < values_.size(); ++k)

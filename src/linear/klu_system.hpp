@@ -32,8 +32,12 @@ public:
     // false if singular or numerically singular. Throws std::bad_alloc.
     bool factorize();
     void solve(double *rhs);  // in place, length N
-    // min |U_ii| / max |U_ii| of the last factorization (KLU's estimate)
-    double rcond() const { return rcond_; }
+    // min |U_ii| / max |U_ii| of the last factorization (KLU's cheap pivot ratio, which
+    // decides singularity)
+    double pivot_ratio() const { return rcond_; }
+    // Reciprocal 1-norm condition estimate of the matrix factorized last, rows scaled as
+    // factorized (klu_condest: a few solves; on demand, not in steps). 0 if singular.
+    double rcond_estimate() const;
     const char *ordering() const { return ordering_; }
     // Factorizations with new pivots so far (the others were refactorizations).
     int full_factorizations() const { return full_factorizations_; }
@@ -48,7 +52,7 @@ private:
     std::vector<double> values_;
     std::vector<double> row_scale_;  // D: 1 / the largest entry of each row at the last full
                                      // factorization
-    klu_common common_;
+    mutable klu_common common_;  // klu_condest writes its result here
     klu_symbolic *symbolic_ = nullptr;
     klu_numeric *numeric_ = nullptr;
     double rcond_ = 0.0;

@@ -98,7 +98,7 @@ public:
 
     void solve(Vec &rhs) override { S_.solve(rhs.data()); }
 
-    double rcond() const override { return S_.rcond(); }
+    double rcond() const override { return S_.rcond_estimate(); }
     const char *name() const override { return "sparse KLU"; }
 
 private:

@@ -19,6 +19,7 @@ typedef struct chain_run {
     double *q, *lambda;
     double energy_drift;
     double velocity_constraint; /* max over the steps of |Phi_q v|_inf */
+    double rcond;               /* GA_INFO_RCOND after the last step */
     long long stiffness_evals, jacobian_evals, factorizations, steps;
     char backend[64];
 } chain_run;
@@ -87,6 +88,7 @@ static chain_run run_formulation(int links, int solver, int formulation, int exa
     ga_get_counter(s, GA_COUNT_JACOBIAN_EVALS, &r.jacobian_evals);
     ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &r.factorizations);
     ga_get_counter(s, GA_COUNT_STEPS, &r.steps);
+    assert_int_equal(ga_get_info(s, GA_INFO_RCOND, &r.rcond), GA_OK);
     ga_free(s);
     free(q);
     free(v);
@@ -127,6 +129,13 @@ static void sparse_and_dense_solvers_agree(void **state)
     assert_true(max_abs_diff(la.q, de.q, 3 * links) < 1e-9);
     assert_true(max_abs_diff(un.q, de.q, 3 * links) < 1e-9);
     assert_true(max_abs_diff(un.lambda, de.lambda, 2 * links) < 1e-6);
+    /* GA_INFO_RCOND: 1-norm estimates of the same matrix from every backend (KLU's of its
+     * rows as equilibrated for the factorization, LAPACK's dgecon for the dense factors) */
+    printf("  rcond: KLU %.2e, Eigen %.2e, LAPACK %.2e, unblocked %.2e\n", sp.rcond, de.rcond,
+           la.rcond, un.rcond);
+    assert_true(la.rcond == de.rcond || fabs(la.rcond / de.rcond - 1.0) < 1e-6);
+    assert_true(fabs(un.rcond / de.rcond - 1.0) < 1e-6);
+    assert_true(sp.rcond > 0.1 * de.rcond && sp.rcond < 10.0 * de.rcond);
     release(&sp);
     release(&de);
     release(&la);
@@ -156,6 +165,10 @@ static void sparse_and_dense_index2_agree(void **state)
     assert_true(sp.velocity_constraint < 1e-9);
     assert_true(de.velocity_constraint < 1e-9);
     assert_true(i3.velocity_constraint > 1e3 * sp.velocity_constraint);
+    /* the index-2 systems report 1-norm condition estimates too */
+    printf("  index 2: rcond %.2e (sparse), %.2e (dense)\n", sp.rcond, de.rcond);
+    assert_true(de.rcond > 0.0 && de.rcond <= 1.0);
+    assert_true(sp.rcond > 0.1 * de.rcond && sp.rcond < 10.0 * de.rcond);
     release(&sp);
     release(&de);
     release(&i3);
@@ -239,6 +252,42 @@ static void energy_is_kept_to_integration_error(void **state)
     assert_true(o > 1.7);
 }
 
+/* An inconsistent start projected on the sparse path (the projection's saddle-point matrix
+ * [I Phi_q^T; Phi_q 0] assembled in the sparse layout) as on the dense one: the same
+ * consistent q0 and v0, on the constraints to round-off. */
+static void inconsistent_start_projected_sparse_as_dense(void **state)
+{
+    (void)state;
+    enum { LINKS = 20, N = 3 * LINKS, M = 2 * LINKS };
+    chain c = chain_make(LINKS);
+    double q0[N], v0[N], q[2][N], v[2][N], phi[M];
+    chain_initial(&c, q0, v0);
+    for (int i = 0; i < N; ++i) { /* off the constraints in positions and velocities */
+        q0[i] += 1e-3 * sin(1.7 * i);
+        v0[i] += 1e-2 * cos(0.9 * i);
+    }
+    const int solvers[2] = {GA_LINEAR_SPARSE, GA_LINEAR_DENSE_EIGEN};
+    for (int k = 0; k < 2; ++k) {
+        ga_solver *s = chain_solver(&c, 1);
+        assert_int_equal(ga_set_linear_solver(s, solvers[k]), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+        ga_get_q(s, q[k]);
+        ga_get_v(s, v[k]);
+        ga_free(s);
+        chain_constraint(0.0, q[k], phi, &c);
+        double worst = 0.0;
+        for (int i = 0; i < M; ++i)
+            worst = fmax(worst, fabs(phi[i]));
+        assert_true(worst < 1e-12);
+        assert_true(velocity_constraint(&c, q[k], v[k]) < 1e-12);
+    }
+    printf("  projected start, sparse vs dense: |dq0| = %.1e, |dv0| = %.1e (moved by %.1e)\n",
+           max_abs_diff(q[0], q[1], N), max_abs_diff(v[0], v[1], N), max_abs_diff(q[0], q0, N));
+    assert_true(max_abs_diff(q[0], q0, N) > 1e-4); /* the projection did move q0 */
+    assert_true(max_abs_diff(q[0], q[1], N) < 1e-13);
+    assert_true(max_abs_diff(v[0], v[1], N) < 1e-12);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -248,6 +297,7 @@ int main(void)
         cmocka_unit_test(grouped_finite_differences_match_exact_tangent),
         cmocka_unit_test(auto_choice_is_sparse_for_large_chains),
         cmocka_unit_test(energy_is_kept_to_integration_error),
+        cmocka_unit_test(inconsistent_start_projected_sparse_as_dense),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
