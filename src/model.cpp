@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <utility>
 
 namespace ga {
@@ -31,8 +32,7 @@ void ColumnGroups::build(const ModelMatrix &A)
     for (int k = 0; k < nnz; ++k)
         order[k] = k;
     std::sort(order.begin(), order.end(), [&](int a, int b) {
-        return std::make_pair(ci[a], ri[a]) < std::make_pair(ci[b], ri[b]) ||
-               (std::make_pair(ci[a], ri[a]) == std::make_pair(ci[b], ri[b]) && a < b);
+        return std::make_tuple(ci[a], ri[a], a) < std::make_tuple(ci[b], ri[b], b);
     });
     std::vector<int> unique;
     for (int k = 0; k < nnz; ++k)
