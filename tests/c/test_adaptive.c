@@ -211,13 +211,17 @@ static void index2_multipliers_stay_second_order_across_step_changes(void **stat
 }
 
 /* ---- start-up transient (ALGORITHMS.md 2.6) ---------------------------------------------- */
-static double startup_lambda_error(int corrected, double h)
+static double startup_lambda_error_rho(double rho, int corrected, double h, double t_end)
 {
-    ga_solver *s = pendulum_solver(0.9, GA_INDEX3, 1, corrected);
+    ga_solver *s = pendulum_solver(rho, GA_INDEX3, 1, corrected);
     exact_pendulum e = {0.0, TH0, OM0};
-    const double worst = max_lambda_error(s, &e, h, lround(0.1 / h));
+    const double worst = max_lambda_error(s, &e, h, lround(t_end / h));
     ga_free(s);
     return worst;
+}
+static double startup_lambda_error(int corrected, double h)
+{
+    return startup_lambda_error_rho(0.9, corrected, h, 0.1);
 }
 
 static void corrected_start_removes_the_first_order_transient(void **state)
@@ -237,6 +241,30 @@ static void corrected_start_removes_the_first_order_transient(void **state)
     assert_true(o_on > 1.8);
     assert_true(o_off < 1.3);
     assert_true(off[K - 1] > 10.0 * on[K - 1]);
+}
+
+/* rho_inf = 1 (no numerical damping, the trapezoidal rule): the start-up oscillation of lambda
+ * never decays, and without corrected starting values lambda does not converge at all
+ * (ALGORITHMS.md 2.6: error about 9 on [0, 1] for every h); the corrected start restores
+ * order 2. */
+static void rho_one_needs_the_corrected_start(void **state)
+{
+    (void)state;
+    enum { K = 4 };
+    double hs[K], on[K], off[K];
+    for (int k = 0; k < K; ++k) {
+        hs[k] = 0.01 / (1 << k);
+        on[k] = startup_lambda_error_rho(1.0, 1, hs[k], 1.0);
+        off[k] = startup_lambda_error_rho(1.0, 0, hs[k], 1.0);
+        printf("  rho_inf = 1, h = %.5f: max lambda error on [0, 1] %.2e corrected, %.2e not\n",
+               hs[k], on[k], off[k]);
+    }
+    const double o_on = fit_order(hs, on, K), o_off = fit_order(hs, off, K);
+    printf("  orders: %.2f corrected, %.2f not\n", o_on, o_off);
+    assert_true(o_on > 1.8);
+    assert_true(fabs(o_off) < 0.2); /* no convergence */
+    for (int k = 0; k < K; ++k)
+        assert_true(off[k] > 1.0);
 }
 
 /* ---- the error estimate against the true local error (ALGORITHMS.md 1.5, 6.5) -------------- */
@@ -693,6 +721,7 @@ int main(void)
         cmocka_unit_test(without_rescaling_alternating_steps_lose_an_order),
         cmocka_unit_test(index2_multipliers_stay_second_order_across_step_changes),
         cmocka_unit_test(corrected_start_removes_the_first_order_transient),
+        cmocka_unit_test(rho_one_needs_the_corrected_start),
         cmocka_unit_test(error_estimate_tends_to_the_true_local_error),
         cmocka_unit_test(advance_lands_on_every_output_time),
         cmocka_unit_test(interpolation_agrees_with_a_step_ending_there),
