@@ -382,7 +382,12 @@ typedef enum ga_formulation {
                                   or sparse: with declared
                                   patterns the system keeps the Newmark increment as extra
                                   unknowns, so no block is a product of the user's matrices
-                                  (2n + 2m sparse unknowns instead of n + 2m dense ones). */
+                                  (2n + 2m sparse unknowns instead of n + 2m dense ones).
+                                  Its Newton matrix includes the curvature of the velocity
+                                  constraint, d(Phi_q v + Phi_t)/dq, from one more Jacobian
+                                  call per matrix (left out with GA_TANGENT_NEGLECT): without
+                                  it Newton converges only linearly, at about the angle a
+                                  body turns in one step. */
 } ga_formulation;
 
 /** formulation is a ::ga_formulation. Errors: GA_ERR_ARG, GA_ERR_STATE, GA_ERR_NOMEM (index-2

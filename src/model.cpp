@@ -214,6 +214,25 @@ ga_status Model::jacobian(double t, const Vec &q, ModelMatrix &J)
     return check_finite(J.data(), J.size(), message_rows(J), "constraint Jacobian Phi_q", t);
 }
 
+// Each Phi_i has a symmetric second derivative, so Phi_qq(v, w) = (d/de Phi_q(q + e v)) w:
+// the whole block is one directional difference of Phi_q along (v, 1) in (q, t), which also
+// takes in Phi_qt = d(Phi_t)/dq for rheonomic constraints.
+ga_status Model::velocity_constraint_tangent(double t, const Vec &q, const Vec &v,
+                                             const ModelMatrix &J, ModelMatrix &Z)
+{
+    const double q_scale = std::max(q.lpNorm<Eigen::Infinity>(), 1.0);
+    const double e = std::sqrt(std::numeric_limits<double>::epsilon()) * q_scale /
+                     std::max(v.lpNorm<Eigen::Infinity>(), 1.0);
+    q_pert_ = q + e * v;
+    if (auto st = jacobian(t + e, q_pert_, Z))
+        return st;
+    const double *j = J.data();
+    double *z = Z.data();
+    for (Eigen::Index k = 0; k < Z.size(); ++k)
+        z[k] = (z[k] - j[k]) / e;
+    return GA_OK;
+}
+
 void Model::dynamics_residual(const ModelMatrix &M, const Vec &qdd, const Vec &f,
                               const ModelMatrix &J, const Vec &lambda, Vec &rq)
 {

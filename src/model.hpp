@@ -63,6 +63,10 @@ public:
     ga_status force(double t, const Vec &q, const Vec &v, Vec &f);
     ga_status constraint(double t, const Vec &q, Vec &phi);
     ga_status jacobian(double t, const Vec &q, ModelMatrix &J);
+    // Z = d/dq (Phi_q(q, t) v + Phi_t(q, t)), the curvature block of the index-2 velocity
+    // constraint, from J = Phi_q(q, t) and one more Jacobian evaluation (layout of J).
+    ga_status velocity_constraint_tangent(double t, const Vec &q, const Vec &v,
+                                          const ModelMatrix &J, ModelMatrix &Z);
 
     // K_t = d r^q / dq at fixed v, qdd, lambda. rq is r^q at q, M the mass matrix at q (both
     // used by finite differences; with a constant mass M is not evaluated again).

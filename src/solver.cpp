@@ -132,6 +132,7 @@ ga_status Solver::setup()
     K_.allocate();
     C_.allocate();
     B_.copy_layout(J_);
+    Z_.copy_layout(J_);
     f_.setZero(n_);
     phi_.setZero(m_);
     phi_v_.setZero(m_);
@@ -173,7 +174,7 @@ void Solver::prefactor_index2()
     if (!S2_.sparse())
         return;
     count(counters, GA_COUNT_FACTORIZATIONS);
-    S2_.factorize(M_, nullptr, nullptr, J_, J_, params, 1.0);
+    S2_.factorize(M_, nullptr, nullptr, J_, J_, nullptr, params, 1.0);
 }
 
 // The projection of error estimates (adaptive mode only): set up at the first adaptive call,
@@ -333,13 +334,13 @@ ga_status Solver::residual(double t, const State &x)
 }
 
 // Rebuild and factorize the iteration matrix at the current iterate.
-ga_status Solver::factorize(double h, bool tangents_K, bool tangents_C, int iter)
+ga_status Solver::factorize(double h, bool tangents_K, bool tangents_C, bool tangent_Z, int iter)
 {
     count(counters, GA_COUNT_FACTORIZATIONS);
     jacobian_valid_ = false;
     const ModelMatrix *C = tangents_C ? &C_ : nullptr, *K = tangents_K ? &K_ : nullptr;
     const bool ok = formulation == GA_INDEX2_STABILIZED
-                        ? S2_.factorize(M_, C, K, J_, B_, params, h)
+                        ? S2_.factorize(M_, C, K, J_, B_, tangent_Z ? &Z_ : nullptr, params, h)
                         : S_.factorize_step(M_, C, K, J_, params, h, scaling);
     if (!ok)
         return diag.fail(GA_ERR_SINGULAR,
@@ -424,8 +425,12 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
             st = model.stiffness(t1, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_);
         if (!st && refresh && tangents_C)
             st = model.damping(t1, x.q, x.v, f_, C_);
+        // index 2: the curvature of the velocity constraint, a tangent like K_t
+        const bool tangent_Z = index2 && m_ > 0 && model.uses_tangents();
+        if (!st && refresh && tangent_Z)
+            st = model.velocity_constraint_tangent(t1, x.q, x.v, J_, Z_);
         if (!st && refresh) {
-            st = factorize(h, tangents_K, tangents_C, iter);
+            st = factorize(h, tangents_K, tangents_C, tangent_Z, iter);
             refresh = false;
             refresh_done = true;
         } else if (!st) {

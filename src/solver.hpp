@@ -123,7 +123,7 @@ private:
     ga_status attempt_step(double h, double tol);
     ga_status newton(double h, double tol, bool refresh, bool &converged, bool &used_stale);
     ga_status residual(double t, const State &x);
-    ga_status factorize(double h, bool tangents_K, bool tangents_C, int iter);
+    ga_status factorize(double h, bool tangents_K, bool tangents_C, bool tangent_Z, int iter);
     ga_status evaluate_mass(double t, const Vec &q);
     void commit(bool land_on, double t_land);
     double error_norm(double h);  // control.cpp
@@ -171,6 +171,7 @@ private:
 
     // Step workspace, sized once.
     ModelMatrix M_, J_, K_, C_, B_;  // B_: index-2, Phi_q(q_n)
+    ModelMatrix Z_;                  // index-2: d(Phi_q v + Phi_t)/dq, layout of J_
     Vec f_, phi_, phi_v_, rq_, dq_, dw_, dlambda_, deta_, c_, qdd_tmp_, lambda_tmp_;
     IterationMatrix S_;
     IterationMatrix P_;  // [I Phi_q^T; Phi_q 0]: tangent projection of error estimates

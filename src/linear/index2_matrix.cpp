@@ -43,7 +43,7 @@ struct Index2Matrix::Sparse {
     int n = 0, m = 0;
     KluSystem S;
     // slots of each block's entries, in the order of the block's pattern
-    std::vector<int> K, M, C, JT, J2, J3, BT, minus_I, plus_I;
+    std::vector<int> K, M, C, JT, J2, J3, BT, Z, minus_I, plus_I;
     std::vector<int> J_rows, lambda_diag, eta_diag;  // inactive constraints
     Vec rhs;
 };
@@ -83,6 +83,7 @@ void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const 
         block(J, true, w0, e0);     // -B^T (B has the layout of Phi_q)
         block(J, false, l0, 0);     // Phi_q d
         block(J, false, e0, w0);    // Phi_q w
+        block(J, false, e0, 0);     // (beta h / gamma) Z d: Z has the pattern of Phi_q
         for (int i = 0; i < n; ++i) {
             entries.emplace_back(w0 + i, i);       // -I
             entries.emplace_back(w0 + i, w0 + i);  // I
@@ -109,6 +110,7 @@ void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const 
         s->BT = slots(J, true, w0, e0);
         s->J2 = slots(J, false, l0, 0);
         s->J3 = slots(J, false, e0, w0);
+        s->Z = slots(J, false, e0, 0);
         for (int i = 0; i < n; ++i) {
             s->minus_I.push_back(s->S.slot(w0 + i, i));
             s->plus_I.push_back(s->S.slot(w0 + i, w0 + i));
@@ -152,9 +154,10 @@ void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const 
 }
 
 bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,
-                             const ModelMatrix &J, const ModelMatrix &B, const Params &p,
-                             double h)
+                             const ModelMatrix &J, const ModelMatrix &B, const ModelMatrix *Z,
+                             const Params &p, double h)
 {
+    const double cZ = p.beta * h / p.gamma;
     const double cM = mass_factor(p);
 #ifdef GALPHA_HAVE_KLU
     if (sparse_) {
@@ -175,6 +178,8 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
         scatter(B, s.BT, -1.0);
         scatter(J, s.J2, 1.0);
         scatter(J, s.J3, 1.0);
+        if (Z)
+            scatter(*Z, s.Z, cZ);
         for (int k : s.minus_I)
             v[k] -= 1.0;
         for (int k : s.plus_I)
@@ -182,7 +187,7 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
         if (active_) {
             for (std::size_t k = 0; k < s.J_rows.size(); ++k)
                 if (!active_[s.J_rows[k]])
-                    v[s.JT[k]] = v[s.BT[k]] = v[s.J2[k]] = v[s.J3[k]] = 0.0;
+                    v[s.JT[k]] = v[s.BT[k]] = v[s.J2[k]] = v[s.J3[k]] = v[s.Z[k]] = 0.0;
             for (int i = 0; i < s.m; ++i)
                 if (!active_[i])
                     v[s.lambda_diag[i]] = v[s.eta_diag[i]] = 1.0;
@@ -209,6 +214,8 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
     d.S.block(0, n, n, m) = Jd.transpose();
     d.S.block(n + m, 0, m, n) = Jd;
     d.S.block(n + m, n + m, m, m).noalias() = Jd * d.Bd.transpose();
+    if (Z)
+        add_block(d.S.data(), N, n + m, 0, cZ, *Z);
     if (active_)
         for (int i = 0; i < m; ++i)
             if (!active_[i])

@@ -9,7 +9,10 @@
 //
 //   = -[ beta h^2 r^q ; Phi ; (beta h / gamma) (Phi_q v + Phi_t) ]
 //
-// (the curvature term d(Phi_q v)/dq of the third row is neglected, as gena does by default).
+// plus, unless tangents are neglected, the curvature of the velocity constraint in the third
+// row's first block, (beta h / gamma) Z with Z = d(Phi_q v + Phi_t)/dq (ALGORITHMS.md sec. 2.2;
+// gena leaves it out by default, and Newton then contracts only like h |v| / length: on
+// Andrews' mechanism 3.5 instead of 2.1 iterations per step).
 // Dense: (n + 2m)^2, Eigen LU. Sparse (declared patterns, KLU): the products A B^T and
 // Phi_q B^T would fill, so the Newmark increment w = d + B^T eta_bar becomes an unknown of its
 // own and every block is one of the user's sparse matrices:
@@ -17,7 +20,7 @@
 //   [ beta h^2 K   A       Phi_q^T   0     ] [d         ]   [ -beta h^2 r^q          ]
 //   [ -I           I       0         -B^T  ] [w         ] = [ 0                      ]
 //   [ Phi_q        0       0         0     ] [lambda_bar]   [ -Phi                   ]
-//   [ 0            Phi_q   0         0     ] [eta_bar   ]   [ -(beta h / gamma) Phi_v ]
+//   [ (bh/g) Z     Phi_q   0         0     ] [eta_bar   ]   [ -(beta h / gamma) Phi_v ]
 //
 // (eliminating w gives the first system back).
 #pragma once
@@ -44,9 +47,10 @@ public:
                const unsigned char *active);
     bool ready() const { return dense_ || sparse_; }
     bool sparse() const { return sparse_ != nullptr; }
-    // false if singular or numerically singular
+    // false if singular or numerically singular. Z (layout of J) may be null: left out.
     bool factorize(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,
-                   const ModelMatrix &J, const ModelMatrix &B, const Params &p, double h);
+                   const ModelMatrix &J, const ModelMatrix &B, const ModelMatrix *Z,
+                   const Params &p, double h);
     // (d, dlambda, eta_bar) in natural units of d and lambda, and the Newmark part of the
     // update, w = d + B^T eta_bar.
     void solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const Params &p, double h,
