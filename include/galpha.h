@@ -289,8 +289,9 @@ typedef enum ga_reuse_mode {
                             than the factor 5/3 in h^2 since it was built (IDA's band), when the
                             contraction measured with it says the tolerance cannot be reached
                             within 4 iterations on that matrix (or the iteration diverges), and
-                            after any failed step. A step that fails to converge with an old matrix is
-                            retried once with a fresh one before GA_ERR_NEWTON is reported. */
+                            after any failed step. A step that fails to converge with an old
+                            matrix is retried once with a fresh one before GA_ERR_NEWTON is
+                            reported. */
     GA_REUSE_NEVER = 1 /**< full Newton as printed in Algorithm 1: tangents and factorization
                             at every iteration */
 } ga_reuse_mode;
@@ -531,8 +532,8 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
  *  The full state as a flat array of doubles, so a host simulator can save, restore and
  *  restart: a run restarted from a checkpoint continues bit-identically, in fixed-step and in
  *  adaptive mode (from a checkpoint taken before the first step too: that step still applies
- *  the corrected start). Layout 2: [magic, layout version, n, m, t, h_last, h_next, err_prev, grew,
- *  q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n)] (h_next, err_prev, grew: the step-size
+ *  the corrected start). Layout 2: [magic, layout version, n, m, t, h_last, h_next, err_prev,
+ *  grew, q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n)] (h_next, err_prev, grew: the step-size
  *  controller; a_prev: the a of the step before, for the error estimate); treat it as opaque.
  *  The factorized iteration matrix is not part of it: taking a checkpoint makes the next step
  *  start with a fresh one, as a restart does. ga_set_state needs callbacks set, allocates like
