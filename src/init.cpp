@@ -77,7 +77,7 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
 ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v, Vec &qdd,
                                            Vec &lambda)
 {
-    ga_status st = model.mass(t, q, M_);
+    ga_status st = evaluate_mass(t, q);  // once for a constant mass (ga_set_constant_mass)
     if (!st)
         st = model.force(t, q, v, f_);
     if (!st)
@@ -86,7 +86,6 @@ ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v,
         st = model.constraint_accel(t, q, v, c_);
     if (st)
         return st;
-    mass_valid_ = model.constant_mass;
     jacobian_valid_ = false;  // S_ holds another matrix now
     double sigma = 1.0;
     const double mmax = max_abs(M_), jmax = max_abs(J_);

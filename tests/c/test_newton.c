@@ -555,6 +555,53 @@ static void index2_newton_converges_like_index3(void **state)
     assert_true(i2 <= i3 + 0.5);
 }
 
+/* ga_set_constant_mass: M is evaluated once - at ga_init, not again by the corrected start's
+ * consistent accelerations, the steps, the index-2 system or the adaptive error projection -
+ * and once more after an option that drops the matrix; without it, at every residual. */
+static long long mass_evaluations(int constant, int formulation)
+{
+    ga_solver *s = NULL;
+    double q[2], v[2];
+    long long evals = 0, residuals = 0;
+    pendulum_state(&P, 1.0, 0.5, q, v);
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &P),
+                     GA_OK);
+    assert_int_equal(ga_set_constant_mass(s, constant), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    for (int k = 0; k < 50; ++k)
+        assert_int_equal(ga_step(s, 1e-2), GA_OK);
+    assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+    assert_int_equal(ga_advance(s, 1.0), GA_OK);
+    ga_get_counter(s, GA_COUNT_MASS_EVALS, &evals);
+    ga_get_counter(s, GA_COUNT_RESIDUALS, &residuals);
+    if (!constant)
+        assert_true(evals > residuals);
+    if (constant) { /* an option that changes the iteration matrix re-reads M once */
+        long long after = 0;
+        assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
+        assert_int_equal(ga_advance(s, 1.5), GA_OK);
+        ga_get_counter(s, GA_COUNT_MASS_EVALS, &after);
+        assert_int_equal(after, evals + 1);
+    }
+    ga_free(s);
+    return evals;
+}
+
+static void constant_mass_is_evaluated_once(void **state)
+{
+    (void)state;
+    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+        const long long once = mass_evaluations(1, formulation);
+        const long long every = mass_evaluations(0, formulation);
+        printf("  %s: M evaluated %lld times (constant), %lld (not)\n",
+               formulation == GA_INDEX3 ? "index 3" : "index 2", once, every);
+        assert_int_equal(once, 1);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -566,6 +613,7 @@ int main(void)
         cmocka_unit_test(full_newton_factorizes_every_iteration),
         cmocka_unit_test(scaling_keeps_the_condition_bounded),
         cmocka_unit_test(index2_newton_converges_like_index3),
+        cmocka_unit_test(constant_mass_is_evaluated_once),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -312,3 +312,71 @@ def test_initial_step_and_counter_reset():
         assert s.stats["steps"] == 1
     with pytest.raises(galpha.ArgumentError, match="initial step"):
         pendulum(initial_step=-1.0)
+
+
+def stiffness(t, q, v, qdd, lam, K):
+    K[:] = lam[0] * np.eye(2)  # d(Phi_q^T lambda)/dq; M constant, f constant
+
+
+def damping(t, q, v, C):
+    C[:] = 0.0  # f does not depend on v
+
+
+def constraint_accel(t, q, v, out):
+    out[0] = v @ v  # d^2/dt^2 Phi - Phi_q q'' = |v|^2
+
+
+def test_every_option_keyword_reaches_its_setter():
+    """Options that do not change the discrete solution, all set at once, give the default
+    run's steps (to the Newton tolerance); each keyword that is refused names its setter's
+    complaint."""
+    def run(**kw):
+        with pendulum(newton=(1e-12, 30), **kw) as s:
+            s.init(0.0, Q0, V0)
+            for _ in range(100):
+                s.step(1e-2)
+            return s.q, s.lam, s.stats
+    q0, l0, _ = run()
+    q1, l1, stats = run(stiffness=stiffness, damping=damping, constraint_accel=constraint_accel,
+                        tangent_mode=galpha.GA_TANGENT_AUTO, scaling=True,
+                        predictor=galpha.GA_PREDICTOR_CONSTANT_A, reuse=galpha.GA_REUSE_NEVER,
+                        constant_mass=True, linear_solver=galpha.GA_LINEAR_DENSE_LAPACK,
+                        init_mode=(galpha.GA_INIT_PROJECT, 1e-12),
+                        redundant=galpha.GA_REDUNDANT_DROP, rescale=True,
+                        corrected_start=True, step_limits=(0.0, 0.0))
+    assert np.max(np.abs(q1 - q0)) < 1e-10
+    assert abs(l1[0] - l0[0]) < 1e-8 * abs(l0[0])
+    assert stats["stiffness_evals"] > 0 and stats["damping_evals"] > 0  # the callbacks ran
+    assert stats["mass_evals"] == 1  # constant mass: evaluated once
+    assert stats["factorizations"] >= stats["newton_iters"]  # full Newton
+    refused = {"tangent_mode": (7, "unknown tangent mode 7"),
+               "predictor": (7, "unknown predictor 7"),
+               "reuse": (7, "unknown reuse mode 7"),
+               "linear_solver": (99, "unknown linear solver 99"),
+               "formulation": (5, "unknown formulation 5"),
+               "redundant": (9, "unknown redundancy mode 9"),
+               "init_mode": ((galpha.GA_INIT_PROJECT, 0.0), "init_tol = 0 must be positive"),
+               "tolerances": ((0.0, 1e-6), "must be positive and finite"),
+               "step_limits": ((-1.0, 0.0), "step limits h_min = -1")}
+    for key, (value, message) in refused.items():
+        with pytest.raises(galpha.ArgumentError, match=message):
+            pendulum(**{key: value})
+
+
+def test_init_checks_the_shapes():
+    with pendulum() as s:
+        with pytest.raises(galpha.ArgumentError, match=r"shape \(2,\)"):
+            s.init(0.0, [0.0, -1.0, 0.0], V0)
+
+
+def test_missing_library_is_reported_with_where_it_looked():
+    import subprocess
+    env = dict(os.environ, GALPHA_LIBRARY="/nonexistent/libgalpha.so.0")
+    code = ("import sys; sys.path.insert(0, %r)\n"
+            "try:\n    import galpha\nexcept OSError as e:\n    print(e)\n"
+            % os.path.join(os.path.dirname(__file__), "..", "..", "bindings", "python"))
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                         text=True, check=True).stdout
+    assert "libgalpha not found" in out
+    assert "environment variable GALPHA_LIBRARY: /nonexistent/libgalpha.so.0" in out
+    assert "Set GALPHA_LIBRARY" in out
