@@ -433,6 +433,15 @@ static void bad_adaptive_calls_are_refused(void **state)
     assert_int_equal(ga_advance(x->s, t), GA_OK); /* already there: nothing to do */
     snapshot(x->s, after);
     assert_memory_equal(before, after, len * sizeof(double));
+
+    /* dense output needs a step: not after ga_set_state; not at NaN or outside the step */
+    double q[2];
+    assert_int_equal(ga_interpolate(x->s, t, q, NULL, NULL), GA_OK);
+    assert_int_equal(ga_interpolate(x->s, NAN, q, NULL, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_interpolate(x->s, t + 1.0, q, NULL, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_set_state(x->s, before, len), GA_OK);
+    assert_int_equal(ga_interpolate(x->s, t, q, NULL, NULL), GA_ERR_STATE);
+    assert_int_equal(ga_interpolate(NULL, t, q, NULL, NULL), GA_ERR_ARG);
 }
 
 static void bad_checkpoints_are_refused(void **state)
