@@ -2,10 +2,13 @@
  * falling under gravity, with the sparsity of M, Phi_q, K_t and C_t declared once
  * (examples/scenes/chain.c). galpha picks SuiteSparse KLU; a dense iteration matrix would have
  * 2.5e9 entries. First 0.1 s at a fixed step, index 3; then 0.5 s in adaptive
- * steps of the stabilized index-2 formulation, with output every 0.1 s by interpolation. */
+ * steps of the stabilized index-2 formulation, with output every 0.1 s by interpolation.
+ * Usage: chain_demo [links] [--print] (--print: the fixed steps only, then the final q and
+ * lambda with 17 digits, for the comparison with examples/python/chain.py). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "scenes/chain.h"
@@ -34,12 +37,24 @@ static int fail(ga_solver *s, ga_status st)
     return 1;
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    chain c = chain_make(10000);
+    int print = 0, links = 10000;
+    for (int i = 1; i < argc; ++i) {
+        if (!strcmp(argv[i], "--print"))
+            print = 1;
+        else
+            links = atoi(argv[i]);
+    }
+    if (links < 1) {
+        fprintf(stderr, "usage: chain_demo [links] [--print]\n");
+        return 2;
+    }
+    chain c = chain_make(links);
     const int n = 3 * c.links, m = 2 * c.links;
     double *q = malloc(sizeof(double) * n), *v = malloc(sizeof(double) * n);
-    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+    const int last = print ? GA_INDEX3 : GA_INDEX2_STABILIZED;
+    for (int formulation = GA_INDEX3; formulation <= last; ++formulation) {
         ga_solver *s = NULL;
         chain_initial(&c, q, v);
         ga_status st = ga_create(n, m, &s);
@@ -101,6 +116,18 @@ int main(void)
                "factorizations per step; %.0f ms (%.2f ms per step, setup included)\n\n",
                t, max_abs_constraint(&c, q), steps, (double)iters / (double)steps,
                (double)facts / (double)steps, 1e3 * elapsed, 1e3 * elapsed / (double)steps);
+        if (print) {
+            double *lambda = malloc(sizeof(double) * m);
+            ga_get_lambda(s, lambda);
+            printf("final q =");
+            for (int i = 0; i < n; ++i)
+                printf(" %.17e", q[i]);
+            printf("\nfinal lambda =");
+            for (int i = 0; i < m; ++i)
+                printf(" %.17e", lambda[i]);
+            printf("\n");
+            free(lambda);
+        }
         ga_free(s);
     }
     free(q);

@@ -8,15 +8,18 @@ import sys
 import numpy as np
 
 bin_dir, py_dir = sys.argv[1], sys.argv[2]
+# scene -> (language, command) pairs, C first; the chain is the sparse path (declared patterns)
 SCENES = {
-    "pendulum": [[os.path.join(bin_dir, "pendulum_demo")],
-                 [os.path.join(bin_dir, "pendulum_fortran")],
-                 [sys.executable, os.path.join(py_dir, "pendulum.py")]],
-    "slider_crank": [[os.path.join(bin_dir, "slider_crank_demo")],
-                     [os.path.join(bin_dir, "slider_crank_fortran")],
-                     [sys.executable, os.path.join(py_dir, "slider_crank.py")]],
+    "pendulum": [("C", [os.path.join(bin_dir, "pendulum_demo")]),
+                 ("Fortran", [os.path.join(bin_dir, "pendulum_fortran")]),
+                 ("Python", [sys.executable, os.path.join(py_dir, "pendulum.py")])],
+    "slider_crank": [("C", [os.path.join(bin_dir, "slider_crank_demo")]),
+                     ("Fortran", [os.path.join(bin_dir, "slider_crank_fortran")]),
+                     ("Python", [sys.executable, os.path.join(py_dir, "slider_crank.py")])],
+    "chain_200": [("C", [os.path.join(bin_dir, "chain_demo"), "200", "--print"]),
+                  ("Python", [sys.executable, os.path.join(py_dir, "chain.py"), "200",
+                              "--print"])],
 }
-LANGS = ("C", "Fortran", "Python")
 
 
 def final_state(cmd):
@@ -30,9 +33,9 @@ def final_state(cmd):
 
 
 ok = True
-for scene, commands in SCENES.items():
-    results = [final_state(cmd) for cmd in commands]
-    for lang, r in zip(LANGS[1:], results[1:]):
+for scene, runs in SCENES.items():
+    results = [final_state(cmd) for _, cmd in runs]
+    for (lang, _), r in zip(runs[1:], results[1:]):
         diff = np.max(np.abs(r - results[0]) / np.maximum(np.abs(results[0]), 1e-300))
         print("%-13s %-8s vs C: %d values, max relative difference %.1e" % (scene, lang, r.size,
                                                                           diff))
