@@ -17,6 +17,7 @@ SCENES = {
                      ("Fortran", [os.path.join(bin_dir, "slider_crank_fortran")]),
                      ("Python", [sys.executable, os.path.join(py_dir, "slider_crank.py")])],
     "chain_200": [("C", [os.path.join(bin_dir, "chain_demo"), "200", "--print"]),
+                  ("Fortran", [os.path.join(bin_dir, "chain_fortran"), "200"]),
                   ("Python", [sys.executable, os.path.join(py_dir, "chain.py"), "200",
                               "--print"])],
 }

@@ -382,6 +382,13 @@ module galpha
      procedure :: step => solver_step
      procedure :: set_tolerances => solver_set_tolerances
      procedure :: set_formulation => solver_set_formulation
+     !> set_pattern(which, rows, cols): the sparsity of GA_MATRIX_MASS, _JACOBIAN, _STIFFNESS or
+     !> _DAMPING with Fortran (1-based) row and column numbers; the callback of that matrix then
+     !> fills size(rows) values in this order
+     procedure :: set_pattern => solver_set_pattern
+     procedure :: set_constant_mass => solver_set_constant_mass
+     procedure :: set_linear_solver => solver_set_linear_solver
+     procedure :: linear_solver_name => solver_linear_solver_name
      procedure :: set_redundant_constraints => solver_set_redundant_constraints
      procedure :: get_active_constraints => solver_get_active_constraints
      procedure :: advance => solver_advance
@@ -537,6 +544,38 @@ contains
     integer(c_int), intent(in) :: formulation
     status = ga_set_formulation(this%handle, formulation)
   end function solver_set_formulation
+
+  integer(c_int) function solver_set_pattern(this, which, rows, cols) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: which
+    integer(c_int), intent(in) :: rows(:), cols(:)
+    integer(c_int), allocatable :: r0(:), c0(:)
+    if (size(rows) /= size(cols)) then
+       status = GA_ERR_ARG
+       return
+    end if
+    r0 = rows - 1  ! the C API counts from 0
+    c0 = cols - 1
+    status = ga_set_pattern(this%handle, which, int(size(rows), c_int), r0, c0)
+  end function solver_set_pattern
+
+  integer(c_int) function solver_set_constant_mass(this, on) result(status)
+    class(galpha_solver), intent(inout) :: this
+    logical, intent(in) :: on
+    status = ga_set_constant_mass(this%handle, merge(1_c_int, 0_c_int, on))
+  end function solver_set_constant_mass
+
+  integer(c_int) function solver_set_linear_solver(this, solver) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: solver
+    status = ga_set_linear_solver(this%handle, solver)
+  end function solver_set_linear_solver
+
+  function solver_linear_solver_name(this) result(name)
+    class(galpha_solver), intent(in) :: this
+    character(len=:), allocatable :: name
+    name = c_to_f(ga_linear_solver_name(this%handle))
+  end function solver_linear_solver_name
 
   integer(c_int) function solver_set_redundant_constraints(this, mode) result(status)
     class(galpha_solver), intent(inout) :: this
