@@ -71,7 +71,9 @@ static void check(const oscillator *o, const char *label)
     for (int k = 0; k < K; ++k) {
         double err[3];
         hs[k] = 0.02 / (double)(1 << k);
-        run(o, hs[k], 2.3, err); /* not a turning point: there the error in q is second order in the phase error */
+        /* t = 2.3 is not a turning point: there the error in q would be second order in the
+         * phase error */
+        run(o, hs[k], 2.3, err);
         for (int j = 0; j < 3; ++j)
             e[j][k] = err[j];
         printf("  %s h = %-8.5g |e_q| = %.3e |e_v| = %.3e |e_qdd| = %.3e\n", label, hs[k],

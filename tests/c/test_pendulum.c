@@ -107,7 +107,8 @@ static void tangent_modes_and_predictors_agree(void **state)
     const double h = 2.5e-3;
     const run_result fd = run(h, (run_options){0.9, GA_TANGENT_FD, GA_PREDICTOR_CONSTANT_A, 1});
     const run_result ex = run(h, (run_options){0.9, GA_TANGENT_AUTO, GA_PREDICTOR_CONSTANT_A, 1});
-    const run_result no = run(h, (run_options){0.9, GA_TANGENT_NEGLECT, GA_PREDICTOR_CONSTANT_A, 0});
+    const run_result no =
+        run(h, (run_options){0.9, GA_TANGENT_NEGLECT, GA_PREDICTOR_CONSTANT_A, 0});
     const run_result zp = run(h, (run_options){0.9, GA_TANGENT_AUTO, GA_PREDICTOR_ZERO, 1});
     const run_result *others[] = {&ex, &no, &zp};
     for (int i = 0; i < 3; ++i) {
