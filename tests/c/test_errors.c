@@ -537,19 +537,25 @@ static void nan_and_inf_in_callback_outputs(void **state)
 
 /* The Phi_t callback is called in every Newton iteration of a stabilized index-2 step: its
  * failures (fatal, recoverable, NaN, Inf) are reported like any callback's, the state kept. */
-static void constraint_dt_failures_in_index2_steps(void **state)
+static void callback_failures_in_index2_steps(void **state)
 {
     (void)state;
     const struct {
+        fault_site site;
         int rc;
         double value;
         ga_status expected;
         const char *part;
     } cases[] = {
-        {-7, 0.0, GA_ERR_CALLBACK, "constraint_dt callback returned -7"},
-        {3, 0.0, GA_ERR_CALLBACK_RETRY, "constraint_dt callback returned 3 (recoverable)"},
-        {0, NAN, GA_ERR_NONFINITE, "constraint time derivative Phi_t[0]"},
-        {0, INFINITY, GA_ERR_NONFINITE, "constraint time derivative Phi_t[0]"},
+        {CONSTRAINT_DT, -7, 0.0, GA_ERR_CALLBACK, "constraint_dt callback returned -7"},
+        {CONSTRAINT_DT, 3, 0.0, GA_ERR_CALLBACK_RETRY,
+         "constraint_dt callback returned 3 (recoverable)"},
+        {CONSTRAINT_DT, 0, NAN, GA_ERR_NONFINITE, "constraint time derivative Phi_t[0]"},
+        {CONSTRAINT_DT, 0, INFINITY, GA_ERR_NONFINITE, "constraint time derivative Phi_t[0]"},
+        /* Phi_q at the start of the step (the direction of the position correction) and at
+         * the perturbed point of the curvature block */
+        {JACOBIAN, -7, 0.0, GA_ERR_CALLBACK, "jacobian callback returned -7"},
+        {JACOBIAN, 0, NAN, GA_ERR_NONFINITE, "constraint Jacobian Phi_q(0,0)"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         faulty model = {{1.0, 1.0, 9.81}, NONE, 0, 0.0, 0, NULL, GA_OK, 0};
@@ -564,7 +570,7 @@ static void constraint_dt_failures_in_index2_steps(void **state)
         assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
         assert_int_equal(ga_step(s, 0.01), GA_OK);
         const size_t len = snapshot(s, before);
-        model.site = CONSTRAINT_DT;
+        model.site = cases[k].site;
         model.rc = cases[k].rc;
         model.value = cases[k].value;
         assert_int_equal(ga_step(s, 0.01), cases[k].expected);
@@ -866,7 +872,7 @@ int main(void)
         cmocka_unit_test(singular_saddle_point_matrix_at_init),
         cmocka_unit_test(massless_coordinate_at_init),
         cmocka_unit_test(nan_in_initial_values),
-        cmocka_unit_test(constraint_dt_failures_in_index2_steps),
+        cmocka_unit_test(callback_failures_in_index2_steps),
         cmocka_unit_test(out_of_memory_is_reported),
         cmocka_unit_test(strerror_names_every_status),
     };
