@@ -6,6 +6,8 @@
 #include <math.h>
 #include <stdio.h>
 
+#include <galpha.h>
+
 #include "scenes/pendulum.h"
 
 /* Slope of the least-squares line through (log h_i, log e_i). */
@@ -64,6 +66,22 @@ static inline int pendulum_twice_jacobian(double t, const double *q, double *J, 
     J[0] = J[1] = q[0]; /* 2 x 2 column-major: both rows (x, y) */
     J[2] = J[3] = q[1];
     return 0;
+}
+
+/* A solver for the pendulum p with its callbacks set (and the exact K_t with_stiffness);
+ * options and ga_init are the caller's. NULL if ga_create or a setter fails. */
+static inline ga_solver *pendulum_new_solver(pendulum *p, int with_stiffness)
+{
+    ga_solver *s = NULL;
+    if (ga_create(2, 1, &s) != GA_OK)
+        return NULL;
+    if (ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                         pendulum_jacobian, p) != GA_OK ||
+        (with_stiffness && ga_set_tangents(s, pendulum_stiffness, NULL) != GA_OK)) {
+        ga_free(s);
+        return NULL;
+    }
+    return s;
 }
 
 static inline double max_abs_diff(const double *a, const double *b, int n)

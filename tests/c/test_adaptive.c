@@ -51,10 +51,8 @@ static ga_solver *pendulum_solver(double rho, int formulation, int rescale, int 
     ga_solver *s = NULL;
     double q[2], v[2];
     pendulum_state(&P, TH0, OM0, q, v);
-    assert_int_equal(ga_create(2, 1, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
-                                      pendulum_jacobian, &P),
-                     GA_OK);
+    s = pendulum_new_solver(&P, 0);
+    assert_non_null(s);
     assert_int_equal(ga_set_constraint_accel(s, pendulum_constraint_accel), GA_OK);
     assert_int_equal(ga_set_rho_inf(s, rho), GA_OK);
     assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
@@ -725,11 +723,8 @@ static double fast_pendulum_lambda_error(double rho, int formulation)
     double q[2], v[2], lambda;
     ga_solver *s = NULL;
     pendulum_state(&p, 1.0, 20.0, q, v);
-    assert_int_equal(ga_create(2, 1, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
-                                      pendulum_jacobian, &p),
-                     GA_OK);
-    assert_int_equal(ga_set_tangents(s, pendulum_stiffness, NULL), GA_OK);
+    s = pendulum_new_solver(&p, 1);
+    assert_non_null(s);
     assert_int_equal(ga_set_rho_inf(s, rho), GA_OK);
     assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);

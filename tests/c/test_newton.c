@@ -414,14 +414,10 @@ static void full_newton_factorizes_every_iteration(void **state)
     double q_end[2][2];
     long long iters[2], facts[2];
     for (int mode = GA_REUSE_AUTO; mode <= GA_REUSE_NEVER; ++mode) {
-        ga_solver *s = NULL;
         double q[2], v[2], info;
         pendulum_state(&P, 1.0, 0.5, q, v);
-        assert_int_equal(ga_create(2, 1, &s), GA_OK);
-        assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
-                                          pendulum_jacobian, &P),
-                         GA_OK);
-        assert_int_equal(ga_set_tangents(s, pendulum_stiffness, NULL), GA_OK);
+        ga_solver *s = pendulum_new_solver(&P, 1);
+        assert_non_null(s);
         assert_int_equal(ga_set_newton(s, 1e-12, 20), GA_OK);
         assert_int_equal(ga_set_jacobian_reuse(s, mode), GA_OK);
         assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
@@ -469,11 +465,8 @@ static double condition_after_a_step(int scaling, double h, double *q)
     ga_solver *s = NULL;
     double v[2], rcond;
     pendulum_state(&P, 1.0, 0.5, q, v);
-    assert_int_equal(ga_create(2, 1, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
-                                      pendulum_jacobian, &P),
-                     GA_OK);
-    assert_int_equal(ga_set_tangents(s, pendulum_stiffness, NULL), GA_OK);
+    s = pendulum_new_solver(&P, 1);
+    assert_non_null(s);
     assert_int_equal(ga_set_scaling(s, scaling), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     assert_int_equal(ga_step(s, h), GA_OK);
@@ -508,10 +501,8 @@ static void scaling_keeps_the_condition_bounded(void **state)
     ga_solver *s = NULL;
     double q[2], v[2];
     pendulum_state(&P, 1.0, 0.5, q, v);
-    assert_int_equal(ga_create(2, 1, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
-                                      pendulum_jacobian, &P),
-                     GA_OK);
+    s = pendulum_new_solver(&P, 0);
+    assert_non_null(s);
     assert_int_equal(ga_set_scaling(s, 0), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     assert_int_equal(ga_step(s, 1e-6), GA_ERR_SINGULAR);
@@ -527,11 +518,8 @@ static double full_newton_iterations_per_step(int formulation)
     ga_solver *s = NULL;
     double q[2], v[2];
     pendulum_state(&P, 1.0, 20.0, q, v);
-    assert_int_equal(ga_create(2, 1, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
-                                      pendulum_jacobian, &P),
-                     GA_OK);
-    assert_int_equal(ga_set_tangents(s, pendulum_stiffness, NULL), GA_OK);
+    s = pendulum_new_solver(&P, 1);
+    assert_non_null(s);
     assert_int_equal(ga_set_jacobian_reuse(s, GA_REUSE_NEVER), GA_OK);
     assert_int_equal(ga_set_newton(s, 1e-12, 30), GA_OK);
     assert_int_equal(ga_set_rho_inf(s, 0.5), GA_OK); /* index 3 stays stable at 0.2 rad/step */
@@ -564,10 +552,8 @@ static long long mass_evaluations(int constant, int formulation)
     double q[2], v[2];
     long long evals = 0, residuals = 0;
     pendulum_state(&P, 1.0, 0.5, q, v);
-    assert_int_equal(ga_create(2, 1, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
-                                      pendulum_jacobian, &P),
-                     GA_OK);
+    s = pendulum_new_solver(&P, 0);
+    assert_non_null(s);
     assert_int_equal(ga_set_constant_mass(s, constant), GA_OK);
     assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
