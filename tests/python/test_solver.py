@@ -154,6 +154,18 @@ def test_integrate_returns_histories():
     assert sol.stats["steps"] == len(sol.t) - 1
 
 
+def test_integrate_checks_its_times():
+    with pytest.raises(ValueError, match="must lie in t_span"):
+        galpha.integrate(mass, force, constraint, jacobian, (0.0, 0.5), Q0, V0, 0.01, m=1,
+                         t_eval=[-0.1, 0.2])
+    with pytest.raises(ValueError, match="the end must come after the start"):
+        galpha.integrate(mass, force, constraint, jacobian, (0.5, 0.0), Q0, V0, 0.01, m=1)
+    sol = galpha.integrate(mass, force, constraint, jacobian, (0.0, 0.5), Q0, V0, 0.01, m=1,
+                           t_eval=[0.0, 0.25, 0.5])
+    assert list(sol.t) == [0.0, 0.25, 0.5]
+    assert np.array_equal(sol.q[0], Q0)  # the start itself, not a later state
+
+
 def test_integrate_reports_method_failure():
     sol = galpha.integrate(mass, force, constraint, jacobian, (0.0, 0.1), Q0, V0, 0.01, m=1,
                            newton=(1e-10, 1))

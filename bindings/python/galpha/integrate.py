@@ -31,6 +31,10 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=0,
     re-raised.
     """
     t0, t1 = float(t_span[0]), float(t_span[1])
+    if not t1 > t0:
+        raise ValueError("t_span = (%g, %g): the end must come after the start" % (t0, t1))
+    if t_eval is not None and any(not t0 <= float(t) <= t1 for t in t_eval):
+        raise ValueError("t_eval: every time must lie in t_span = [%g, %g]" % (t0, t1))
     q0 = np.asarray(q0, dtype=float)
     n = q0.size
     ts, qs, vs, as_, ls = [], [], [], [], []
@@ -48,7 +52,7 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=0,
         def record_eval(t_prev):
             while pending and pending[0] <= s.t:
                 te = pending.pop(0)
-                if te == s.t or te <= t_prev:
+                if te == s.t or te == t_prev:
                     record()
                     ts[-1] = te
                 else:
