@@ -2,7 +2,7 @@
 # The README's test command: installs what is missing (as root), then builds galpha twice --
 # release with warnings as errors, and AddressSanitizer + UndefinedBehaviorSanitizer -- and
 # runs the whole ctest suite (C, Python, Fortran, install/consumers, ABI) in both; then the C
-# suites once more under valgrind's memcheck.
+# suites once more under valgrind's memcheck, and the threads suite under helgrind.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/deps.sh
@@ -26,4 +26,7 @@ find build/tests/c -maxdepth 1 -type f -name 'test_*' -perm -u+x ! -name test_al
     xargs -0 -P "$JOBS" -I{} sh -c \
         'valgrind --error-exitcode=9 --quiet "$1" >"$1.memcheck.log" 2>&1 ||
          { echo "memcheck FAILED: $1"; tail -n 40 "$1.memcheck.log"; exit 255; }' _ {}
+# Helgrind on the suite that runs solvers in parallel threads: data races.
+echo "=== helgrind: build/tests/c/test_threads"
+valgrind --tool=helgrind --error-exitcode=9 --quiet build/tests/c/test_threads >/dev/null
 echo "all tests passed"
