@@ -537,6 +537,24 @@ static void nan_and_inf_in_callback_outputs(void **state)
 
 /* The Phi_t callback is called in every Newton iteration of a stabilized index-2 step: its
  * failures (fatal, recoverable, NaN, Inf) are reported like any callback's, the state kept. */
+/* Finite callback outputs whose Newton increment overflows (a force of 1e308 against the small
+ * beta' M of a step of 10 s): reported as non-finite, with the state kept. */
+static void overflow_in_the_newton_increment(void **state)
+{
+    fixture *x = *state;
+    double before[STATE_MAX], after[STATE_MAX];
+    const size_t len = snapshot(x->s, before);
+    x->model.site = FORCE;
+    x->model.rc = 0;
+    x->model.value = 1e308;
+    assert_int_equal(ga_step(x->s, 10.0), GA_ERR_NONFINITE);
+    expect_message(x->s, "Newton increment is not finite in iteration 1");
+    snapshot(x->s, after);
+    assert_memory_equal(before, after, len * sizeof(double));
+    x->model.site = NONE;
+    continues_undisturbed(x, before, len);
+}
+
 static void callback_failures_in_index2_steps(void **state)
 {
     (void)state;
@@ -860,6 +878,7 @@ int main(void)
         T(fatal_callback_failure),
         T(recoverable_callback_failure),
         T(nan_and_inf_in_callback_outputs),
+        T(overflow_in_the_newton_increment),
         cmocka_unit_test(failure_in_the_corrected_start),
         T(singular_iteration_matrix),
         T(newton_not_converged_in_max_iter),
