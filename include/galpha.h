@@ -31,7 +31,8 @@
  *     ga_create -> ga_set_callbacks -> [ga_set_* options] -> ga_init -> ga_step ... -> ga_free
  *
  * Memory is allocated by ga_create and ga_init (and by options that need more workspace once
- * it exists: ga_set_formulation to index 2, the first adaptive step); ga_step never allocates.
+ * it exists: ga_set_formulation to index 2, tangent options that call for finite differences,
+ * the first adaptive step); ga_step never allocates.
  *
  * ## Conventions
  *  - Every function that can fail returns a ::ga_status (0 = GA_OK, negative = error);
@@ -270,11 +271,13 @@ typedef enum ga_tangent_mode {
 } ga_tangent_mode;
 
 /** Optional exact tangent callbacks (either may be NULL: finite differences for that one).
- *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
+ *  After ga_init, the workspace of the differences a NULL calls for is allocated here.
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE, GA_ERR_NOMEM. */
 GA_API ga_status ga_set_tangents(ga_solver *s, ga_stiffness_fn stiffness, ga_damping_fn damping);
 
-/** Choose how K_t and C_t enter the iteration matrix: mode is a ::ga_tangent_mode.
- *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
+/** Choose how K_t and C_t enter the iteration matrix: mode is a ::ga_tangent_mode (after
+ *  ga_init, allocates the workspace of finite differences if the mode calls for them).
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE, GA_ERR_NOMEM. */
 GA_API ga_status ga_set_tangent_mode(ga_solver *s, int mode);
 
 /** Switch the scaling (10) of the iteration matrix, D_L = diag(beta h^2 I, I),
@@ -301,7 +304,9 @@ GA_API ga_status ga_set_jacobian_reuse(ga_solver *s, int mode);
 
 /** Declare the mass matrix constant (1) or not (0, default): with 1, M is evaluated once (at
  *  ga_init or ga_set_state, and after an option changes) and its derivative is dropped from
- *  finite-difference tangents. Errors: GA_ERR_ARG, GA_ERR_STATE. */
+ *  finite-difference tangents. Switching it off after ga_init allocates the perturbed mass
+ *  matrix of finite-difference tangents, if they are used. Errors: GA_ERR_ARG, GA_ERR_STATE,
+ *  GA_ERR_NOMEM. */
 GA_API ga_status ga_set_constant_mass(ga_solver *s, int on);
 
 /** Newton predictor. Both converge to the same step solution (to the Newton tolerance). */
