@@ -384,7 +384,8 @@ module galpha
      procedure :: set_formulation => solver_set_formulation
      !> set_pattern(which, rows, cols): the sparsity of GA_MATRIX_MASS, _JACOBIAN, _STIFFNESS or
      !> _DAMPING with Fortran (1-based) row and column numbers; the callback of that matrix then
-     !> fills size(rows) values in this order
+     !> fills size(rows) values in this order (GA_ERR_ARG, without a message, if rows and cols
+     !> differ in size)
      procedure :: set_pattern => solver_set_pattern
      procedure :: set_constant_mass => solver_set_constant_mass
      procedure :: set_linear_solver => solver_set_linear_solver
