@@ -101,11 +101,9 @@ public:
     {
         if (!rcond_valid_ && pivot_ratio_ > 0.0) {
             const int N = n_ + m_;
-            int info = 0;
             if (in_eigen())  // S is intact: Eigen factorizes a copy
-                anorm_ = dlange_("1", &N, &N, S_.data(), &N, work_.data(), 1);
-            dgecon_("1", &N, factors().data(), &N, &anorm_, &rcond_, work_.data(), iwork_.data(),
-                    &info, 1);
+                anorm_ = norm1(N, S_.data(), work_.data());
+            rcond_ = lu_rcond(N, factors().data(), anorm_, work_.data(), iwork_.data());
             rcond_valid_ = true;
         }
         return pivot_ratio_ > 0.0 ? rcond_ : 0.0;

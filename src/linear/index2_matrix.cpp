@@ -303,13 +303,10 @@ double Index2Matrix::rcond() const
     const Dense &d = *dense_;
     if (!d.rcond_valid) {
         const int N = static_cast<int>(d.S.rows());
-        int info = 0;
         const Mat &factors = d.unblocked ? d.S : d.lu.matrixLU();
-        double anorm = d.anorm;
-        if (!d.unblocked)  // S is intact: Eigen factorized a copy
-            anorm = dlange_("1", &N, &N, d.S.data(), &N, d.work.data(), 1);
-        dgecon_("1", &N, factors.data(), &N, &anorm, &d.rcond, d.work.data(), d.iwork.data(),
-                &info, 1);
+        // unblocked: S holds the factors, its norm was taken before; Eigen factorized a copy
+        const double anorm = d.unblocked ? d.anorm : norm1(N, d.S.data(), d.work.data());
+        d.rcond = lu_rcond(N, factors.data(), anorm, d.work.data(), d.iwork.data());
         d.rcond_valid = true;
     }
     return d.rcond;

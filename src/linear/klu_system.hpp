@@ -32,9 +32,6 @@ public:
     // false if singular or numerically singular. Throws std::bad_alloc.
     bool factorize();
     void solve(double *rhs);  // in place, length N
-    // min |U_ii| / max |U_ii| of the last factorization (KLU's cheap pivot ratio, which
-    // decides singularity)
-    double pivot_ratio() const { return rcond_; }
     // Reciprocal 1-norm condition estimate of the matrix factorized last, rows scaled as
     // factorized (klu_condest: a few solves; on demand, not in steps). 0 if singular.
     double rcond_estimate() const;
@@ -55,7 +52,7 @@ private:
     mutable klu_common common_;  // klu_condest writes its result here
     klu_symbolic *symbolic_ = nullptr;
     klu_numeric *numeric_ = nullptr;
-    double rcond_ = 0.0;
+    double rcond_ = 0.0;  // min |U_ii| / max |U_ii| (klu_rcond): decides singularity
     const char *ordering_ = "AMD";
     int full_factorizations_ = 0;
 };
