@@ -18,6 +18,13 @@ LENGTH, MASS, GRAVITY = 1.0, 1.0, 9.81
 INERTIA, HALF = MASS * LENGTH * LENGTH / 12.0, 0.5 * LENGTH
 
 
+def jacobian_entries(links):
+    """Which of the 8 entries per joint exist: the first joint (the pin) has no previous link."""
+    keep = np.ones((links, 8), dtype=bool)
+    keep[0, [2, 3, 6, 7]] = False
+    return keep
+
+
 def patterns(links):
     """Rows and columns of M (diagonal), Phi_q (joint i: x_i, th_i and, for i > 0, x_{i-1},
     th_{i-1} in each of its two rows), K_t (the angles' diagonal) and C_t (empty)."""
@@ -28,8 +35,7 @@ def patterns(links):
         cols.append(np.stack([3 * i + d, 3 * i + 2, 3 * i - 3 + d, 3 * i - 1], axis=1))
     r = np.stack(rows, axis=1).reshape(links, 8)
     c = np.stack(cols, axis=1).reshape(links, 8)
-    keep = np.ones((links, 8), dtype=bool)
-    keep[0, [2, 3, 6, 7]] = False  # the first joint is the pin: no previous link
+    keep = jacobian_entries(links)
     theta = 3 * i + 2
     return {"mass": (np.arange(3 * links), np.arange(3 * links)),
             "jacobian": (r[keep], c[keep]),
@@ -46,6 +52,8 @@ def cos_sin(th):
 
 
 def model(links):
+    keep = jacobian_entries(links)
+
     def mass(t, q, M):
         M.reshape(links, 3)[:] = (MASS, MASS, INERTIA)
 
@@ -67,8 +75,6 @@ def model(links):
         vals = np.empty((links, 8))
         vals[:, 0], vals[:, 1], vals[:, 4], vals[:, 5] = 1.0, s, 1.0, -c
         vals[1:, 2], vals[1:, 3], vals[1:, 6], vals[1:, 7] = -1.0, s[:-1], -1.0, -c[:-1]
-        keep = np.ones((links, 8), dtype=bool)
-        keep[0, [2, 3, 6, 7]] = False
         J[:] = vals[keep]
 
     def stiffness(t, q, v, qdd, lam, K):
