@@ -25,20 +25,15 @@ constexpr double kMinTrustedRate = 0.05;
 constexpr int kIterationBudget = 4;
 }  // namespace
 
-ConvergenceTest::Verdict ConvergenceTest::check(double tol, const Vec &dq, const Vec &dw,
-                                                double beta_prime, const Vec &dlambda,
-                                                const Vec &q, const Vec &qdd, const Vec &lambda)
+ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &size,
+                                                double beta_prime)
 {
     ++iteration_;
     ++with_matrix_;
-    const double dq_norm = dq.lpNorm<Eigen::Infinity>();
-    const double q_norm = q.lpNorm<Eigen::Infinity>();
-    const double dw_norm = &dw == &dq ? dq_norm : dw.lpNorm<Eigen::Infinity>();
+    const double dq_norm = size.dq, q_norm = size.q;
     double eta = std::max(relative(dq_norm, tol, q_norm),
-                          relative(beta_prime * dw_norm, tol, qdd.lpNorm<Eigen::Infinity>()));
-    if (dlambda.size() > 0)
-        eta = std::max(eta, relative(dlambda.lpNorm<Eigen::Infinity>(), tol,
-                                     lambda.lpNorm<Eigen::Infinity>()));
+                          relative(beta_prime * size.dw, tol, size.qdd));
+    eta = std::max(eta, relative(size.dlambda, tol, size.lambda));  // 0 without constraints
     ratio_ = eta;
 
     double theta = -1.0;

@@ -25,6 +25,14 @@
 
 namespace ga {
 
+// The max-norms of one Newton update and of the iterate it produced: all the stopping test
+// reads. The solver takes them in the pass that applies the update.
+struct UpdateSizes {
+    double dq = 0.0, dw = 0.0, dlambda = 0.0;  // increments (dw: see ConvergenceTest::check)
+    double q = 0.0, qdd = 0.0, lambda = 0.0;   // the updated iterate
+    bool increments_finite = true, iterate_finite = true;
+};
+
 class ConvergenceTest {
 public:
     enum class Verdict { Converged, Continue, Slow };
@@ -48,10 +56,10 @@ public:
         with_matrix_ = 0;
     }
 
-    // dq: position increment; dw: the increment that moves the accelerations (qdd += beta' dw;
-    // the same vector as dq except in the stabilized index-2 formulation).
-    Verdict check(double tol, const Vec &dq, const Vec &dw, double beta_prime, const Vec &dlambda,
-                  const Vec &q, const Vec &qdd, const Vec &lambda);
+    // size.dq: of the position increment; size.dw: of the increment that moves the
+    // accelerations (qdd += beta' dw; the same vector as dq except in the stabilized index-2
+    // formulation).
+    Verdict check(double tol, const UpdateSizes &size, double beta_prime);
 
     double ratio() const { return ratio_; }  // eta of the last update
     double rate() const { return rate_; }    // last measured theta (< 0: none yet)

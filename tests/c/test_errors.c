@@ -555,6 +555,36 @@ static void overflow_in_the_newton_increment(void **state)
     continues_undisturbed(x, before, len);
 }
 
+/* A state that overflows while every callback output and every increment stays finite: a
+ * free particle at q = 1e308 moving at 1e308 per second, a step of 10 s. Reported as a
+ * non-finite iterate, with the state kept; a step that stays in range goes on exactly. */
+static int unit_mass(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    M[0] = 1.0;
+    return 0;
+}
+
+static void overflow_of_the_iterate(void **state)
+{
+    (void)state;
+    ga_solver *s = NULL;
+    double q = 1e308, v = 1e308, before[STATE_MAX], after[STATE_MAX];
+    assert_int_equal(ga_create(1, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, unit_mass, NULL, NULL, NULL, NULL), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, &q, &v), GA_OK);
+    const size_t len = snapshot(s, before);
+    assert_int_equal(ga_step(s, 10.0), GA_ERR_NONFINITE);
+    expect_message(s, "Newton iterate is not finite in iteration 1");
+    snapshot(s, after);
+    assert_memory_equal(before, after, len * sizeof(double));
+    /* no force: qdd = 0 and q moves by h v exactly (1e308 + 1e307 is representable) */
+    assert_int_equal(ga_step(s, 0.1), GA_OK);
+    assert_int_equal(ga_get_q(s, &q), GA_OK);
+    assert_true(q == 1e308 + 0.1 * 1e308);
+    ga_free(s);
+}
+
 static void callback_failures_in_index2_steps(void **state)
 {
     (void)state;
@@ -892,6 +922,7 @@ int main(void)
         cmocka_unit_test(massless_coordinate_at_init),
         cmocka_unit_test(nan_in_initial_values),
         cmocka_unit_test(callback_failures_in_index2_steps),
+        cmocka_unit_test(overflow_of_the_iterate),
         cmocka_unit_test(out_of_memory_is_reported),
         cmocka_unit_test(strerror_names_every_status),
     };
