@@ -555,9 +555,11 @@ static void overflow_in_the_newton_increment(void **state)
     continues_undisturbed(x, before, len);
 }
 
-/* A state that overflows while every callback output and every increment stays finite: a
- * free particle at q = 1e308 moving at 1e308 per second, a step of 10 s. Reported as a
- * non-finite iterate, with the state kept; a step that stays in range goes on exactly. */
+/* States that overflow while every callback output stays finite are reported as non-finite,
+ * with the state kept, and a step that stays in range goes on. Two places: the predictor (a
+ * free particle at q = 1e308 moving at 1e308 per second, a step of 10 s) and a Newton update
+ * (a repulsive spring f = k q at q0 = 1.15e308 with k h^2 = 1: the predictor, 1.5 q0, is
+ * finite, so are the increments, the solution, 1.67 q0, is not). */
 static int unit_mass(double t, const double *q, double *M, void *u)
 {
     (void)t, (void)q, (void)u;
@@ -565,24 +567,44 @@ static int unit_mass(double t, const double *q, double *M, void *u)
     return 0;
 }
 
+static int repulsive_spring(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)v, (void)u;
+    f[0] = q[0];
+    return 0;
+}
+
 static void overflow_of_the_iterate(void **state)
 {
     (void)state;
-    ga_solver *s = NULL;
-    double q = 1e308, v = 1e308, before[STATE_MAX], after[STATE_MAX];
-    assert_int_equal(ga_create(1, 0, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, unit_mass, NULL, NULL, NULL, NULL), GA_OK);
-    assert_int_equal(ga_init(s, 0.0, &q, &v), GA_OK);
-    const size_t len = snapshot(s, before);
-    assert_int_equal(ga_step(s, 10.0), GA_ERR_NONFINITE);
-    expect_message(s, "Newton iterate is not finite in iteration 1");
-    snapshot(s, after);
-    assert_memory_equal(before, after, len * sizeof(double));
-    /* no force: qdd = 0 and q moves by h v exactly (1e308 + 1e307 is representable) */
-    assert_int_equal(ga_step(s, 0.1), GA_OK);
-    assert_int_equal(ga_get_q(s, &q), GA_OK);
-    assert_true(q == 1e308 + 0.1 * 1e308);
-    ga_free(s);
+    const struct {
+        ga_force_fn force;
+        double q0, v0;
+        const char *message;
+    } cases[] = {
+        {NULL, 1e308, 1e308, "predicted Newton iterate is not finite"},
+        {repulsive_spring, 1.15e308, 0.0, "Newton iterate is not finite in iteration"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        ga_solver *s = NULL;
+        double q = cases[k].q0, v = cases[k].v0, before[STATE_MAX], after[STATE_MAX];
+        assert_int_equal(ga_create(1, 0, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, unit_mass, cases[k].force, NULL, NULL, NULL),
+                         GA_OK);
+        assert_int_equal(ga_init(s, 0.0, &q, &v), GA_OK);
+        const size_t len = snapshot(s, before);
+        assert_int_equal(ga_step(s, k == 0 ? 10.0 : 1.0), GA_ERR_NONFINITE);
+        expect_message(s, cases[k].message);
+        snapshot(s, after);
+        assert_memory_equal(before, after, len * sizeof(double));
+        assert_int_equal(ga_step(s, 0.1), GA_OK);
+        assert_int_equal(ga_get_q(s, &q), GA_OK);
+        if (k == 0)  /* no force: qdd = 0 and q moves by h v exactly */
+            assert_true(q == 1e308 + 0.1 * 1e308);
+        else         /* pushed outwards, still finite: q0 (1 + k h^2 / 2 + ...) */
+            assert_true(q > cases[k].q0 * (1.0 + 0.5 * 0.01) && isfinite(q));
+        ga_free(s);
+    }
 }
 
 static void callback_failures_in_index2_steps(void **state)
