@@ -41,9 +41,17 @@ struct Index2Matrix::Dense {
 #ifdef GALPHA_HAVE_KLU
 struct Index2Matrix::Sparse {
     int n = 0, m = 0;
+    bool reduced = true;  // the (n + 2m) system of the dense path; else the augmented one
     KluSystem S;
-    // slots of each block's entries, in the order of the block's pattern
-    std::vector<int> K, M, C, JT, J2, J3, BT, Z, minus_I, plus_I;
+    // slots of each block's entries, in the order of the block's pattern (J3: the third block
+    // row's Phi_q, which Z shares; augmented only: M and C at w, BT, minus_I, plus_I)
+    std::vector<int> K, M, C, JT, J2, J3, Z, BT, minus_I, plus_I;
+    // reduced only: the products A B^T and Phi_q B^T, one term per entry: S[slot] += c *
+    // left[left_k] * B[b_k] (left: M or C for A B^T, J for Phi_q B^T)
+    struct Term {
+        int slot, left_k, b_k;
+    };
+    std::vector<Term> MBt, CBt, JBt;
     std::vector<int> J_rows, lambda_diag, eta_diag;  // inactive constraints
     Vec rhs;
 };
@@ -61,69 +69,7 @@ void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const 
     active_ = active;
 #ifdef GALPHA_HAVE_KLU
     if (sparse) {
-        auto s = std::make_unique<Sparse>();
-        s->n = n;
-        s->m = m;
-        // columns: d [0, n), w [n, 2n), lambda_bar [2n, 2n + m), eta_bar [2n + m, 2n + 2m);
-        // rows: dynamics [0, n), w - d - B^T eta_bar [n, 2n), Phi [2n, 2n + m),
-        // velocity constraint [2n + m, 2n + 2m)
-        const int w0 = n, l0 = 2 * n, e0 = 2 * n + m;
-        std::vector<std::pair<int, int>> entries;
-        auto block = [&](const ModelMatrix &A, bool transposed, int row0, int col0) {
-            for (int k = 0; k < A.nnz(); ++k) {
-                const int i = A.row_index()[k], j = A.col_index()[k];
-                entries.emplace_back(transposed ? row0 + j : row0 + i,
-                                     transposed ? col0 + i : col0 + j);
-            }
-        };
-        block(K, false, 0, 0);
-        block(M, false, 0, w0);
-        block(C, false, 0, w0);
-        block(J, true, 0, l0);      // Phi_q^T
-        block(J, true, w0, e0);     // -B^T (B has the layout of Phi_q)
-        block(J, false, l0, 0);     // Phi_q d
-        block(J, false, e0, w0);    // Phi_q w
-        block(J, false, e0, 0);     // (beta h / gamma) Z d: Z has the pattern of Phi_q
-        for (int i = 0; i < n; ++i) {
-            entries.emplace_back(w0 + i, i);       // -I
-            entries.emplace_back(w0 + i, w0 + i);  // I
-        }
-        if (active)
-            for (int i = 0; i < m; ++i) {
-                entries.emplace_back(l0 + i, l0 + i);
-                entries.emplace_back(e0 + i, e0 + i);
-            }
-        s->S.setup(2 * n + 2 * m, std::move(entries));
-        auto slots = [&](const ModelMatrix &A, bool transposed, int row0, int col0) {
-            std::vector<int> out(A.nnz());
-            for (int k = 0; k < A.nnz(); ++k) {
-                const int i = A.row_index()[k], j = A.col_index()[k];
-                out[k] = transposed ? s->S.slot(row0 + j, col0 + i)
-                                    : s->S.slot(row0 + i, col0 + j);
-            }
-            return out;
-        };
-        s->K = slots(K, false, 0, 0);
-        s->M = slots(M, false, 0, w0);
-        s->C = slots(C, false, 0, w0);
-        s->JT = slots(J, true, 0, l0);
-        s->BT = slots(J, true, w0, e0);
-        s->J2 = slots(J, false, l0, 0);
-        s->J3 = slots(J, false, e0, w0);
-        s->Z = slots(J, false, e0, 0);
-        for (int i = 0; i < n; ++i) {
-            s->minus_I.push_back(s->S.slot(w0 + i, i));
-            s->plus_I.push_back(s->S.slot(w0 + i, w0 + i));
-        }
-        if (active) {
-            s->J_rows = J.row_index();
-            for (int i = 0; i < m; ++i) {
-                s->lambda_diag.push_back(s->S.slot(l0 + i, l0 + i));
-                s->eta_diag.push_back(s->S.slot(e0 + i, e0 + i));
-            }
-        }
-        s->rhs.setZero(2 * n + 2 * m);
-        sparse_ = std::move(s);
+        sparse_ = setup_sparse(n, m, M, J, K, C, active != nullptr);
         return;
     }
 #else
@@ -153,6 +99,146 @@ void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const 
     dense_ = std::move(d);
 }
 
+#ifdef GALPHA_HAVE_KLU
+// The sparse system. Reduced: the matrix of the dense path (index2_matrix.hpp, first display),
+// unknowns d [0, n), lambda_bar [n, n + m), eta_bar [n + m, n + 2m), with the products A B^T
+// and Phi_q B^T assembled term by term on patterns fixed here. Augmented (second display, the
+// Newmark increment w an unknown of its own): only where the products would hold many more
+// entries than the augmented matrix -- a coordinate in many constraints makes Phi_q B^T dense
+// in them. On the chain the reduced system has 7N unknowns instead of 10N, fills 0.63 times
+// as much, and refactorizes and solves 1.5 to 2 times faster.
+std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
+                                                                 const ModelMatrix &M,
+                                                                 const ModelMatrix &J,
+                                                                 const ModelMatrix &K,
+                                                                 const ModelMatrix &C,
+                                                                 bool with_inactive)
+{
+    auto s = std::make_unique<Sparse>();
+    s->n = n;
+    s->m = m;
+    const std::vector<int> &Jr = J.row_index(), &Jc = J.col_index();
+    std::vector<std::pair<int, int>> entries;
+    auto block = [&entries](const ModelMatrix &A, bool transposed, int row0, int col0) {
+        for (int k = 0; k < A.nnz(); ++k) {
+            const int i = A.row_index()[k], j = A.col_index()[k];
+            entries.emplace_back(transposed ? row0 + j : row0 + i,
+                                 transposed ? col0 + i : col0 + j);
+        }
+    };
+    auto slots = [&s](const ModelMatrix &A, bool transposed, int row0, int col0) {
+        std::vector<int> out(A.nnz());
+        for (int k = 0; k < A.nnz(); ++k) {
+            const int i = A.row_index()[k], j = A.col_index()[k];
+            out[k] = transposed ? s->S.slot(row0 + j, col0 + i) : s->S.slot(row0 + i, col0 + j);
+        }
+        return out;
+    };
+
+    // the reduced pattern, and whether it stays sparse
+    std::vector<std::vector<int>> M_col(n), C_col(n), J_col(n);  // entries of each column
+    for (int k = 0; k < M.nnz(); ++k)
+        M_col[M.col_index()[k]].push_back(k);
+    for (int k = 0; k < C.nnz(); ++k)
+        C_col[C.col_index()[k]].push_back(k);
+    for (int k = 0; k < J.nnz(); ++k)
+        J_col[Jc[k]].push_back(k);
+    const int l0 = n, e0 = n + m;
+    // every product term: (left factor entry, B entry k = (r, j)) -> (row of left, e0 + r)
+    auto for_each_term = [&](auto &&term) {
+        for (int k = 0; k < J.nnz(); ++k) {
+            for (int a : M_col[Jc[k]])
+                term(s->MBt, a, k, M.row_index()[a]);
+            for (int a : C_col[Jc[k]])
+                term(s->CBt, a, k, C.row_index()[a]);
+            for (int a : J_col[Jc[k]])
+                term(s->JBt, a, k, e0 + Jr[a]);
+        }
+    };
+    for (int i = 0; i < n; ++i)
+        entries.emplace_back(i, i);
+    block(M, false, 0, 0);
+    block(C, false, 0, 0);
+    block(K, false, 0, 0);
+    block(J, true, 0, l0);   // Phi_q^T
+    block(J, false, l0, 0);  // Phi_q
+    block(J, false, e0, 0);  // Phi_q + (beta h / gamma) Z: Z has the pattern of Phi_q
+    for_each_term([&](std::vector<Sparse::Term> &, int, int k, int row) {
+        entries.emplace_back(row, e0 + Jr[k]);
+    });
+    if (with_inactive)
+        for (int i = 0; i < m; ++i) {
+            entries.emplace_back(l0 + i, l0 + i);
+            entries.emplace_back(e0 + i, e0 + i);
+        }
+    std::sort(entries.begin(), entries.end());
+    entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
+    const std::size_t augmented_entries = K.nnz() + M.nnz() + C.nnz() + 5 * J.nnz() + 2 * n;
+    s->reduced = entries.size() <= 2 * augmented_entries;
+
+    if (s->reduced) {
+        s->S.setup(n + 2 * m, std::move(entries));
+        s->M = slots(M, false, 0, 0);
+        s->C = slots(C, false, 0, 0);
+        s->K = slots(K, false, 0, 0);
+        s->JT = slots(J, true, 0, l0);
+        s->J2 = slots(J, false, l0, 0);
+        s->J3 = slots(J, false, e0, 0);
+        for_each_term([&](std::vector<Sparse::Term> &terms, int a, int k, int row) {
+            terms.push_back({s->S.slot(row, e0 + Jr[k]), a, k});
+        });
+    } else {
+        // columns: d [0, n), w [n, 2n), lambda_bar [2n, 2n + m), eta_bar [2n + m, 2n + 2m);
+        // rows: dynamics [0, n), w - d - B^T eta_bar [n, 2n), Phi [2n, 2n + m),
+        // velocity constraint [2n + m, 2n + 2m)
+        const int w0 = n;
+        entries.clear();
+        block(K, false, 0, 0);
+        block(M, false, 0, w0);
+        block(C, false, 0, w0);
+        block(J, true, 0, 2 * n);           // Phi_q^T
+        block(J, true, w0, 2 * n + m);      // -B^T (B has the layout of Phi_q)
+        block(J, false, 2 * n, 0);          // Phi_q d
+        block(J, false, 2 * n + m, w0);     // Phi_q w
+        block(J, false, 2 * n + m, 0);      // (beta h / gamma) Z d
+        for (int i = 0; i < n; ++i) {
+            entries.emplace_back(w0 + i, i);       // -I
+            entries.emplace_back(w0 + i, w0 + i);  // I
+        }
+        if (with_inactive)
+            for (int i = 0; i < m; ++i) {
+                entries.emplace_back(2 * n + i, 2 * n + i);
+                entries.emplace_back(2 * n + m + i, 2 * n + m + i);
+            }
+        s->S.setup(2 * n + 2 * m, std::move(entries));
+        s->K = slots(K, false, 0, 0);
+        s->M = slots(M, false, 0, w0);
+        s->C = slots(C, false, 0, w0);
+        s->JT = slots(J, true, 0, 2 * n);
+        s->BT = slots(J, true, w0, 2 * n + m);
+        s->J2 = slots(J, false, 2 * n, 0);
+        s->J3 = slots(J, false, 2 * n + m, w0);
+        for (int i = 0; i < n; ++i) {
+            s->minus_I.push_back(s->S.slot(w0 + i, i));
+            s->plus_I.push_back(s->S.slot(w0 + i, w0 + i));
+        }
+    }
+    // Z: in the first block column of the velocity-constraint rows, J3's slots (reduced) or
+    // those of Phi_q d there (augmented)
+    s->Z = s->reduced ? s->J3 : slots(J, false, 2 * n + m, 0);
+    if (with_inactive) {
+        s->J_rows = Jr;
+        const int lambda0 = s->reduced ? l0 : 2 * n, eta0 = s->reduced ? e0 : 2 * n + m;
+        for (int i = 0; i < m; ++i) {
+            s->lambda_diag.push_back(s->S.slot(lambda0 + i, lambda0 + i));
+            s->eta_diag.push_back(s->S.slot(eta0 + i, eta0 + i));
+        }
+    }
+    s->rhs.setZero(s->reduced ? n + 2 * m : 2 * n + 2 * m);
+    return s;
+}
+#endif
+
 bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,
                              const ModelMatrix &J, const ModelMatrix &B, const ModelMatrix *Z,
                              const Params &p, double h)
@@ -169,25 +255,47 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
             for (std::size_t k = 0; k < slots.size(); ++k)
                 v[slots[k]] += c * a[k];
         };
+        auto products = [&](const ModelMatrix &A, const std::vector<Sparse::Term> &terms,
+                            double c) {
+            const double *a = A.data(), *b = B.data();
+            for (const Sparse::Term &t : terms)
+                v[t.slot] += c * a[t.left_k] * b[t.b_k];
+        };
         scatter(M, s.M, cM);
         if (C)
             scatter(*C, s.C, p.gamma * h);
         if (K)
             scatter(*K, s.K, p.beta * h * h);
         scatter(J, s.JT, 1.0);
-        scatter(B, s.BT, -1.0);
         scatter(J, s.J2, 1.0);
         scatter(J, s.J3, 1.0);
         if (Z)
             scatter(*Z, s.Z, cZ);
-        for (int k : s.minus_I)
-            v[k] -= 1.0;
-        for (int k : s.plus_I)
-            v[k] += 1.0;
+        if (s.reduced) {
+            products(M, s.MBt, cM);  // A B^T
+            if (C)
+                products(*C, s.CBt, p.gamma * h);
+            products(J, s.JBt, 1.0);  // Phi_q B^T
+        } else {
+            scatter(B, s.BT, -1.0);
+            for (int k : s.minus_I)
+                v[k] -= 1.0;
+            for (int k : s.plus_I)
+                v[k] += 1.0;
+        }
         if (active_) {
-            for (std::size_t k = 0; k < s.J_rows.size(); ++k)
-                if (!active_[s.J_rows[k]])
-                    v[s.JT[k]] = v[s.BT[k]] = v[s.J2[k]] = v[s.J3[k]] = v[s.Z[k]] = 0.0;
+            // an inactive constraint's rows and columns: those of the identity
+            const std::vector<int> &r = s.J_rows;
+            for (std::size_t k = 0; k < r.size(); ++k)
+                if (!active_[r[k]]) {
+                    v[s.JT[k]] = v[s.J2[k]] = v[s.J3[k]] = v[s.Z[k]] = 0.0;
+                    if (!s.reduced)
+                        v[s.BT[k]] = 0.0;
+                }
+            for (const auto *terms : {&s.MBt, &s.CBt, &s.JBt})
+                for (const Sparse::Term &t : *terms)
+                    if (!active_[r[t.b_k]] || (terms == &s.JBt && !active_[r[t.left_k]]))
+                        v[t.slot] = 0.0;
             for (int i = 0; i < s.m; ++i)
                 if (!active_[i])
                     v[s.lambda_diag[i]] = v[s.eta_diag[i]] = 1.0;
@@ -252,19 +360,26 @@ void Index2Matrix::solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const 
     if (sparse_) {
         Sparse &s = *sparse_;
         const int n = s.n, m = s.m;
+        const int nw = s.reduced ? 0 : n;  // the Newmark rows and unknowns (augmented only)
         s.rhs.head(n) = -bh2 * rq;
-        s.rhs.segment(n, n).setZero();
-        s.rhs.segment(2 * n, m) = -phi;
+        s.rhs.segment(n, nw).setZero();
+        s.rhs.segment(n + nw, m) = -phi;
         s.rhs.tail(m) = -(p.beta * h / p.gamma) * phi_v;
         if (active_)
             for (int i = 0; i < m; ++i)
                 if (!active_[i])
-                    s.rhs[2 * n + i] = s.rhs[2 * n + m + i] = 0.0;
+                    s.rhs[n + nw + i] = s.rhs[n + nw + m + i] = 0.0;
         s.S.solve(s.rhs.data());
         d = s.rhs.head(n);
-        w = s.rhs.segment(n, n);
-        dlambda = s.rhs.segment(2 * n, m) / bh2;
+        dlambda = s.rhs.segment(n + nw, m) / bh2;
         eta_bar = s.rhs.tail(m);
+        if (s.reduced) {
+            w = d;
+            if (m > 0)
+                B.multiply_transpose_add(1.0, eta_bar, w);
+        } else {
+            w = s.rhs.segment(n, n);
+        }
         return;
     }
 #endif

@@ -13,9 +13,11 @@
 // row's first block, (beta h / gamma) Z with Z = d(Phi_q v + Phi_t)/dq (ALGORITHMS.md sec. 2.2;
 // gena leaves it out by default, and Newton then contracts only like h |v| / length: on
 // Andrews' mechanism, h = 5e-5, 3.5 instead of 2.5 iterations per step).
-// Dense: (n + 2m)^2, Eigen LU. Sparse (declared patterns, KLU): the products A B^T and
-// Phi_q B^T would fill, so the Newmark increment w = d + B^T eta_bar becomes an unknown of its
-// own and every block is one of the user's sparse matrices:
+// Dense: (n + 2m)^2, Eigen LU. Sparse (declared patterns, KLU): the same matrix, the products
+// A B^T and Phi_q B^T on patterns fixed at setup -- unless they would hold many more entries
+// (a coordinate in many constraints makes Phi_q B^T dense in them); then the Newmark increment
+// w = d + B^T eta_bar becomes an unknown of its own and every block is one of the user's
+// sparse matrices:
 //
 //   [ beta h^2 K   A       Phi_q^T   0     ] [d         ]   [ -beta h^2 r^q          ]
 //   [ -I           I       0         -B^T  ] [w         ] = [ 0                      ]
@@ -61,6 +63,9 @@ public:
 private:
     struct Dense;
     struct Sparse;
+    static std::unique_ptr<Sparse> setup_sparse(int n, int m, const ModelMatrix &M,
+                                                const ModelMatrix &J, const ModelMatrix &K,
+                                                const ModelMatrix &C, bool with_inactive);
     const unsigned char *active_ = nullptr;
     std::unique_ptr<Dense> dense_;
     std::unique_ptr<Sparse> sparse_;
