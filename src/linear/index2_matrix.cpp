@@ -407,6 +407,15 @@ void Index2Matrix::solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const 
         B.multiply_transpose_add(1.0, eta_bar, w);
 }
 
+bool Index2Matrix::sparse_reduced() const
+{
+#ifdef GALPHA_HAVE_KLU
+    return sparse_ && sparse_->reduced;
+#else
+    return false;
+#endif
+}
+
 double Index2Matrix::rcond() const
 {
 #ifdef GALPHA_HAVE_KLU

@@ -49,6 +49,8 @@ public:
                const unsigned char *active);
     bool ready() const { return dense_ || sparse_; }
     bool sparse() const { return sparse_ != nullptr; }
+    // sparse, in the reduced (n + 2m) form (else the augmented one, or dense)
+    bool sparse_reduced() const;
     // false if singular or numerically singular. Z (layout of J) may be null: left out.
     bool factorize(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,
                    const ModelMatrix &J, const ModelMatrix &B, const ModelMatrix *Z,

@@ -10,41 +10,33 @@
 #include <xmmintrin.h>
 #endif
 
-namespace ga
-{
+namespace ga {
 
-namespace
-{
+namespace {
 // RCM is kept when it fills, and costs to factorize, at most this much more than AMD.
 constexpr double kBandFillAllowance = 1.5;
 // A refactorization with the old pivots is kept while its pivot ratio stays above this.
 constexpr double kRefactorRcond = 1e-12;
 
-// Subnormal numbers flushed to zero inside KLU's numeric kernels, and the caller's setting
-// restored on the way out (no user code runs inside them). Factors of long chains hold
-// entries that decay geometrically along the chain through every decade down to the
-// subnormal range, which the processor handles some 100 times slower: the stabilized index-2
-// system of a 10 000-link chain took 108 ms per step with them, 11 ms without. An entry below
-// 2.2e-308 next to entries of order one changes nothing a solve can resolve.
-class FlushSubnormals
-{
-  public:
+// Subnormal numbers flushed to zero inside KLU's numeric kernels, and the caller's two mode
+// bits put back on the way out (no user code runs inside them; exception flags raised there
+// stay raised). Factors of long chains hold entries that decay geometrically along the chain
+// through every decade down to the subnormal range, where the processor is some 100 times
+// slower: the stabilized index-2 system of a 10 000-link chain took 108 ms per step with
+// them, 11 ms without. An entry below 2.2e-308 beside entries of order one changes nothing a
+// solve can resolve.
+class FlushSubnormals {
+public:
 #if defined(__SSE2__)
-    FlushSubnormals() : saved_(_mm_getcsr())
-    {
-        _mm_setcsr(saved_ | kFlushToZero | kDenormalsAreZero);
-    }
-    ~FlushSubnormals()
-    {
-        _mm_setcsr(saved_);
-    }
+    FlushSubnormals() : saved_(_mm_getcsr() & kBits) { _mm_setcsr(_mm_getcsr() | kBits); }
+    ~FlushSubnormals() { _mm_setcsr((_mm_getcsr() & ~kBits) | saved_); }
 
-  private:
-    static constexpr unsigned kFlushToZero = 0x8000, kDenormalsAreZero = 0x0040; // MXCSR bits
+private:
+    static constexpr unsigned kBits = 0x8040;  // MXCSR: flush to zero, denormals are zero
     unsigned saved_;
 #endif
 };
-} // namespace
+}  // namespace
 
 // Row k of L is the subtree of the elimination tree that the entries of row k reach (Davis,
 // Direct Methods for Sparse Linear Systems, ch. 4): O(|L|) time, no factor stored.
@@ -53,7 +45,7 @@ CholeskyFill cholesky_fill(const std::vector<std::vector<int>> &adj, const std::
 {
     const int N = static_cast<int>(order.size());
     std::vector<int> position(N), parent(N, -1), ancestor(N, -1), mark(N, -1);
-    std::vector<double> column(N, 0.0); // entries of each column of L
+    std::vector<double> column(N, 0.0);  // entries of each column of L
     for (int k = 0; k < N; ++k)
         position[order[k]] = k;
     CholeskyFill fill;
@@ -113,7 +105,7 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries)
 {
     N_ = N;
     for (auto &e : entries)
-        std::swap(e.first, e.second); // (col, row): sorted by column, then row
+        std::swap(e.first, e.second);  // (col, row): sorted by column, then row
     std::sort(entries.begin(), entries.end());
     entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
     colptr_.assign(N + 1, 0);
@@ -144,8 +136,8 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries)
     if (rcm_fill_.entries > kBandFillAllowance * amd_fill_.entries ||
         rcm_fill_.flops > kBandFillAllowance * amd_fill_.flops)
         return;
-    klu_symbolic *banded =
-        klu_analyze_given(N, colptr_.data(), rowind_.data(), order.data(), order.data(), &common_);
+    klu_symbolic *banded = klu_analyze_given(N, colptr_.data(), rowind_.data(), order.data(),
+                                             order.data(), &common_);
     if (banded) {
         klu_free_symbolic(&symbolic_, &common_);
         symbolic_ = banded;
@@ -171,7 +163,7 @@ bool KluSystem::factorize()
             rcond_ = common_.rcond;
             return true;
         }
-        klu_free_numeric(&numeric_, &common_); // pivots no longer fit: start afresh
+        klu_free_numeric(&numeric_, &common_);  // pivots no longer fit: start afresh
         unscale_rows();
     }
     // A full factorization picks new pivots: new scale factors first.
@@ -190,7 +182,7 @@ bool KluSystem::factorize()
         if (common_.status == KLU_OUT_OF_MEMORY)
             throw std::bad_alloc();
         rcond_ = 0.0;
-        return false; // singular
+        return false;  // singular
     }
     klu_rcond(symbolic_, numeric_, &common_);
     rcond_ = common_.rcond;
@@ -224,7 +216,7 @@ void KluSystem::unscale_rows()
 
 void KluSystem::solve(double *rhs)
 {
-    for (int i = 0; i < N_; ++i) // (D S) x = D b
+    for (int i = 0; i < N_; ++i)  // (D S) x = D b
         rhs[i] *= row_scale_[i];
     const FlushSubnormals flush;
     klu_solve(symbolic_, numeric_, N_, 1, rhs, &common_);
@@ -254,7 +246,7 @@ std::vector<int> KluSystem::reverse_cuthill_mckee(const std::vector<std::vector<
     const int N = N_;
     std::vector<int> order, level(N, -1);
     order.reserve(N);
-    auto bfs = [&](int root, std::vector<int> &out) { // Cuthill-McKee from root
+    auto bfs = [&](int root, std::vector<int> &out) {  // Cuthill-McKee from root
         std::fill(level.begin(), level.end(), -1);
         out.clear();
         out.push_back(root);
@@ -295,5 +287,5 @@ std::vector<int> KluSystem::reverse_cuthill_mckee(const std::vector<std::vector<
     return order;
 }
 
-} // namespace ga
+}  // namespace ga
 #endif

@@ -288,9 +288,62 @@ static void inconsistent_start_projected_sparse_as_dense(void **state)
     assert_true(max_abs_diff(v[0], v[1], N) < 1e-12);
 }
 
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+/* galpha flushes subnormal numbers to zero inside KLU's kernels (the factors of long chains
+ * decay through them): the caller's floating-point mode (the control bits of MXCSR: rounding,
+ * exception masks, flush-to-zero, denormals-are-zero; not the exception flags, which any
+ * arithmetic raises) must be back on return, and the callbacks, which run outside those
+ * kernels, must see the caller's mode. Checked from the default mode and from one with
+ * flush-to-zero on, index 3 and 2, on the sparse path. */
+enum { CONTROL_BITS = 0xFFC0 };
+static unsigned seen_csr[64];
+static int seen_count;
+static int recording_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    if (seen_count < 64)
+        seen_csr[seen_count++] = _mm_getcsr() & CONTROL_BITS;
+    return chain_force(t, q, v, f, u);
+}
+
+static void callers_floating_point_mode_is_kept(void **state)
+{
+    (void)state;
+    const unsigned original = _mm_getcsr(), flush_to_zero = 0x8000;
+    chain c = chain_make(50);
+    double q[150], v[150];
+    for (int mode = 0; mode < 2; ++mode)
+        for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+            const unsigned caller = mode ? original | flush_to_zero : original & ~flush_to_zero;
+            _mm_setcsr(caller);
+            chain_initial(&c, q, v);
+            ga_solver *s = chain_solver(&c, 1);
+            assert_int_equal(ga_set_callbacks(s, chain_mass, recording_force, chain_constraint,
+                                              chain_jacobian, &c),
+                             GA_OK);
+            assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+            assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+            seen_count = 0;
+            assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+            for (int k = 0; k < 5; ++k)
+                assert_int_equal(ga_step(s, 1e-3), GA_OK);
+            const unsigned after = _mm_getcsr() & CONTROL_BITS;
+            ga_free(s);
+            _mm_setcsr(original);
+            assert_true(after == (caller & CONTROL_BITS));
+            assert_true(seen_count >= 5);
+            for (int k = 0; k < seen_count; ++k)
+                assert_true(seen_csr[k] == (caller & CONTROL_BITS));
+        }
+}
+#endif
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+#if defined(__SSE2__)
+        cmocka_unit_test(callers_floating_point_mode_is_kept),
+#endif
         cmocka_unit_test(sparse_and_dense_solvers_agree),
         cmocka_unit_test(sparse_and_dense_index2_agree),
         cmocka_unit_test(index2_on_a_sparse_solver_set_up_already),
