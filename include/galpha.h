@@ -389,9 +389,10 @@ typedef enum ga_formulation {
                                   for small h; recommended with adaptive steps. Same callbacks
                                   (Phi_t: ga_set_constraint_dt, or finite differences), dense
                                   or sparse: with declared
-                                  patterns the system keeps the Newmark increment as extra
-                                  unknowns, so no block is a product of the user's matrices
-                                  (2n + 2m sparse unknowns instead of n + 2m dense ones).
+                                  patterns the n + 2m system has its products of the user's
+                                  matrices assembled on fixed patterns, or, where they would
+                                  fill (a coordinate in many constraints), keeps the Newmark
+                                  increment as n extra unknowns instead.
                                   Its Newton matrix includes the curvature of the velocity
                                   constraint, d(Phi_q v + Phi_t)/dq, from one more Jacobian
                                   call per matrix (left out with GA_TANGENT_NEGLECT): without

@@ -21,7 +21,7 @@ for N in 10 30 100 300 1000 3000 10000 30000 100000; do
     "$b/step_cost" chain "$N" 10 >> "$out/chain.csv"
 done
 echo "links,n,m,backend,steps,newton_per_step,factorizations_per_step,us_per_step,limit_us,ratio,peak_rss_kib" > "$out/chain_index2.csv"
-for N in 1000 10000; do
+for N in 1000 10000 100000; do
     "$b/step_cost" chain "$N" 10 1e-10 1 >> "$out/chain_index2.csv"
 done
 if command -v valgrind >/dev/null; then

@@ -128,11 +128,14 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries)
     symbolic_ = klu_analyze(N, colptr_.data(), rowind_.data(), &common_);
     if (!symbolic_)
         throw std::bad_alloc();
-    const std::vector<std::vector<int>> adj = symmetric_adjacency();
-    amd_fill_ = cholesky_fill(adj, std::vector<int>(symbolic_->Q, symbolic_->Q + N),
-                              std::numeric_limits<double>::infinity());
-    std::vector<int> order = reverse_cuthill_mckee(adj);
-    rcm_fill_ = cholesky_fill(adj, order, kBandFillAllowance * amd_fill_.entries);
+    std::vector<int> order;
+    {
+        const std::vector<std::vector<int>> adj = symmetric_adjacency();  // freed before
+        amd_fill_ = cholesky_fill(adj, std::vector<int>(symbolic_->Q, symbolic_->Q + N),
+                                  std::numeric_limits<double>::infinity());
+        order = reverse_cuthill_mckee(adj);
+        rcm_fill_ = cholesky_fill(adj, order, kBandFillAllowance * amd_fill_.entries);
+    }
     if (rcm_fill_.entries > kBandFillAllowance * amd_fill_.entries ||
         rcm_fill_.flops > kBandFillAllowance * amd_fill_.flops)
         return;
