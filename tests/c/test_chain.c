@@ -310,6 +310,13 @@ static void callers_floating_point_mode_is_kept(void **state)
 {
     (void)state;
     const unsigned original = _mm_getcsr(), flush_to_zero = 0x8000;
+    _mm_setcsr(original | flush_to_zero);
+    const int honoured = (_mm_getcsr() & flush_to_zero) != 0;
+    _mm_setcsr(original);
+    if (!honoured) {  /* valgrind, for one, emulates no flush-to-zero mode */
+        printf("  the MXCSR register ignores writes here: nothing to check\n");
+        skip();
+    }
     chain c = chain_make(50);
     double q[150], v[150];
     for (int mode = 0; mode < 2; ++mode)
