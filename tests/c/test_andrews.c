@@ -10,6 +10,7 @@
 #include <cmocka.h>
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "helpers.h"
 #include "scene_run.h"
@@ -144,41 +145,49 @@ static void energy_balance_and_constraints(void **state)
 }
 
 /* The 31-coordinate model with declared patterns and sparse callbacks, solved by KLU, takes the
- * same steps as the dense model. */
+ * same steps as the dense model, in the index-3 and in the stabilized index-2 formulation (whose
+ * sparse system assembles the products A Phi_q(q_n)^T and Phi_q Phi_q(q_n)^T of this closed
+ * loop on fixed patterns). */
 static void sparse_model_matches_dense_model(void **state)
 {
     (void)state;
     double q0[AN31_N], v0[AN31_N], q[2][AN31_N], lam[2][AN31_M];
     an31_from_angles(andrews_q0, V7, q0, v0);
-    for (int sparse = 0; sparse < 2; ++sparse) {
-        ga_solver *s = NULL;
-        assert_int_equal(ga_create(AN31_N, AN31_M, &s), GA_OK);
-        if (sparse)
-            assert_int_equal(an31_declare_patterns(s), GA_OK);
-        assert_int_equal(ga_set_callbacks(s, sparse ? an31_mass_sparse : an31_mass, an31_force,
-                                          an31_constraint,
-                                          sparse ? an31_jacobian_sparse : an31_jacobian, NULL),
-                         GA_OK);
-        assert_int_equal(ga_set_tangents(s, sparse ? an31_stiffness_sparse : an31_stiffness,
-                                         NULL),
-                         GA_OK);
-        assert_int_equal(ga_set_constraint_accel(s, an31_constraint_accel), GA_OK);
-        assert_int_equal(ga_set_rho_inf(s, 0.7), GA_OK);
-        assert_int_equal(ga_set_linear_solver(s, sparse ? GA_LINEAR_SPARSE : GA_LINEAR_DENSE),
-                         GA_OK);
-        assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
-        for (int k = 0; k < 100; ++k)
-            assert_int_equal(ga_step(s, 3e-4), GA_OK);
-        assert_string_equal(ga_linear_solver_name(s),
-                            sparse ? "sparse KLU" : "dense unblocked LU");
-        ga_get_q(s, q[sparse]);
-        ga_get_lambda(s, lam[sparse]);
-        ga_free(s);
+    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+        for (int sparse = 0; sparse < 2; ++sparse) {
+            ga_solver *s = NULL;
+            assert_int_equal(ga_create(AN31_N, AN31_M, &s), GA_OK);
+            if (sparse)
+                assert_int_equal(an31_declare_patterns(s), GA_OK);
+            assert_int_equal(ga_set_callbacks(s, sparse ? an31_mass_sparse : an31_mass,
+                                              an31_force, an31_constraint,
+                                              sparse ? an31_jacobian_sparse : an31_jacobian, NULL),
+                             GA_OK);
+            assert_int_equal(ga_set_tangents(s, sparse ? an31_stiffness_sparse : an31_stiffness,
+                                             NULL),
+                             GA_OK);
+            assert_int_equal(ga_set_constraint_accel(s, an31_constraint_accel), GA_OK);
+            assert_int_equal(ga_set_rho_inf(s, 0.7), GA_OK);
+            assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+            assert_int_equal(
+                ga_set_linear_solver(s, sparse ? GA_LINEAR_SPARSE : GA_LINEAR_DENSE), GA_OK);
+            assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+            for (int k = 0; k < 100; ++k)
+                assert_int_equal(ga_step(s, 3e-4), GA_OK);
+            const char *name = ga_linear_solver_name(s);
+            assert_true(strncmp(name, sparse ? "sparse KLU" : "dense", sparse ? 10 : 5) == 0);
+            assert_true((strstr(name, "index-2") != NULL) == (formulation == GA_INDEX2_STABILIZED));
+            ga_get_q(s, q[sparse]);
+            ga_get_lambda(s, lam[sparse]);
+            ga_free(s);
+        }
+        printf("  31 coordinates, %s, sparse vs dense after 100 steps: |dq| = %.1e, |dlambda| = "
+               "%.1e\n",
+               formulation == GA_INDEX3 ? "index 3" : "index 2", max_abs_diff(q[0], q[1], AN31_N),
+               max_abs_diff(lam[0], lam[1], AN31_M));
+        assert_true(max_abs_diff(q[0], q[1], AN31_N) < 1e-8);
+        assert_true(max_abs_diff(lam[0], lam[1], AN31_M) < 1e-5 * 200.0);
     }
-    printf("  31 coordinates, sparse vs dense after 100 steps: |dq| = %.1e, |dlambda| = %.1e\n",
-           max_abs_diff(q[0], q[1], AN31_N), max_abs_diff(lam[0], lam[1], AN31_M));
-    assert_true(max_abs_diff(q[0], q[1], AN31_N) < 1e-8);
-    assert_true(max_abs_diff(lam[0], lam[1], AN31_M) < 1e-5 * 200.0);
 }
 
 /* The 7-angle model has no tangent callback. beta h^2 K_t is small against M for every h
