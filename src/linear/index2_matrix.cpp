@@ -155,26 +155,34 @@ std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
                 term(s->JBt, a, k, e0 + Jr[a]);
         }
     };
-    for (int i = 0; i < n; ++i)
-        entries.emplace_back(i, i);
-    block(M, false, 0, 0);
-    block(C, false, 0, 0);
-    block(K, false, 0, 0);
-    block(J, true, 0, l0);   // Phi_q^T
-    block(J, false, l0, 0);  // Phi_q
-    block(J, false, e0, 0);  // Phi_q + (beta h / gamma) Z: Z has the pattern of Phi_q
-    for_each_term([&](std::vector<Sparse::Term> &, int, int k, int row) {
-        entries.emplace_back(row, e0 + Jr[k]);
-    });
-    if (with_inactive)
-        for (int i = 0; i < m; ++i) {
-            entries.emplace_back(l0 + i, l0 + i);
-            entries.emplace_back(e0 + i, e0 + i);
-        }
-    std::sort(entries.begin(), entries.end());
-    entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
+    // The terms are counted before any is stored: around a hub their number grows like the
+    // square of its constraints, and the augmented form needs none.
     const std::size_t augmented_entries = K.nnz() + M.nnz() + C.nnz() + 5 * J.nnz() + 2 * n;
-    s->reduced = entries.size() <= 2 * augmented_entries;
+    std::size_t terms = 0;
+    for (int j = 0; j < n; ++j)
+        terms += J_col[j].size() * (M_col[j].size() + C_col[j].size() + J_col[j].size());
+    s->reduced = terms <= 4 * augmented_entries;
+    if (s->reduced) {
+        for (int i = 0; i < n; ++i)
+            entries.emplace_back(i, i);
+        block(M, false, 0, 0);
+        block(C, false, 0, 0);
+        block(K, false, 0, 0);
+        block(J, true, 0, l0);   // Phi_q^T
+        block(J, false, l0, 0);  // Phi_q
+        block(J, false, e0, 0);  // Phi_q + (beta h / gamma) Z: Z has the pattern of Phi_q
+        for_each_term([&](std::vector<Sparse::Term> &, int, int k, int row) {
+            entries.emplace_back(row, e0 + Jr[k]);
+        });
+        if (with_inactive)
+            for (int i = 0; i < m; ++i) {
+                entries.emplace_back(l0 + i, l0 + i);
+                entries.emplace_back(e0 + i, e0 + i);
+            }
+        std::sort(entries.begin(), entries.end());
+        entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
+        s->reduced = entries.size() <= 2 * augmented_entries;
+    }
 
     if (s->reduced) {
         s->S.setup(n + 2 * m, std::move(entries));
