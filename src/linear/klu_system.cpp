@@ -34,6 +34,10 @@ public:
 private:
     static constexpr unsigned kBits = 0x8040;  // MXCSR: flush to zero, denormals are zero
     unsigned saved_;
+#else
+    // other processors keep their mode (user-provided, so that no unused-variable warning)
+    FlushSubnormals() {}
+    ~FlushSubnormals() {}
 #endif
 };
 }  // namespace
