@@ -1,7 +1,8 @@
 /* The sparse path on a mesh: a square membrane of particles joined to their four neighbours by
  * springs, its edge pinned (one constraint per pinned coordinate), set swinging. Its pattern is
  * a 2-D grid, on which the band of reverse Cuthill-McKee fills solid and KLU keeps its AMD
- * ordering (the chain takes the band): the sparse solver must give the dense solvers' steps. */
+ * ordering (the chain takes the band): the sparse solver must give the dense solvers' steps, in
+ * the index-3 and in the stabilized index-2 formulation. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -110,6 +111,13 @@ static int jacobian(double t, const double *q, double *J, void *u)
     return 0;
 }
 
+static int constraint_dt(double t, const double *q, double *out, void *u)
+{
+    (void)t, (void)q, (void)u;
+    memset(out, 0, sizeof(double) * M);
+    return 0;
+}
+
 static int jacobian_pattern(int *rows, int *cols)
 {
     int c = 0;
@@ -132,7 +140,7 @@ typedef struct membrane_run {
 
 /* 40 steps of 2 ms (the fastest mode of the springs turns 1.1 rad per step, the slowest 0.1) from
  * rest, the interior moving as sin(pi x) sin(pi y) in both directions. */
-static void run(int solver, membrane_run *r)
+static void run(int solver, int formulation, membrane_run *r)
 {
     int diag_rows[N], diag_cols[N], J_rows[M], J_cols[M];
     for (int p = 0; p < N; ++p)
@@ -150,6 +158,8 @@ static void run(int solver, membrane_run *r)
     assert_int_equal(ga_set_constant_mass(s, 1), GA_OK);
     assert_int_equal(ga_set_linear_solver(s, solver), GA_OK);
     assert_int_equal(ga_set_newton(s, 1e-12, 10), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    assert_int_equal(ga_set_constraint_dt(s, constraint_dt), GA_OK);
     static double q[N], v[N];
     const double pi = acos(-1.0);
     for (int j = 0; j < SIDE; ++j)
@@ -183,26 +193,34 @@ static double max_abs_diff(const double *a, const double *b, int len, double *si
     return d;
 }
 
+/* In both formulations; the stabilized index-2 system of the mesh is the reduced one (its
+ * products of Phi_q with itself are diagonal here). */
 static void sparse_and_dense_solvers_agree_on_a_mesh(void **state)
 {
     (void)state;
     static membrane_run sp, de;
-    run(GA_LINEAR_SPARSE, &sp);
-    run(GA_LINEAR_DENSE_EIGEN, &de);
-    assert_string_equal(sp.backend, "sparse KLU");
-    assert_string_equal(de.backend, "dense Eigen LU");
-    double q_size, l_size;
-    const double dq = max_abs_diff(sp.q, de.q, N, &q_size);
-    const double dl = max_abs_diff(sp.lambda, de.lambda, M, &l_size);
-    printf("  %d x %d membrane, %d + %d unknowns: |q| %.3g, sparse - dense %.1e; |lambda| %.3g, "
-           "%.1e; %.2f Newton iterations per step\n",
-           SIDE, SIDE, N, M, q_size, dq, l_size, dl, (double)sp.newton / sp.steps);
-    assert_true(q_size > 1e-3 && l_size > 1e-3); /* it moved, and the edge pulls */
-    assert_true(dq <= 1e-12 * q_size);
-    assert_true(dl <= 1e-10 * l_size);
-    /* linear equations, exact tangent: Newton ends in its second iteration (the first
-     * increment solves them, the second measures that) */
-    assert_true(sp.newton == 2 * sp.steps && de.newton == 2 * de.steps);
+    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+        const int index2 = formulation == GA_INDEX2_STABILIZED;
+        run(GA_LINEAR_SPARSE, formulation, &sp);
+        run(GA_LINEAR_DENSE_EIGEN, formulation, &de);
+        assert_string_equal(sp.backend,
+                            index2 ? "sparse KLU (stabilized index-2)" : "sparse KLU");
+        assert_string_equal(de.backend, index2 ? "dense Eigen LU (stabilized index-2)"
+                                               : "dense Eigen LU");
+        double q_size, l_size;
+        const double dq = max_abs_diff(sp.q, de.q, N, &q_size);
+        const double dl = max_abs_diff(sp.lambda, de.lambda, M, &l_size);
+        printf("  %d x %d membrane, index %d, %d + %d unknowns: |q| %.3g, sparse - dense %.1e; "
+               "|lambda| %.3g, %.1e; %.2f Newton iterations per step\n",
+               SIDE, SIDE, index2 ? 2 : 3, N, M, q_size, dq, l_size, dl,
+               (double)sp.newton / sp.steps);
+        assert_true(q_size > 1e-3 && l_size > 1e-3); /* it moved, and the edge pulls */
+        assert_true(dq <= 1e-12 * q_size);
+        assert_true(dl <= 1e-10 * l_size);
+        /* linear equations, exact tangent: Newton ends in its second iteration (the first
+         * increment solves them, the second measures that) */
+        assert_true(sp.newton == 2 * sp.steps && de.newton == 2 * de.steps);
+    }
 }
 
 int main(void)
