@@ -122,9 +122,10 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries)
         colptr_[j + 1] += colptr_[j];
     values_.assign(entries.size(), 0.0);
     row_scale_.assign(N, 1.0);
-    // Two orderings: KLU's AMD (least fill) and reverse Cuthill-McKee (a band, so the
-    // triangular solves walk memory in order). For mechanism-like sparsity both fill about
-    // the same, and the band is several times faster once the factors leave the cache:
+    // Two orderings: KLU's AMD (least fill) and reverse Cuthill-McKee (a band). For
+    // mechanism-like sparsity both fill about the same, and the band keeps KLU's pivoting in
+    // saddle-point systems local (with AMD's ordering the stabilized index-2 system of a
+    // 1 000-link chain filled until a step took many seconds; docs/design-notes.md):
     // take the band unless it fills much more or costs many more operations to factorize (a
     // mesh in two or three dimensions, where the band is wide and fills solid: 3 to 6 times
     // slower refactorizations on 100 x 100 to 200 x 200 grids). Both orderings are measured
