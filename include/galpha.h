@@ -32,7 +32,10 @@
  *
  * Memory is allocated by ga_create and ga_init (and by options that need more workspace once
  * it exists: ga_set_formulation to index 2, tangent options that call for finite differences,
- * the first adaptive step); ga_step never allocates.
+ * the first adaptive step); ga_step never allocates, except on the sparse path where KLU
+ * chooses new pivots, which allocates its factors anew: in the first step after a checkpoint
+ * is taken or restored (see ga_get_state), and when a refactorization with the old pivots
+ * comes out numerically singular (pivot ratio below 1e-12).
  *
  * ## Conventions
  *  - Every function that can fail returns a ::ga_status (0 = GA_OK, negative = error);
@@ -299,7 +302,9 @@ typedef enum ga_reuse_mode {
                             at every iteration */
 } ga_reuse_mode;
 
-/** mode is a ::ga_reuse_mode. Errors: GA_ERR_ARG, GA_ERR_STATE. */
+/** mode is a ::ga_reuse_mode. Setting it, to the mode in use too, drops the kept
+ *  factorization: the next step builds a fresh one (e.g. after the model changed in a way its
+ *  callbacks do not show). Errors: GA_ERR_ARG, GA_ERR_STATE. */
 GA_API ga_status ga_set_jacobian_reuse(ga_solver *s, int mode);
 
 /** Declare the mass matrix constant (1) or not (0, default): with 1, M is evaluated once (at
@@ -541,8 +546,10 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
  *  the corrected start). Layout 2: [magic, layout version, n, m, t, h_last, h_next, err_prev,
  *  grew, q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n)] (h_next, err_prev, grew: the step-size
  *  controller; a_prev: the a of the step before, for the error estimate); treat it as opaque.
- *  The factorized iteration matrix is not part of it: taking a checkpoint makes the next step
- *  start with a fresh one, as a restart does. ga_set_state needs callbacks set, allocates like
+ *  The factorized iteration matrix is not part of it: taking a checkpoint (or restoring one)
+ *  makes the next step start with a fresh one, as a restart does; on the sparse path with
+ *  pivots chosen afresh too (KLU allocates its factors again in that step), since a new solver
+ *  has no earlier pivots to keep. ga_set_state needs callbacks set, allocates like
  *  ga_init (when the solver was not initialized) and makes the solver initialized; dense
  *  output (ga_interpolate) is available again after the next step. */
 /**@{*/

@@ -295,6 +295,12 @@ ga_status Solver::attempt_step(double h, double tol)
 {
     if (formulation == GA_INDEX2_STABILIZED && !S2_.ready())
         return diag.fail(GA_ERR_INTERNAL, "the stabilized index-2 system was not set up");
+    if (pivots_forgotten_) {  // after a checkpoint: pivots as a restarted solver picks them
+        S_.forget_pivots();
+        S2_.forget_pivots();
+        P_.forget_pivots();
+        pivots_forgotten_ = false;
+    }
     const State &s = accepted_;
     // The start of the step. a_n carries the shift delta_alpha h_last; rescaled to the h of
     // this step the scheme stays second order under any sequence of step sizes (ALGORITHMS.md
@@ -601,6 +607,7 @@ void Solver::get_state(double *buf) const
         p += x->size();
     }
     invalidate_jacobian();
+    pivots_forgotten_ = true;
 }
 
 ga_status Solver::set_state(const double *buf, std::size_t len)
@@ -639,6 +646,7 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
     }
 
     invalidate_jacobian();
+    pivots_forgotten_ = true;
     previous_valid_ = false;
     // A checkpoint from before the first step (h_last = 0) still owes that step its corrected
     // starting values, as the solver it was taken from does.

@@ -109,8 +109,10 @@ public:
     double last_newton_ratio() const { return convergence_.ratio(); }
 
     // Checkpoint (layout 2): [magic, 2, n, m, t, h_last, h_next, err_prev, grew, q, v, qdd,
-    // lambda, a, a_prev]. Taking one also drops the reusable iteration matrix, so that the run
-    // continues exactly as a restart from the checkpoint does (the matrix is not part of it).
+    // lambda, a, a_prev]. Taking one (or restoring one) also drops the reusable iteration
+    // matrix and, on the sparse path, the pivot order and row scaling KLU keeps from its last
+    // full factorization, so that the run continues exactly as a restart from the checkpoint
+    // does (neither is part of it): the next step factorizes afresh.
     std::size_t state_size() const;
     void get_state(double *buf) const;
     ga_status set_state(const double *buf, std::size_t len);
@@ -167,6 +169,8 @@ private:
     // choice is made again whenever the matrix is dropped.
     static constexpr double kDeferredTangentRate = 0.1;
     mutable bool fd_tangents_ = false;
+    // A checkpoint was taken or restored: the next step forgets the pivots (get_state).
+    mutable bool pivots_forgotten_ = false;
     bool tangents_deferred_ = false;  // the last Newton iteration ran without them
 
     // Step workspace, sized once.

@@ -42,6 +42,9 @@ public:
     // sparse: KLU's min |U_ii| / max |U_ii|).
     virtual double rcond() const = 0;
     virtual const char *name() const = 0;
+    // The next factorization chooses its pivots (and the sparse row scaling) afresh, as in a
+    // new solver; a dense LU does so at every factorization anyway.
+    virtual void forget_pivots() {}
 };
 
 // Auto: per factorization, the unblocked kernel for small or mostly-zero S, Eigen's otherwise.

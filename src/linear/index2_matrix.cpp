@@ -444,6 +444,14 @@ double Index2Matrix::rcond() const
     return d.rcond;
 }
 
+void Index2Matrix::forget_pivots()
+{
+#ifdef GALPHA_HAVE_KLU
+    if (sparse_)
+        sparse_->S.forget_pivots();
+#endif
+}
+
 const char *Index2Matrix::name() const
 {
     if (sparse_)

@@ -61,6 +61,8 @@ public:
                const ModelMatrix &B, Vec &d, Vec &w, Vec &dlambda, Vec &eta_bar);
     double rcond() const;
     const char *name() const;
+    // The next factorization picks its pivots afresh (LinearBackend::forget_pivots).
+    void forget_pivots();
 
 private:
     struct Dense;

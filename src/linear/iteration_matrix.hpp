@@ -35,6 +35,12 @@ public:
     void solve(const Vec &r1, const Vec &r2, Vec &x1, Vec &x2, double row_scale = 1.0);
 
     double rcond() const { return backend_ ? backend_->rcond() : 0.0; }
+    // The next factorization picks its pivots afresh (LinearBackend::forget_pivots).
+    void forget_pivots()
+    {
+        if (backend_)
+            backend_->forget_pivots();
+    }
 
 private:
     int n_ = 0, m_ = 0;

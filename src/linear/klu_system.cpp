@@ -160,6 +160,12 @@ int KluSystem::slot(int row, int col) const
     return static_cast<int>(std::lower_bound(first, last, row) - rowind_.begin());
 }
 
+void KluSystem::forget_pivots()
+{
+    if (numeric_)
+        klu_free_numeric(&numeric_, &common_);
+}
+
 bool KluSystem::factorize()
 {
     if (numeric_) {

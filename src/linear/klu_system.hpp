@@ -43,6 +43,9 @@ public:
 
     // false if singular or numerically singular. Throws std::bad_alloc.
     bool factorize();
+    // The next factorize() is a full one (new pivots and row scaling, KLU's factors allocated
+    // again) instead of a refactorization with the pivots of an earlier matrix.
+    void forget_pivots();
     void solve(double *rhs);  // in place, length N
     // Reciprocal 1-norm condition estimate of the matrix factorized last, rows scaled as
     // factorized (klu_condest: a few solves; on demand, not in steps). 0 if singular.

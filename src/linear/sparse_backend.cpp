@@ -100,6 +100,7 @@ public:
 
     double rcond() const override { return S_.rcond_estimate(); }
     const char *name() const override { return "sparse KLU"; }
+    void forget_pivots() override { S_.forget_pivots(); }
 
 private:
     int n_ = 0, m_ = 0;
