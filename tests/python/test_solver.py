@@ -144,6 +144,90 @@ def test_checkpoint_restart_is_bit_identical():
         assert np.array_equal(a.get_state(), b.get_state())
 
 
+class Boom(Exception):
+    """Raised by a model callback at a chosen call."""
+
+
+class FaultyPendulum:
+    """The pendulum's callbacks, counting their calls; call number fail_at raises Boom."""
+
+    def __init__(self):
+        self.calls, self.fail_at = 0, 0
+
+    def _count(self, name):
+        self.calls += 1
+        if self.calls == self.fail_at:
+            raise Boom(f"{name} at call {self.calls}")
+
+    def mass(self, t, q, M):
+        mass(t, q, M)
+        self._count("mass")
+
+    def force(self, t, q, v, f):
+        force(t, q, v, f)
+        self._count("force")
+
+    def constraint(self, t, q, phi):
+        constraint(t, q, phi)
+        self._count("constraint")
+
+    def jacobian(self, t, q, J):
+        jacobian(t, q, J)
+        self._count("jacobian")
+
+    def solver(self, **kw):
+        return galpha.Solver(2, 1, self.mass, self.force, self.constraint, self.jacobian, **kw)
+
+
+@pytest.mark.parametrize("adaptive", [False, True])
+def test_exception_at_every_callback_call_of_a_step(adaptive):
+    """An exception raised at any callback call of a step (full Newton, so that every
+    iteration evaluates the matrices) is re-raised from that step, which leaves t, q, v, qdd,
+    lambda and a bit-identical; the run then continues exactly like one restarted from a
+    checkpoint of that state."""
+    kw = dict(tolerances=(1e-6, 1e-6), reuse=galpha.GA_REUSE_NEVER)
+
+    def advance(s):
+        if adaptive:
+            s.step_adaptive(10.0)
+        else:
+            s.step(2e-3)
+
+    def readout(s):
+        return np.concatenate(([s.t, s.h_last], s.q, s.v, s.qdd, s.lam, s.a))
+
+    failed_in = set()
+    for k in range(1, 100):
+        model = FaultyPendulum()
+        with model.solver(**kw) as s:
+            s.init(0.0, Q0, V0)
+            for _ in range(3):
+                advance(s)
+            before = readout(s)
+            model.calls, model.fail_at = 0, k
+            try:
+                advance(s)
+            except Boom as e:
+                failed_in.add(str(e).split()[0])
+            else:
+                assert model.calls < k  # the step made fewer calls: every one was failed
+                break
+            assert np.array_equal(readout(s), before)
+            assert s.stats["failed_steps"] == 1
+            model.fail_at = 0
+            with FaultyPendulum().solver(**kw) as ref:
+                ckpt_source = FaultyPendulum().solver(**kw)
+                ckpt_source.init(0.0, Q0, V0)
+                for _ in range(3):
+                    advance(ckpt_source)
+                ref.set_state(ckpt_source.get_state())
+                ckpt_source.close()
+                advance(s)
+                advance(ref)
+                assert np.array_equal(readout(s), readout(ref))
+    assert k > 4 and failed_in == {"mass", "force", "constraint", "jacobian"}
+
+
 def test_integrate_returns_histories():
     sol = galpha.integrate(mass, force, constraint, jacobian, (0.0, 0.5), Q0, V0, 0.003, m=1,
                            rho_inf=0.8)
