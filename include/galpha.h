@@ -468,8 +468,10 @@ GA_API ga_status ga_set_initial_step(ga_solver *s, double h0);
  *  matrix; GA_COUNT_FAILED_STEPS) are retried smaller until one is accepted.
  *  Error estimate (position, ALGORITHMS.md sec. 1.5a): h^2 (beta + delta_alpha/2 - 1/6)
  *  (a_n+1 - a_n); velocity (sec. 1.5b) from the divided differences of a over two steps.
- *  Controller: PI (Gustafsson), safety 0.9, growth at most 2 and not on consecutive steps nor
- *  right after a rejection, a dead band [1, 1.2] that keeps h, shrink at least 0.2.
+ *  Controller: predictive (Gustafsson, as in Radau5), safety 0.9, growth at most 2 and not on
+ *  consecutive steps nor right after a rejection, shrink at least 0.2. First step (unless
+ *  ga_set_initial_step): half the step over which qdd moves q by the tolerance, in the
+ *  weighted norm of the error test.
  *  Use with ga_interpolate for output at user times without shortening steps. The first
  *  adaptive call allocates the workspace of the error estimate's projection (fixed-step runs
  *  do without it); ga_step_adaptive never allocates after that.
