@@ -137,15 +137,17 @@ ga_status Solver::step_adaptive(double t_stop)
                 // controller, fac = s err^(-0.7/k) err_prev^(0.4/k), answers a steady error
                 // only with err^(-0.1): with that dead band it held h for any error between
                 // 0.06 and 0.35 of the tolerance.)
+                // The first step's estimate has no velocity part (no a history) and is blind to
+                // a start from rest: it is no base for a prediction (err_prev = 0: none).
                 const double e = std::max(err, 1e-10);
                 double fac = kSafety * std::pow(e, -1.0 / 3.0);
-                if (h_prev > 0.0)
+                if (control.err_prev > 0.0 && h_prev > 0.0)
                     fac *= std::min(1.0, (h / h_prev) * std::cbrt(control.err_prev / e));
                 fac = std::clamp(fac, kMinShrink, kMaxGrowth);
                 if (fac > 1.0 && (rejected || control.grew))
                     fac = 1.0;
                 control.grew = fac > 1.0;
-                control.err_prev = e;
+                control.err_prev = h_prev > 0.0 ? e : 0.0;
                 control.h_next = h * fac;
                 if (control.h_max > 0.0)
                     control.h_next = std::min(control.h_next, control.h_max);

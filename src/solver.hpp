@@ -29,7 +29,7 @@ struct Control {
     double rtol = 1e-6, atol = 1e-6;
     double h_min = 0.0, h_max = 0.0, h_init = 0.0;  // 0: automatic / unlimited
     // controller state (part of the checkpoint)
-    double h_next = 0.0, err_prev = 1.0;
+    double h_next = 0.0, err_prev = 0.0;  // err_prev 0: none (see control.cpp)
     bool grew = false;
     double err_last = 0.0;  // error norm of the last accepted step
 };
