@@ -208,6 +208,59 @@ static void no_allocation_in_sparse_step(void **state)
     assert_int_equal(count_sparse_step_allocations(1, GA_INDEX2_STABILIZED, 1), 0);
 }
 
+/* The chain's forces, failing (recoverably) while chain_force_fails is set. */
+static int chain_force_fails = 0;
+static int chain_force_maybe_failing(double t, const double *q, const double *v, double *f,
+                                     void *user)
+{
+    chain_force(t, q, v, f, user);
+    return chain_force_fails;
+}
+
+/* A checkpoint on the sparse path: the step after it lets KLU choose its pivots afresh, as a
+ * restarted solver does, which allocates KLU's factors (documented at ga_get_state); the steps
+ * after that one allocate nothing again, failed steps (which keep the pivots) included. */
+static void sparse_allocation_only_in_the_step_after_a_checkpoint(void **state)
+{
+    (void)state;
+    chain c = chain_make(50);
+    double q[150], v[150];
+    chain_initial(&c, q, v);
+    ga_solver *s = chain_solver(&c, 1);
+    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force_maybe_failing,
+                                      chain_constraint, chain_jacobian, &c),
+                     GA_OK);
+    assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    for (int i = 0; i < 5; ++i)
+        assert_int_equal(ga_step(s, 1e-3), GA_OK);
+    size_t len = 0;
+    assert_int_equal(ga_state_size(s, &len), GA_OK);
+    double *ckpt = malloc(len * sizeof *ckpt);
+    assert_non_null(ckpt);
+    assert_int_equal(ga_get_state(s, ckpt, len), GA_OK);
+    allocations = 0;
+    armed = 1;
+    assert_int_equal(ga_step(s, 1e-3), GA_OK);
+    armed = 0;
+    const long first = allocations;
+    allocations = 0;
+    armed = 1;
+    for (int i = 0; i < 20; ++i) {
+        chain_force_fails = i % 5 == 2;
+        assert_int_equal(ga_step(s, 1e-3), chain_force_fails ? GA_ERR_CALLBACK_RETRY : GA_OK);
+    }
+    chain_force_fails = 0;
+    armed = 0;
+    printf("  sparse: %ld allocations in the step after a checkpoint (KLU's new factors), %ld in "
+           "the 20 after it (4 of them failing)\n",
+           first, allocations);
+    assert_true(first > 0);
+    assert_int_equal(allocations, 0);
+    free(ckpt);
+    ga_free(s);
+}
+
 /* Every dense LU kernel, index 3 and 2, on a 12-link chain (60 unknowns: GA_LINEAR_DENSE
  * measures the fill of each matrix before it chooses). */
 static void no_allocation_with_any_dense_kernel(void **state)
@@ -299,6 +352,7 @@ int main(void)
         cmocka_unit_test(no_allocation_in_step),
         cmocka_unit_test(no_allocation_in_failing_step),
         cmocka_unit_test(no_allocation_in_sparse_step),
+        cmocka_unit_test(sparse_allocation_only_in_the_step_after_a_checkpoint),
         cmocka_unit_test(no_allocation_with_dropped_constraints),
         cmocka_unit_test(no_allocation_with_any_dense_kernel),
         cmocka_unit_test(no_allocation_after_tangent_options_change),
