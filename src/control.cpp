@@ -129,16 +129,10 @@ ga_status Solver::step_adaptive(double t_stop)
                 // the error grew faster than the step size explains,
                 //     fac = s min(1, (h / h_prev) (err_prev / err)^(1/k)) err^(-1/k),
                 // growth at most 2, none right after a rejection or on two consecutive steps
-                // (sec. 1.2). No dead band: holding h for growth below 1.2 (to keep the
-                // factorization) left the error estimates between 0.4 and 0.7 instead of near
-                // 0.7, and on Andrews' mechanism it doubled the largest error over the
-                // trajectory at the same work, while the matrix was refactorized at nearly
-                // every step anyway; on the chain it saved nothing measurable. (A PI
-                // controller, fac = s err^(-0.7/k) err_prev^(0.4/k), answers a steady error
-                // only with err^(-0.1): with that dead band it held h for any error between
-                // 0.06 and 0.35 of the tolerance.)
-                // The first step's estimate has no velocity part (no a history) and is blind to
-                // a start from rest: it is no base for a prediction (err_prev = 0: none).
+                // (sec. 1.2). No dead band for small growth: it kept the estimates well below
+                // the tolerance and cost accuracy for the same work (design-notes.md, "Step-size
+                // control"). The first step's estimate has no velocity part (no a history) and
+                // is blind to a start from rest: no base for a prediction (err_prev = 0: none).
                 const double e = std::max(err, 1e-10);
                 double fac = kSafety * std::pow(e, -1.0 / 3.0);
                 if (control.err_prev > 0.0 && h_prev > 0.0)
