@@ -44,9 +44,8 @@ typedef struct faulty_chain {
 } faulty_chain;
 
 /* The callbacks a sweep has failed, as a bit set over the names below. */
-static const char *const CALLBACK_NAMES[] = {"mass",      "force",           "constraint",
-                                             "jacobian",  "stiffness",       "constraint_accel",
-                                             "constraint_dt"};
+static const char *const CALLBACK_NAMES[] = {
+    "mass", "force", "constraint", "jacobian", "stiffness", "constraint_accel", "constraint_dt"};
 enum { CALLBACKS = sizeof CALLBACK_NAMES / sizeof CALLBACK_NAMES[0] };
 enum {
     CB_MASS = 1,
@@ -154,7 +153,6 @@ static ga_solver *configured(const config *cf, faulty_chain *f)
     }
     return s;
 }
-
 
 static ga_status take_step(ga_solver *s, const config *cf)
 {
@@ -272,7 +270,7 @@ static double constraint_residual(const ga_solver *s, const chain *c)
 
 static ga_status expected_status(fault_kind kind)
 {
-    return kind == RETRY ? GA_ERR_CALLBACK_RETRY
+    return kind == RETRY   ? GA_ERR_CALLBACK_RETRY
            : kind == FATAL ? GA_ERR_CALLBACK
                            : GA_ERR_NONFINITE;
 }
