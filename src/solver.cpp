@@ -286,7 +286,7 @@ void Solver::commit(bool land_on, double t_land)
     if (land_on)
         accepted_.t = t_land;  // exactly, not t_n + h rounded
     previous_valid_ = true;
-    start_pending_ = false;
+    start_pending_ = accepted_.h_last == 0.0;  // a step that ended like a restart
     count(counters, GA_COUNT_STEPS);
 }
 
@@ -295,6 +295,8 @@ ga_status Solver::attempt_step(double h, double tol)
 {
     if (formulation == GA_INDEX2_STABILIZED && !S2_.ready())
         return diag.fail(GA_ERR_INTERNAL, "the stabilized index-2 system was not set up");
+    if (accepted_.h_last > 0.0 && h < accepted_.h_last / kShortStepRatio)
+        return sliver_step(h);
     if (pivots_forgotten_) {  // after a checkpoint: pivots as a restarted solver picks them
         S_.forget_pivots();
         S2_.forget_pivots();
@@ -362,6 +364,41 @@ ga_status Solver::attempt_step(double h, double tol)
     x.h_last = h;
     if (convergence_.rate() >= 0.0)
         theta_prev_ = convergence_.rate();
+    return GA_OK;
+}
+
+// A step far shorter than the one before it (a sliver that lands on an output time, a step
+// after repeated failures) is not solved from the discrete equations: they determine its
+// accelerations badly. In index 3 the position constraint makes a_{n+1} absorb the
+// O(h_last^2) velocity-constraint residual left by the steps before, an impulse of size
+// O(h_last^2 / h), and at h = 1e-16 only to eps |q| / (beta h^2), which then moves v by O(1)
+// through h gamma a_{n+1}; in index 2 they are fixed only to eps |v| / (gamma h). Through a,
+// the next steps carried that on (a sliver of 1e-8 after steps of 1e-3 put the index-3
+// pendulum 1.5 off its path). Instead: a Taylor step q + h v + h^2/2 qdd, v + h qdd (local
+// errors O(h^3) and O(h^2) in the third derivative, with h at most 1e-2 of the step before),
+// accelerations and multipliers from the acceleration-level equations at its end, a = qdd,
+// and h_last = 0, so that the next step starts like a first one (corrected start, no
+// rescaling of a).
+ga_status Solver::sliver_step(double h)
+{
+    const State &s = accepted_;
+    State &x = trial_;
+    x.t = s.t + h;
+    x.q = s.q + h * s.v + (0.5 * h * h) * s.qdd;
+    x.v = s.v + h * s.qdd;
+    if (!x.q.allFinite() || !x.v.allFinite())
+        return diag.fail(GA_ERR_NONFINITE,
+                         "the short step from t = %.17g with h = %g is not finite", s.t, h);
+    if (auto st = consistent_accelerations(x.t, x.q, x.v, x.qdd, x.lambda)) {
+        diag.append(" (short step from t = %.17g, h = %g: %g times shorter than the one before)",
+                    s.t, h, s.h_last / h);
+        return st;
+    }
+    x.a = x.qdd;
+    x.a_prev = x.a;
+    x.h_last = 0.0;
+    a_n_ = x.a;  // for the error estimate of adaptive steps: none from this step
+    last_newton_iters_ = 0;
     return GA_OK;
 }
 

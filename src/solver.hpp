@@ -123,6 +123,10 @@ private:
     void prefactor_index2();
     double newton_tolerance(bool adaptive) const;
     ga_status attempt_step(double h, double tol);
+    ga_status sliver_step(double h);
+    // A step this many times shorter than the one before is a Taylor step that ends like a
+    // restart (sliver_step).
+    static constexpr double kShortStepRatio = 100.0;
     ga_status newton(double h, double tol, bool refresh, bool &converged, bool &used_stale);
     ga_status residual(double t, const State &x);
     ga_status factorize(double h, bool tangents_K, bool tangents_C, bool tangent_Z, int iter);
@@ -150,7 +154,7 @@ private:
     State trial_;     // the step being computed
     State previous_;  // the accepted step before (dense output)
     bool previous_valid_ = false;
-    bool start_pending_ = false;  // first step after ga_init: corrected starting values
+    bool start_pending_ = false;  // first step after ga_init (or a restart): corrected start
 
     // The start of the step being computed: a_n rescaled to h (ALGORITHMS.md 1.2) and, in the
     // first step, the corrected a_0 and v_0 (sec. 3.4-3.5).
