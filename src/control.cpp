@@ -117,7 +117,9 @@ ga_status Solver::step_adaptive(double t_stop)
                              "step size %g fell below the minimum %g at t = %.17g (last error "
                              "estimate %.3g)",
                              h, h_min, t, control.err_last);
-        ga_status st = attempt_step(h, tol);
+        // A sliver is a Taylor step (sliver_step) only when it lands on t_stop; retries after
+        // failures stay under error control.
+        ga_status st = attempt_step(h, tol, land);
         if (st == GA_OK) {
             const double err = error_norm(h);
             control.err_last = err;

@@ -268,7 +268,7 @@ ga_status Solver::step(double h)
                 count(c, GA_COUNT_FAILED_STEPS);
         }
     } failed{counters};
-    const ga_status st = attempt_step(h, newton_tolerance(false));
+    const ga_status st = attempt_step(h, newton_tolerance(false), true);
     if (st != GA_OK) {
         // Whatever went wrong, the next attempt starts from a fresh iteration matrix.
         invalidate_jacobian();
@@ -291,11 +291,11 @@ void Solver::commit(bool land_on, double t_land)
 }
 
 // One step from accepted_ into trial_. accepted_ is only read.
-ga_status Solver::attempt_step(double h, double tol)
+ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
 {
     if (formulation == GA_INDEX2_STABILIZED && !S2_.ready())
         return diag.fail(GA_ERR_INTERNAL, "the stabilized index-2 system was not set up");
-    if (accepted_.h_last > 0.0 && h < accepted_.h_last / kShortStepRatio)
+    if (sliver_allowed && accepted_.h_last > 0.0 && h < accepted_.h_last / kShortStepRatio)
         return sliver_step(h);
     if (pivots_forgotten_) {  // after a checkpoint: pivots as a restarted solver picks them
         S_.forget_pivots();

@@ -122,7 +122,9 @@ private:
     void setup_projection();
     void prefactor_index2();
     double newton_tolerance(bool adaptive) const;
-    ga_status attempt_step(double h, double tol);
+    // sliver_allowed: a step over kShortStepRatio times shorter than the one before is a
+    // Taylor step (sliver_step)
+    ga_status attempt_step(double h, double tol, bool sliver_allowed);
     ga_status sliver_step(double h);
     // A step this many times shorter than the one before is a Taylor step that ends like a
     // restart (sliver_step).
