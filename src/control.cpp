@@ -106,6 +106,7 @@ ga_status Solver::step_adaptive(double t_stop)
         // After a rejection only the clamp to t_stop applies (else the stretch would undo the
         // shrink).
         bool land = false;
+        const double h_planned = h;
         if (h * (rejected ? 1.0 : 1.5) >= remaining) {
             h = remaining;
             land = true;
@@ -135,16 +136,20 @@ ga_status Solver::step_adaptive(double t_stop)
                 // the tolerance and cost accuracy for the same work (design-notes.md, "Step-size
                 // control"). The first step's estimate has no velocity part (no a history) and
                 // is blind to a start from rest: no base for a prediction (err_prev = 0: none).
+                // A step shortened to land on t_stop (down to a sliver, when t_stop was that
+                // close) was not the controller's choice: no prediction from it, and unless
+                // its error asks for less, the next step takes the one planned.
+                const bool shortened = land && h < h_planned;
                 const double e = std::max(err, 1e-10);
                 double fac = kSafety * std::pow(e, -1.0 / 3.0);
-                if (control.err_prev > 0.0 && h_prev > 0.0)
+                if (!shortened && control.err_prev > 0.0 && h_prev > 0.0)
                     fac *= std::min(1.0, (h / h_prev) * std::cbrt(control.err_prev / e));
                 fac = std::clamp(fac, kMinShrink, kMaxGrowth);
                 if (fac > 1.0 && (rejected || control.grew))
                     fac = 1.0;
                 control.grew = fac > 1.0;
                 control.err_prev = h_prev > 0.0 ? e : 0.0;
-                control.h_next = h * fac;
+                control.h_next = shortened && fac >= 1.0 ? h_planned : h * fac;
                 if (control.h_max > 0.0)
                     control.h_next = std::min(control.h_next, control.h_max);
                 return GA_OK;

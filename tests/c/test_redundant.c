@@ -47,6 +47,7 @@ static int twice_jacobian(double t, const double *q, double *J, void *u)
 typedef struct result {
     double q[2], v[2], lambda[2];
     int active[2];
+    double h_min; /* the shortest step that ended an output interval */
 } result;
 
 static result run_pendulum(int m, int formulation, int adaptive, int steps)
@@ -54,6 +55,7 @@ static result run_pendulum(int m, int formulation, int adaptive, int steps)
     ga_solver *s = NULL;
     result r;
     memset(&r, 0, sizeof r);
+    r.h_min = 1e-3;
     double q[2], v[2];
     pendulum_state(&P, 1.0, 0.5, q, v);
     assert_int_equal(ga_create(2, m, &s), GA_OK);
@@ -74,6 +76,10 @@ static result run_pendulum(int m, int formulation, int adaptive, int steps)
         const ga_status st = adaptive ? ga_advance(s, 1e-3 * (k + 1)) : ga_step(s, 1e-3);
         if (st)
             fail_msg("step %d: %s", k, ga_last_error(s));
+        double h = 0.0;
+        ga_get_h_last(s, &h);
+        if (h > 0.0 && h < r.h_min)
+            r.h_min = h;
     }
     ga_get_q(s, r.q);
     ga_get_v(s, r.v);
@@ -96,7 +102,17 @@ static void compare_pendulum(int formulation, int adaptive)
         assert_int_equal(two.active[1], 0);
         assert_true(max_abs_diff(one.q, two.q, 2) < 1e-12);
         assert_true(max_abs_diff(one.v, two.v, 2) < 1e-11);
-        assert_true(fabs(two.lambda[0] - one.lambda[0]) < 1e-9 * fabs(one.lambda[0]));
+        /* Index-3 multipliers are determined only to about eps |q| / (beta h^2) per step
+         * (paper, sec. 3.3): once the two runs' Newton iterations part by one iteration (the
+         * stopping test of adaptive steps decides on round-off-sized differences), their
+         * multipliers differ by that floor, accumulated over the 500 steps like a random walk.
+         * q, v and index-2 multipliers stay within 1e-9 regardless. (beta >= 1/4 for every
+         * rho_inf, |q| = 1.) */
+        const double h = fmin(one.h_min, two.h_min);
+        const double floor = formulation == GA_INDEX3 && adaptive
+                                 ? sqrt(500.0) * DBL_EPSILON / (0.25 * h * h)
+                                 : 0.0;
+        assert_true(fabs(two.lambda[0] - one.lambda[0]) < 1e-9 * fabs(one.lambda[0]) + floor);
         assert_true(two.lambda[1] == 0.0);
     }
 }
