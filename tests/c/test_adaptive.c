@@ -882,6 +882,45 @@ static void sliver_steps_do_not_derail_the_run(void **state)
     }
 }
 
+/* A step shortened to land on t_stop was not the controller's choice: the step after it is
+ * the one planned before. Output every 1e-3 by ga_advance, with steps of about 2e-3 planned,
+ * takes one step per output interval (it took two: every landing step of 1e-3 made the next
+ * proposal from itself); a landing sliver of 1e-13 (a t_stop that close) is followed by the
+ * step planned before it (the next steps restarted from 1e-13 and needed ~80 steps to grow
+ * back). */
+static void landing_on_t_stop_keeps_the_planned_step(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    double q[2], v[2];
+    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+        ga_solver *s = pendulum_new_solver(&p, 1);
+        assert_non_null(s);
+        assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+        assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+        pendulum_state(&p, 1.0, 0.5, q, v);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        for (int k = 0; k < 500; ++k)
+            assert_int_equal(ga_advance(s, 1e-3 * (k + 1)), GA_OK);
+        long long steps = 0;
+        double planned = 0.0, t = 0.0, h = 0.0;
+        ga_get_counter(s, GA_COUNT_STEPS, &steps);
+        ga_get_info(s, GA_INFO_H_NEXT, &planned);
+        printf("  %s: 500 output intervals of 1e-3 in %lld steps, step planned %.2e\n",
+               formulation == GA_INDEX3 ? "index 3" : "index 2", steps, planned);
+        assert_true(planned > 1e-3);
+        assert_true(steps <= 510);
+        ga_get_t(s, &t);
+        assert_int_equal(ga_step_adaptive(s, t + 1e-13), GA_OK); /* the sliver */
+        ga_get_h_last(s, &h);
+        assert_true(h == 0.0); /* a Taylor step: the next starts like a first one */
+        assert_int_equal(ga_step_adaptive(s, 1.0), GA_OK);
+        ga_get_h_last(s, &h);
+        assert_true(h == planned);
+        ga_free(s);
+    }
+}
+
 static void fast_rotation_needs_damping_or_index2(void **state)
 {
     (void)state;
@@ -905,6 +944,7 @@ int main(void)
         cmocka_unit_test(rho_one_needs_the_corrected_start),
         cmocka_unit_test(fast_rotation_needs_damping_or_index2),
         cmocka_unit_test(sliver_steps_do_not_derail_the_run),
+        cmocka_unit_test(landing_on_t_stop_keeps_the_planned_step),
         cmocka_unit_test(error_estimate_tends_to_the_true_local_error),
         cmocka_unit_test(advance_lands_on_every_output_time),
         cmocka_unit_test(interpolation_agrees_with_a_step_ending_there),
