@@ -199,7 +199,9 @@ GA_API ga_status ga_init(ga_solver *s, double t0, const double *q0, const double
  *  it: it is a Taylor step, q + h v + h^2/2 qdd and v + h qdd, with qdd and lambda at its end
  *  from the acceleration-level equations (as in ga_init), and the next step starts like a
  *  first one (ga_get_h_last gives 0). (ga_step_adaptive does so only for a step that lands on
- *  its t_stop.)
+ *  its t_stop.) A step more than 100 times longer than the one before starts like a first one
+ *  too (corrected starting values, ga_set_corrected_start), instead of rescaling a_n by that
+ *  ratio, which would multiply its round-off.
  *  Errors: GA_ERR_ARG (h <= 0, NaN, Inf, or t + h == t), GA_ERR_STATE (before ga_init, or from a
  *  callback), GA_ERR_CALLBACK, GA_ERR_CALLBACK_RETRY, GA_ERR_NONFINITE, GA_ERR_SINGULAR,
  *  GA_ERR_NEWTON, GA_ERR_INTERNAL. */

@@ -313,9 +313,13 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
         a_n_ = s.a;
     v_n_ = s.v;
     lambda_n_ = s.lambda;
-    if (start_pending_ && corrected_start)
+    const bool long_after_short = s.h_last > 0.0 && h > kShortStepRatio * s.h_last;
+    if ((start_pending_ || long_after_short) && corrected_start) {
         if (auto st = starting_values(h))
             return st;
+    } else if (long_after_short) {
+        a_n_ = s.qdd;
+    }
 
     // After a reused matrix was too slow, the next steps start with a fresh one; how many
     // doubles with every failed attempt to reuse (up to 32) and resets when reuse works.

@@ -882,6 +882,52 @@ static void sliver_steps_do_not_derail_the_run(void **state)
     }
 }
 
+/* The pendulum (exact K_t): `count` steps of h1, then steps of h2 up to about t = 1; the
+ * errors in q and lambda at the end against the RK4 reference of helpers.h. */
+static void pendulum_two_step_sizes(int formulation, int count, double h1, double h2,
+                                    double *err_q, double *err_lambda)
+{
+    pendulum p = {1.0, 1.0, 9.81};
+    double q[2], v[2], lambda, t;
+    ga_solver *s = pendulum_new_solver(&p, 1);
+    assert_non_null(s);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    pendulum_state(&p, 1.0, 0.5, q, v);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    for (int k = 0; k < count; ++k)
+        assert_int_equal(ga_step(s, h1), GA_OK);
+    const int rest = (int)floor((1.0 - count * h1) / h2);
+    for (int k = 0; k < rest; ++k)
+        assert_int_equal(ga_step(s, h2), GA_OK);
+    ga_get_t(s, &t);
+    ga_get_q(s, q);
+    ga_get_lambda(s, &lambda);
+    const pendulum_exact r = pendulum_reference(&p, 1.0, 0.5, t, 200000);
+    *err_q = max_abs_diff(q, r.q, 2);
+    *err_lambda = fabs(lambda - r.lambda);
+    ga_free(s);
+}
+
+/* A step over 100 times longer than the one before starts like a first one (corrected
+ * starting values from consistent accelerations): rescaling a_n - qdd_n by h / h_last = 1e4
+ * multiplied its round-off (in index 3 the multiplier of steps of 1e-6 is known only to
+ * eps / (beta h^2) ~ 1e-3), and the index-3 multiplier was still 0.3 off after 99 more steps.
+ * Now 1 000 steps of 1e-6 and then steps of 1e-2 end with the errors of steps of 1e-2. */
+static void long_step_after_short_ones_starts_afresh(void **state)
+{
+    (void)state;
+    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+        double eq_uniform, el_uniform, eq, el;
+        pendulum_two_step_sizes(formulation, 0, 1e-2, 1e-2, &eq_uniform, &el_uniform);
+        pendulum_two_step_sizes(formulation, 1000, 1e-6, 1e-2, &eq, &el);
+        printf("  %s: steps of 1e-2: errors %.1e in q, %.1e in lambda; after 1000 of 1e-6: "
+               "%.1e, %.1e\n",
+               formulation == GA_INDEX3 ? "index 3" : "index 2", eq_uniform, el_uniform, eq, el);
+        assert_true(eq <= 2.0 * eq_uniform);
+        assert_true(el <= 2.0 * el_uniform);
+    }
+}
+
 /* A step shortened to land on t_stop was not the controller's choice: the step after it is
  * the one planned before. Output every 1e-3 by ga_advance, with steps of about 2e-3 planned,
  * takes one step per output interval (it took two: every landing step of 1e-3 made the next
@@ -945,6 +991,7 @@ int main(void)
         cmocka_unit_test(fast_rotation_needs_damping_or_index2),
         cmocka_unit_test(sliver_steps_do_not_derail_the_run),
         cmocka_unit_test(landing_on_t_stop_keeps_the_planned_step),
+        cmocka_unit_test(long_step_after_short_ones_starts_afresh),
         cmocka_unit_test(error_estimate_tends_to_the_true_local_error),
         cmocka_unit_test(advance_lands_on_every_output_time),
         cmocka_unit_test(interpolation_agrees_with_a_step_ending_there),
