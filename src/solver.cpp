@@ -295,14 +295,14 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
 {
     if (formulation == GA_INDEX2_STABILIZED && !S2_.ready())
         return diag.fail(GA_ERR_INTERNAL, "the stabilized index-2 system was not set up");
-    if (sliver_allowed && accepted_.h_last > 0.0 && h < accepted_.h_last / kShortStepRatio)
-        return sliver_step(h);
     if (pivots_forgotten_) {  // after a checkpoint: pivots as a restarted solver picks them
         S_.forget_pivots();
         S2_.forget_pivots();
         P_.forget_pivots();
         pivots_forgotten_ = false;
     }
+    if (sliver_allowed && accepted_.h_last > 0.0 && h < accepted_.h_last / kShortStepRatio)
+        return sliver_step(h);
     const State &s = accepted_;
     // The start of the step. a_n carries the shift delta_alpha h_last; rescaled to the h of
     // this step the scheme stays second order under any sequence of step sizes (ALGORITHMS.md
@@ -371,9 +371,8 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     return GA_OK;
 }
 
-// A step far shorter than the one before it (a sliver that lands on an output time, a step
-// after repeated failures) is not solved from the discrete equations: they determine its
-// accelerations badly. In index 3 the position constraint makes a_{n+1} absorb the
+// A step far shorter than the one before it (a sliver that lands on an output time) is not
+// solved from the discrete equations: they determine its accelerations badly. In index 3 the position constraint makes a_{n+1} absorb the
 // O(h_last^2) velocity-constraint residual left by the steps before, an impulse of size
 // O(h_last^2 / h), and at h = 1e-16 only to eps |q| / (beta h^2), which then moves v by O(1)
 // through h gamma a_{n+1}; in index 2 they are fixed only to eps |v| / (gamma h). Through a,

@@ -147,6 +147,40 @@ static void sparse_restart(int formulation, int adaptive)
     ga_free(s[1]);
 }
 
+/* The same when the first step after the checkpoint is a sliver (a Taylor step whose
+ * accelerations come from a KKT factorization): that factorization too picks its pivots
+ * afresh in both solvers. */
+static void sparse_restart_with_a_sliver_first(void **state)
+{
+    (void)state;
+    chain c = chain_make(30);
+    double q[3 * 30], v[3 * 30];
+    chain_initial(&c, q, v);
+    ga_solver *s[2];
+    for (int i = 0; i < 2; ++i) {
+        s[i] = chain_solver(&c, 1);
+        assert_int_equal(ga_set_linear_solver(s[i], GA_LINEAR_SPARSE), GA_OK);
+    }
+    assert_int_equal(ga_init(s[0], 0.0, q, v), GA_OK);
+    steps(s[0], 5);
+    size_t len = 0;
+    assert_int_equal(ga_state_size(s[0], &len), GA_OK);
+    double *ckpt = malloc(3 * len * sizeof(double)), *a = ckpt + len, *b = a + len;
+    assert_non_null(ckpt);
+    assert_int_equal(ga_get_state(s[0], ckpt, len), GA_OK);
+    assert_int_equal(ga_set_state(s[1], ckpt, len), GA_OK);
+    for (int i = 0; i < 2; ++i) {
+        assert_int_equal(ga_step(s[i], 1e-12), GA_OK);
+        steps(s[i], 20);
+    }
+    assert_int_equal(ga_get_state(s[0], a, len), GA_OK);
+    assert_int_equal(ga_get_state(s[1], b, len), GA_OK);
+    assert_memory_equal(a, b, len * sizeof(double));
+    free(ckpt);
+    ga_free(s[0]);
+    ga_free(s[1]);
+}
+
 static void sparse_restart_is_bit_identical(void **state)
 {
     (void)state;
@@ -184,6 +218,7 @@ int main(void)
         cmocka_unit_test(restart_in_new_solver_is_bit_identical),
         cmocka_unit_test(rewind_same_solver_is_bit_identical),
         cmocka_unit_test(sparse_restart_is_bit_identical),
+        cmocka_unit_test(sparse_restart_with_a_sliver_first),
         cmocka_unit_test(checkpoint_without_a_would_not_restart_exactly),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
