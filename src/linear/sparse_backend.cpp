@@ -57,6 +57,16 @@ public:
         diag_.resize(n);
         for (int i = 0; i < n; ++i)
             diag_[i] = S_.slot(i, i);
+        // The slots of the top-left block, where M, C_t, K_t (or I) add up; the constraint
+        // blocks are written, not added, unless Phi_q's pattern repeats an entry.
+        top_left_ = diag_;
+        for (const std::vector<int> *m : {&map_M_, &map_K_, &map_C_})
+            top_left_.insert(top_left_.end(), m->begin(), m->end());
+        std::sort(top_left_.begin(), top_left_.end());
+        top_left_.erase(std::unique(top_left_.begin(), top_left_.end()), top_left_.end());
+        std::vector<int> j_slots = map_J_;
+        std::sort(j_slots.begin(), j_slots.end());
+        j_written_ = std::adjacent_find(j_slots.begin(), j_slots.end()) == j_slots.end();
         lower_diag_.clear();
         if (with_inactive)
             for (int i = 0; i < m; ++i)
@@ -66,7 +76,14 @@ public:
     bool factorize(const SaddleBlocks &b) override
     {
         std::vector<double> &values = S_.values();
-        std::fill(values.begin(), values.end(), 0.0);
+        if (j_written_) {  // zero only what is added to (a quarter of S for a chain)
+            for (int s : top_left_)
+                values[s] = 0.0;
+            for (int s : lower_diag_)
+                values[s] = 0.0;
+        } else {
+            std::fill(values.begin(), values.end(), 0.0);
+        }
         auto scatter = [&](const ModelMatrix &A, const std::vector<int> &map, double c) {
             const double *v = A.data();
             for (std::size_t k = 0; k < map.size(); ++k)
@@ -81,9 +98,15 @@ public:
             scatter(*b.C, map_C_, b.cC);
         if (b.K)
             scatter(*b.K, map_K_, b.cK);
-        if (m_ > 0) {
+        if (m_ > 0 && j_written_) {
+            const double *v = b.J->data();
+            for (std::size_t k = 0; k < map_J_.size(); ++k)
+                values[map_J_[k]] = values[map_JT_[k]] = v[k];
+        } else if (m_ > 0) {
             scatter(*b.J, map_J_, 1.0);
             scatter(*b.J, map_JT_, 1.0);
+        }
+        if (m_ > 0) {
             if (b.active && !lower_diag_.empty()) {
                 for (std::size_t k = 0; k < map_J_.size(); ++k)
                     if (!b.active[J_rows_[k]])
@@ -105,7 +128,8 @@ public:
 private:
     int n_ = 0, m_ = 0;
     KluSystem S_;
-    std::vector<int> map_M_, map_K_, map_C_, map_J_, map_JT_, diag_, lower_diag_;
+    std::vector<int> map_M_, map_K_, map_C_, map_J_, map_JT_, diag_, lower_diag_, top_left_;
+    bool j_written_ = false;  // no slot of Phi_q twice in its pattern
     std::vector<int> J_rows_;  // row of each Phi_q entry
 };
 
