@@ -196,12 +196,13 @@ GA_API ga_status ga_init(ga_solver *s, double t0, const double *q0, const double
  *  GA_ERR_NONFINITE or GA_ERR_SINGULAR the caller may retry, typically with a smaller h.
  *  A step more than 100 times shorter than the one before (a sliver that lands on an output
  *  time) is not solved from Algorithm 1's equations, which cannot determine accelerations over
- *  it: it is a Taylor step, q + h v + h^2/2 qdd and v + h qdd, with qdd and lambda at its end
- *  from the acceleration-level equations (as in ga_init), and the next step starts like a
- *  first one (ga_get_h_last gives 0). (ga_step_adaptive does so only for a step that lands on
- *  its t_stop.) A step more than 100 times longer than the one before starts like a first one
- *  too (corrected starting values, ga_set_corrected_start), instead of rescaling a_n by that
- *  ratio, which would multiply its round-off.
+ *  it: it is a Taylor step, q + h v + h^2/2 qdd and v + h qdd, with v projected onto the
+ *  velocity constraint and qdd, lambda at its end from the acceleration-level equations (as in
+ *  ga_init); a keeps its offset from qdd and ga_get_h_last that of the step before, so that the
+ *  next steps go on as if the sliver had not been taken. (ga_step_adaptive does so only for a
+ *  step that lands on its t_stop.) A step more than 100 times longer than the one before
+ *  starts like a first one (corrected starting values, ga_set_corrected_start), instead of
+ *  rescaling a_n by that ratio, which would multiply its round-off.
  *  Errors: GA_ERR_ARG (h <= 0, NaN, Inf, or t + h == t), GA_ERR_STATE (before ga_init, or from a
  *  callback), GA_ERR_CALLBACK, GA_ERR_CALLBACK_RETRY, GA_ERR_NONFINITE, GA_ERR_SINGULAR,
  *  GA_ERR_NEWTON, GA_ERR_INTERNAL. */
@@ -545,8 +546,8 @@ GA_API ga_status ga_get_qdd(const ga_solver *s, double *qdd);
 GA_API ga_status ga_get_lambda(const ga_solver *s, double *lambda);
 /** Copy the auxiliary acceleration-like vector a of eq. (3) (n doubles). */
 GA_API ga_status ga_get_a(const ga_solver *s, double *a);
-/** Size of the last accepted step (0 before the first, and after a step more than 100 times
- *  shorter than the one before it: see ga_step). */
+/** Size of the last accepted step (0 before the first; a sliver, a step more than 100 times
+ *  shorter than the one before it, leaves it: see ga_step). */
 GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
 /**@}*/
 

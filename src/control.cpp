@@ -148,7 +148,8 @@ ga_status Solver::step_adaptive(double t_stop)
                 if (fac > 1.0 && (rejected || control.grew))
                     fac = 1.0;
                 control.grew = fac > 1.0;
-                control.err_prev = h_prev > 0.0 ? e : 0.0;
+                if (!shortened)  // nor a base for the next prediction
+                    control.err_prev = h_prev > 0.0 ? e : 0.0;
                 control.h_next = shortened && fac >= 1.0 ? h_planned : h * fac;
                 if (control.h_max > 0.0)
                     control.h_next = std::min(control.h_next, control.h_max);

@@ -246,6 +246,28 @@ ga_status Solver::project_positions(double t, Vec &q)
                      norm, init_tol, norm0);
 }
 
+// v <- v + dv, the minimum-norm correction with Phi_q v + Phi_t = 0, from J_ = Phi_q(q),
+// c_ = Phi_t and phi_ = Phi_q v + Phi_t (linear: one correction, plus one pass of refinement
+// for round-off). Leaves phi_ at the corrected v.
+ga_status Solver::correct_velocities(Vec &v, const char *what)
+{
+    count(counters, GA_COUNT_FACTORIZATIONS);
+    if (!S_.factorize_projection(J_))
+        return diag.fail(GA_ERR_SINGULAR,
+                         "cannot project %s: Phi_q is rank deficient (rcond of "
+                         "[I Phi_q^T; Phi_q 0] = %.3g)",
+                         what, S_.rcond());
+    jacobian_valid_ = false;  // S_ holds another matrix now
+    rq_.setZero();
+    for (int pass = 0; pass < 2; ++pass) {
+        S_.solve(rq_, phi_, dq_, dlambda_);
+        v += dq_;
+        phi_ = c_;
+        J_.multiply_add(1.0, v, phi_);
+    }
+    return GA_OK;
+}
+
 ga_status Solver::project_velocities(double t, const Vec &q, Vec &v)
 {
     // Velocity constraint w = Phi_q v + Phi_t.
@@ -264,20 +286,8 @@ ga_status Solver::project_velocities(double t, const Vec &q, Vec &v)
                          "(constraint %ld) > init_tol = %.3g, and projection is off "
                          "(GA_INIT_REFUSE)",
                          norm0, static_cast<long>(argmax_abs(phi_)), init_tol);
-    // Linear: one minimum-norm correction, plus one pass of refinement for round-off.
-    count(counters, GA_COUNT_FACTORIZATIONS);
-    if (!S_.factorize_projection(J_))
-        return diag.fail(GA_ERR_SINGULAR,
-                         "cannot project v0: Phi_q is rank deficient (rcond of "
-                         "[I Phi_q^T; Phi_q 0] = %.3g)",
-                         S_.rcond());
-    rq_.setZero();
-    for (int pass = 0; pass < 2; ++pass) {
-        S_.solve(rq_, phi_, dq_, dlambda_);
-        v += dq_;
-        phi_ = c_;
-        J_.multiply_add(1.0, v, phi_);
-    }
+    if (auto st = correct_velocities(v, "v0"))
+        return st;
     const double norm = phi_.lpNorm<Eigen::Infinity>();
     if (!(norm <= init_tol))
         return diag.fail(GA_ERR_INCONSISTENT,

@@ -286,7 +286,7 @@ void Solver::commit(bool land_on, double t_land)
     if (land_on)
         accepted_.t = t_land;  // exactly, not t_n + h rounded
     previous_valid_ = true;
-    start_pending_ = accepted_.h_last == 0.0;  // a step that ended like a restart
+    start_pending_ = false;
     count(counters, GA_COUNT_STEPS);
 }
 
@@ -372,16 +372,15 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
 }
 
 // A step far shorter than the one before it (a sliver that lands on an output time) is not
-// solved from the discrete equations: they determine its accelerations badly. In index 3 the position constraint makes a_{n+1} absorb the
-// O(h_last^2) velocity-constraint residual left by the steps before, an impulse of size
-// O(h_last^2 / h), and at h = 1e-16 only to eps |q| / (beta h^2), which then moves v by O(1)
-// through h gamma a_{n+1}; in index 2 they are fixed only to eps |v| / (gamma h). Through a,
-// the next steps carried that on (a sliver of 1e-8 after steps of 1e-3 put the index-3
-// pendulum 1.5 off its path). Instead: a Taylor step q + h v + h^2/2 qdd, v + h qdd (local
-// errors O(h^3) and O(h^2) in the third derivative, with h at most 1e-2 of the step before),
-// accelerations and multipliers from the acceleration-level equations at its end, a = qdd,
-// and h_last = 0, so that the next step starts like a first one (corrected start, no
-// rescaling of a).
+// solved from the discrete equations: they determine its accelerations badly. In index 3 the
+// position constraint makes a_{n+1} absorb the O(h_last^2) velocity-constraint residual left
+// by the steps before, an impulse of size O(h_last^2 / h), and the round-off of Phi over
+// beta h^2; in index 2 they are fixed only to eps |v| / (gamma h). Through a, the next steps
+// carried that on (a sliver of 1e-8 after steps of 1e-3 put the index-3 pendulum 1.5 off its
+// path). Instead: a Taylor step q + h v + h^2/2 qdd, v + h qdd (local errors O(h^3) and
+// O(h^2) in the third derivative, with h at most 1e-2 of the step before), v projected onto
+// the velocity constraint, and qdd, lambda from the acceleration-level equations at its end,
+// as at ga_init; the recursion for a then goes on as if the sliver had not been taken.
 ga_status Solver::sliver_step(double h)
 {
     const State &s = accepted_;
@@ -392,14 +391,30 @@ ga_status Solver::sliver_step(double h)
     if (!x.q.allFinite() || !x.v.allFinite())
         return diag.fail(GA_ERR_NONFINITE,
                          "the short step from t = %.17g with h = %g is not finite", s.t, h);
-    if (auto st = consistent_accelerations(x.t, x.q, x.v, x.qdd, x.lambda)) {
+    // The velocities onto the velocity constraint, as at ga_init: in index 3 they carry an
+    // O(h_last^2) normal part, which a further short step would again take as an impulse.
+    ga_status st = m_ > 0 ? model.jacobian(x.t, x.q, J_) : GA_OK;
+    if (!st && m_ > 0)
+        st = model.constraint_dt(x.t, x.q, c_);
+    if (!st && m_ > 0) {
+        phi_ = c_;
+        J_.multiply_add(1.0, x.v, phi_);
+        st = correct_velocities(x.v, "the velocities");
+    }
+    if (!st)
+        st = consistent_accelerations(x.t, x.q, x.v, x.qdd, x.lambda);
+    if (st) {
         diag.append(" (short step from t = %.17g, h = %g: %g times shorter than the one before)",
                     s.t, h, s.h_last / h);
         return st;
     }
-    x.a = x.qdd;
-    x.a_prev = x.a;
-    x.h_last = 0.0;
+    // The recursion for a goes on as if the sliver had not been taken: a and a_prev keep
+    // their offsets from qdd (the shift delta_alpha h_last qddd that the next step rescales),
+    // and h_last stays the size of the step before, so that a further sliver is one too.
+    qdd_tmp_ = x.qdd - s.qdd;
+    x.a = s.a + qdd_tmp_;
+    x.a_prev = s.a_prev + qdd_tmp_;
+    x.h_last = s.h_last;
     a_n_ = x.a;  // for the error estimate of adaptive steps: none from this step
     last_newton_iters_ = 0;
     return GA_OK;

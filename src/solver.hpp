@@ -138,6 +138,7 @@ private:
     // init.cpp
     ga_status project_positions(double t, Vec &q);
     ga_status project_velocities(double t, const Vec &q, Vec &v);
+    ga_status correct_velocities(Vec &v, const char *what);
     ga_status consistent_accelerations(double t, const Vec &q, const Vec &v, Vec &qdd,
                                        Vec &lambda);
     ga_status starting_values(double h);

@@ -55,7 +55,7 @@ static void reference_step(const step_data *n, double h, const double prm[4], lo
 
 /* The pendulum after 20 steps of 1e-3 and then steps ten times shorter each, down to 10 h:
  * the step of h to be checked is at most ten times shorter than the one before (a step over a
- * hundred times shorter ends like a restart, with accelerations and multipliers from the
+ * hundred times shorter is a Taylor step, with accelerations and multipliers from the
  * acceleration-level equations instead of its own discrete ones; test_adaptive.c). */
 static ga_solver *start(int pred, step_data *n, double h)
 {
