@@ -132,6 +132,7 @@ static const double H = 2e-3, RTOL = 1e-4, ATOL = 1e-6, T_STOP = 10.0;
  * across steps (the swept step starts with the matrix of the step before). */
 typedef struct config {
     int linear_solver, formulation, exact_tangent, fresh_matrix, adaptive;
+    int sliver; /* the swept step is a sliver of 1e-12 (a Taylor step, see ga_step) */
 } config;
 
 /* Callbacks, options and patterns of configuration cf on a new solver (NULL on failure). */
@@ -291,7 +292,7 @@ static int sweep(const config *cf, fault_kind kind, unsigned *failed)
         f.kind = kind;
         f.k = k;
         f.calls = 0;
-        const ga_status st = take_step(s, cf);
+        const ga_status st = cf->sliver ? ga_step(s, 1e-12) : take_step(s, cf);
         if (f.calls < k) { /* the step made fewer calls: the sweep is complete */
             assert_int_equal(st, GA_OK);
             ga_free(s);
@@ -412,7 +413,7 @@ static void sweep_init(const config *cf)
     static void name(void **state)                                                             \
     {                                                                                          \
         (void)state;                                                                           \
-        const config cf = {solver, formulation, 1, 0, 0};                                      \
+        const config cf = {solver, formulation, 1, 0, 0, 0};                                   \
         sweep_init(&cf);                                                                       \
     }
 INIT_SWEEP_TEST(init_sparse_index3, GA_LINEAR_SPARSE, GA_INDEX3)
@@ -424,7 +425,7 @@ INIT_SWEEP_TEST(init_dense_index2, GA_LINEAR_DENSE, GA_INDEX2_STABILIZED)
     static void name(void **state)                                                             \
     {                                                                                          \
         (void)state;                                                                           \
-        const config cf = {solver, formulation, exact, fresh, adaptive};                       \
+        const config cf = {solver, formulation, exact, fresh, adaptive, 0};                    \
         sweep_all_kinds(&cf, must_fail);                                                       \
     }
 
@@ -461,9 +462,24 @@ SWEEP_TEST(dense_index2_exact_fresh_adaptive, GA_LINEAR_DENSE, GA_INDEX2_STABILI
 SWEEP_TEST(dense_index3_fd_fresh_adaptive, GA_LINEAR_DENSE, GA_INDEX3, 0, 1, 1,
            CB_MASS|CB_FORCE|CB_CONSTRAINT|CB_JACOBIAN)
 
+/* A sliver: its Taylor step projects the velocities (Jacobian, Phi_t) and computes
+ * consistent accelerations (mass, forces, Jacobian, constraint acceleration term). */
+#define SLIVER_SWEEP_TEST(name, solver, formulation)                                            \
+    static void name(void **state)                                                             \
+    {                                                                                          \
+        (void)state;                                                                           \
+        const config cf = {solver, formulation, 1, 0, 0, 1};                                   \
+        sweep_all_kinds(&cf, CB_MASS | CB_FORCE | CB_JACOBIAN | CB_CONSTRAINT_ACCEL |          \
+                                 CB_CONSTRAINT_DT);                                            \
+    }
+SLIVER_SWEEP_TEST(sparse_index3_sliver, GA_LINEAR_SPARSE, GA_INDEX3)
+SLIVER_SWEEP_TEST(dense_index2_sliver, GA_LINEAR_DENSE, GA_INDEX2_STABILIZED)
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(sparse_index3_sliver),
+        cmocka_unit_test(dense_index2_sliver),
         cmocka_unit_test(init_sparse_index3),
         cmocka_unit_test(init_sparse_index2),
         cmocka_unit_test(init_dense_index3),
