@@ -99,8 +99,6 @@ KluSystem::KluSystem()
 
 KluSystem::~KluSystem()
 {
-    if (numeric_)
-        klu_free_numeric(&numeric_, &common_);
     if (symbolic_)
         klu_free_symbolic(&symbolic_, &common_);
 }
@@ -162,22 +160,20 @@ int KluSystem::slot(int row, int col) const
 
 void KluSystem::forget_pivots()
 {
-    if (numeric_)
-        klu_free_numeric(&numeric_, &common_);
+    lu_.clear();
 }
 
 bool KluSystem::factorize()
 {
-    if (numeric_) {
+    if (lu_.ready()) {
         scale_rows();
         const FlushSubnormals flush;
-        const int ok = klu_refactor(colptr_.data(), rowind_.data(), values_.data(), symbolic_,
-                                    numeric_, &common_);
-        if (ok && klu_rcond(symbolic_, numeric_, &common_) && common_.rcond > kRefactorRcond) {
-            rcond_ = common_.rcond;
+        const double ratio = lu_.refactor(values_.data());
+        if (ratio > kRefactorRcond) {
+            rcond_ = ratio;
             return true;
         }
-        klu_free_numeric(&numeric_, &common_);  // pivots no longer fit: start afresh
+        lu_.clear();  // pivots no longer fit: start afresh
         unscale_rows();
     }
     // A full factorization picks new pivots: new scale factors first.
@@ -188,30 +184,44 @@ bool KluSystem::factorize()
         r = r > 0.0 ? 1.0 / r : 1.0;
     scale_rows();
     ++full_factorizations_;
+    klu_numeric *numeric;
     {
         const FlushSubnormals flush;
-        numeric_ = klu_factor(colptr_.data(), rowind_.data(), values_.data(), symbolic_, &common_);
+        numeric = klu_factor(colptr_.data(), rowind_.data(), values_.data(), symbolic_, &common_);
     }
-    if (!numeric_) {
+    if (!numeric) {
         if (common_.status == KLU_OUT_OF_MEMORY)
             throw std::bad_alloc();
         rcond_ = 0.0;
         return false;  // singular
     }
-    klu_rcond(symbolic_, numeric_, &common_);
-    rcond_ = common_.rcond;
+    // KLU chose the pivots and the patterns of L and U; the factors move to lu_, which
+    // refactorizes and solves from now on. (Freed before anything can throw again.)
+    struct Release {
+        klu_numeric *&n;
+        klu_common &c;
+        ~Release() { klu_free_numeric(&n, &c); }
+    } release{numeric, common_};
+    lu_.build(N_, colptr_.data(), rowind_.data(), symbolic_, numeric, &common_);
+    rcond_ = lu_.pivot_ratio();
     return rcond_ >= std::numeric_limits<double>::epsilon();
 }
 
 double KluSystem::rcond_estimate() const
 {
-    if (!numeric_ || rcond_ <= 0.0)
+    if (!lu_.ready() || rcond_ <= 0.0)
         return 0.0;
-    // values_ still holds the scaled matrix of the last factorization
-    // (klu_condest does not write to the matrix; its prototype is not const-correct)
-    if (!klu_condest(const_cast<int *>(colptr_.data()), const_cast<double *>(values_.data()),
-                     symbolic_, numeric_, &common_) ||
-        !(common_.condest > 0.0))
+    // values_ still holds the scaled matrix of the last factorization. klu_condest needs
+    // KLU's own factors of it: made here, on demand (never in a step), with pivots of KLU's
+    // choice. (KLU's prototypes are not const-correct; nothing is written to the matrix.)
+    int *colptr = const_cast<int *>(colptr_.data()), *rowind = const_cast<int *>(rowind_.data());
+    double *values = const_cast<double *>(values_.data());
+    klu_numeric *numeric = klu_factor(colptr, rowind, values, symbolic_, &common_);
+    if (!numeric)
+        return 0.0;
+    const int ok = klu_condest(colptr, values, symbolic_, numeric, &common_);
+    klu_free_numeric(&numeric, &common_);
+    if (!ok || !(common_.condest > 0.0))
         return 0.0;
     return 1.0 / common_.condest;
 }
@@ -233,7 +243,7 @@ void KluSystem::solve(double *rhs)
     for (int i = 0; i < N_; ++i)  // (D S) x = D b
         rhs[i] *= row_scale_[i];
     const FlushSubnormals flush;
-    klu_solve(symbolic_, numeric_, N_, 1, rhs, &common_);
+    lu_.solve(rhs);
 }
 
 // The pattern of S + S^T without the diagonal, as sorted neighbour lists.

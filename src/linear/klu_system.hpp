@@ -1,13 +1,16 @@
 // A square sparse matrix whose pattern is fixed once, factorized with SuiteSparse KLU:
 // symbolic analysis at setup (KLU's AMD ordering, or reverse Cuthill-McKee when it fills
-// little more), a numeric factorization the first time, then klu_refactor -- same pivot order,
-// no allocation. If a refactorization comes out poorly conditioned (pivots chosen for other
+// little more), a numeric factorization with partial pivoting the first time (klu_factor), then
+// refactorizations and solves with the same pivot order and patterns by FixedPivotLU -- no
+// allocation. If a refactorization comes out poorly conditioned (pivots chosen for other
 // values), the matrix is factorized afresh with new pivots (this rare path allocates).
 // Shared by the sparse saddle-point backend and the sparse stabilized index-2 system.
 #pragma once
 
 #ifdef GALPHA_HAVE_KLU
 #include <klu.h>
+
+#include "fixed_pivot_lu.hpp"
 
 #include <utility>
 #include <vector>
@@ -71,8 +74,8 @@ private:
                                      // factorization
     mutable klu_common common_;  // klu_condest writes its result here
     klu_symbolic *symbolic_ = nullptr;
-    klu_numeric *numeric_ = nullptr;
-    double rcond_ = 0.0;  // min |U_ii| / max |U_ii| (klu_rcond): decides singularity
+    FixedPivotLU lu_;     // the factors, with the pivots of KLU's last full factorization
+    double rcond_ = 0.0;  // min |U_ii| / max |U_ii| (as klu_rcond): decides singularity
     const char *ordering_ = "AMD";
     CholeskyFill amd_fill_, rcm_fill_;
     int full_factorizations_ = 0;
