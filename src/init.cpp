@@ -39,7 +39,7 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
     x.h_last = 0.0;
     x.q = Eigen::Map<const Vec>(q0, n_);
     x.v = Eigen::Map<const Vec>(v0, n_);
-    if (!x.q.allFinite() || !x.v.allFinite())
+    if (!all_finite(x.q) || !all_finite(x.v))
         return diag.fail(GA_ERR_ARG, "q0 or v0 contains NaN or Inf");
 
     if (redundancy == GA_REDUNDANT_DROP && m_ > 0)
@@ -104,7 +104,7 @@ ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v,
     S_.solve(rq_, c_, qdd, lambda);
     if (m_ > 0)
         lambda /= sigma;
-    if (!qdd.allFinite() || !lambda.allFinite())
+    if (!all_finite(qdd) || !all_finite(lambda))
         return diag.fail(GA_ERR_NONFINITE, "consistent accelerations or multipliers are not "
                          "finite at t = %.17g", t);
     return GA_OK;

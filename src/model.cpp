@@ -129,25 +129,6 @@ ga_status Model::callback_status(int rc, const char *name, double t)
                       t);
 }
 
-namespace {
-// true if no entry is Inf or NaN: x * 0 is 0 for every finite x and NaN otherwise, summed in
-// four independent chains (the compiler pairs them into vector instructions); the test runs on
-// every callback output of every Newton iteration.
-bool all_finite(const double *x, Eigen::Index size)
-{
-    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
-    Eigen::Index k = 0;
-    for (; k + 4 <= size; k += 4) {
-        a0 += x[k] * 0.0;
-        a1 += x[k + 1] * 0.0;
-        a2 += x[k + 2] * 0.0;
-        a3 += x[k + 3] * 0.0;
-    }
-    for (; k < size; ++k)
-        a0 += x[k] * 0.0;
-    return (a0 + a1) + (a2 + a3) == 0.0;
-}
-}  // namespace
 
 ga_status Model::check_finite(const double *x, Eigen::Index size, Eigen::Index rows,
                               const char *what, double t)

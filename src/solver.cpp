@@ -62,8 +62,8 @@ void apply_update(const Vec &dq, const Vec &dw, const Vec &dlambda, double gamma
         const Eigen::Index len = std::min(kBlock, dq.size() - i);
         const auto d = dq.segment(i, len), w = dw.segment(i, len);
         auto q = x.q.segment(i, len), v = x.v.segment(i, len), qdd = x.qdd.segment(i, len);
-        size.increments_finite =
-            size.increments_finite && d.allFinite() && (!separate_dw || w.allFinite());
+        size.increments_finite = size.increments_finite && all_finite(d.data(), len) &&
+                                 (!separate_dw || all_finite(w.data(), len));
         q += d;
         v += gamma_prime * w;
         qdd += beta_prime * w;
@@ -80,7 +80,7 @@ void apply_update(const Vec &dq, const Vec &dw, const Vec &dlambda, double gamma
         const Eigen::Index len = std::min(kBlock, dlambda.size() - i);
         const auto d = dlambda.segment(i, len);
         auto lambda = x.lambda.segment(i, len);
-        size.increments_finite = size.increments_finite && d.allFinite();
+        size.increments_finite = size.increments_finite && all_finite(d.data(), len);
         lambda += d;
         size.dlambda = std::max(size.dlambda, d.cwiseAbs().maxCoeff());
         size.lambda = std::max(size.lambda, lambda.cwiseAbs().maxCoeff());
@@ -388,7 +388,7 @@ ga_status Solver::sliver_step(double h)
     x.t = s.t + h;
     x.q = s.q + h * s.v + (0.5 * h * h) * s.qdd;
     x.v = s.v + h * s.qdd;
-    if (!x.q.allFinite() || !x.v.allFinite())
+    if (!all_finite(x.q) || !all_finite(x.v))
         return diag.fail(GA_ERR_NONFINITE,
                          "the short step from t = %.17g with h = %g is not finite", s.t, h);
     // The velocities onto the velocity constraint, as at ga_init: in index 3 they carry an
@@ -498,7 +498,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
     x.v = v_n + h * ((1.0 - p.gamma) * a_n + p.gamma * x.a);               // eq. (5)
     // The iteration starts from a finite iterate (the updates keep it so or report it): a
     // predictor can overflow where the accepted state is huge or h is.
-    if (!x.q.allFinite() || !x.v.allFinite() || !x.qdd.allFinite() || !x.lambda.allFinite())
+    if (!all_finite(x.q) || !all_finite(x.v) || !all_finite(x.qdd) || !all_finite(x.lambda))
         return diag.fail(GA_ERR_NONFINITE,
                          "predicted Newton iterate is not finite in the step from t = %.17g "
                          "with h = %g",
