@@ -23,8 +23,8 @@ double ratio_of(const double *d, int N)
 }
 }  // namespace
 
-void FixedPivotLU::build(int N, const int *colptr, const int *rowind, klu_symbolic *symbolic,
-                         klu_numeric *numeric, klu_common *common)
+void FixedPivotLU::build(int N, const int *colptr, const int *rowind, const double *row_scale,
+                         klu_symbolic *symbolic, klu_numeric *numeric, klu_common *common)
 {
     ready_ = false;
     N_ = N;
@@ -86,8 +86,11 @@ void FixedPivotLU::build(int N, const int *colptr, const int *rowind, klu_symbol
     Ux_.resize(out);
 
     std::vector<int> pinv(N);
-    for (int i = 0; i < N; ++i)
+    scale_.resize(N);
+    for (int i = 0; i < N; ++i) {
         pinv[P_[i]] = i;
+        scale_[i] = row_scale[P_[i]];
+    }
     a_row_.resize(colptr[N]);
     for (int p = 0; p < colptr[N]; ++p)
         a_row_[p] = pinv[rowind[p]];
@@ -96,19 +99,22 @@ void FixedPivotLU::build(int N, const int *colptr, const int *rowind, klu_symbol
     ready_ = true;
 }
 
-// Column j of P A Q = L U, left-looking: scatter column Q_[j] of A into the dense work
+// Column j of P D A Q = L U, left-looking: scatter column Q_[j] of D A into the dense work
 // column, apply the columns k of L with u_kj != 0 in ascending k (each x_k is final once every
 // column before it is applied), then split the column into U(:, j), u_jj and L(:, j). Every
 // work entry touched lies in the pattern of L(:, j) and U(:, j) and is zeroed on the way out.
 double FixedPivotLU::refactor(const double *values)
 {
     double *x = work_.data();
+    const double *D = scale_.data();
     const int *Lp = Lp_.data(), *Li = Li_.data(), *Up = Up_.data(), *Ui = Ui_.data();
     double *Lx = Lx_.data(), *Ux = Ux_.data(), *Ud = Ud_.data();
     for (int j = 0; j < N_; ++j) {
         const int col = Q_[j];
-        for (int p = colptr_[col]; p < colptr_[col + 1]; ++p)
-            x[a_row_[p]] = values[p];
+        for (int p = colptr_[col]; p < colptr_[col + 1]; ++p) {
+            const int i = a_row_[p];
+            x[i] = D[i] * values[p];
+        }
         for (int p = Up[j]; p < Up[j + 1]; ++p) {
             const int k = Ui[p];
             const double u = x[k];
@@ -129,14 +135,14 @@ double FixedPivotLU::refactor(const double *values)
     return pivot_ratio_;
 }
 
-// A x = b as P A Q = L U: w = P b, L y = w, U z = y, x = Q z (column-oriented sweeps).
+// A x = b as P D A Q = L U: w = P D b, L y = w, U z = y, x = Q z (column-oriented sweeps).
 void FixedPivotLU::solve(double *rhs)
 {
     double *w = work_.data();
     const int *Lp = Lp_.data(), *Li = Li_.data(), *Up = Up_.data(), *Ui = Ui_.data();
     const double *Lx = Lx_.data(), *Ux = Ux_.data();
     for (int i = 0; i < N_; ++i)
-        w[i] = rhs[P_[i]];
+        w[i] = scale_[i] * rhs[P_[i]];
     for (int k = 0; k < N_; ++k) {
         const double y = w[k];
         for (int q = Lp[k]; q < Lp[k + 1]; ++q)

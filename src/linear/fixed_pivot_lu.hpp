@@ -18,16 +18,16 @@ namespace ga {
 
 class FixedPivotLU {
 public:
-    // The orders and patterns of KLU's factorization `numeric` of the N x N matrix in CSC form
-    // (colptr, rowind; no block triangular form, no scaling by KLU), and its values.
-    // Throws std::bad_alloc.
-    void build(int N, const int *colptr, const int *rowind, klu_symbolic *symbolic,
-               klu_numeric *numeric, klu_common *common);
+    // The orders and patterns of KLU's factorization `numeric` of D A, A the N x N matrix in
+    // CSC form (colptr, rowind) and D = diag(row_scale) (no block triangular form, no
+    // scaling by KLU), and its values. Throws std::bad_alloc.
+    void build(int N, const int *colptr, const int *rowind, const double *row_scale,
+               klu_symbolic *symbolic, klu_numeric *numeric, klu_common *common);
     bool ready() const { return ready_; }
     void clear() { ready_ = false; }  // the next matrix needs pivots chosen afresh
 
-    // LU factors of a new matrix on the pattern given to build() (values in its CSC order),
-    // with the same pivots. Returns min |u_ii| / max |u_ii| (0 if a pivot is zero or not
+    // LU factors of D A for a new matrix A on the pattern given to build() (values in its CSC
+    // order), with the same pivots and row scaling D. Returns min |u_ii| / max |u_ii| (0 if a pivot is zero or not
     // finite): a small value says the old pivots no longer fit these values.
     double refactor(const double *values);
     // The pivot ratio of the factors at hand, as refactor() returns it.
@@ -42,6 +42,7 @@ private:
     const int *colptr_ = nullptr;  // the caller's pattern (KluSystem keeps it alive and fixed)
     std::vector<int> P_, Q_;       // row i of P A Q is row P_[i] of A; column j is column Q_[j]
     std::vector<int> a_row_;       // for each entry of A (CSC order): its row in P A Q
+    std::vector<double> scale_;    // D, row i of P A Q scaled by scale_[i]
     // strictly lower part of L (unit diagonal), by columns; strictly upper part of U by
     // columns, rows ascending (the order the left-looking update needs); the diagonal of U
     std::vector<int> Lp_, Li_, Up_, Ui_;

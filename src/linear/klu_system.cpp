@@ -166,15 +166,13 @@ void KluSystem::forget_pivots()
 bool KluSystem::factorize()
 {
     if (lu_.ready()) {
-        scale_rows();
         const FlushSubnormals flush;
-        const double ratio = lu_.refactor(values_.data());
+        const double ratio = lu_.refactor(values_.data());  // rows scaled as it reads them
         if (ratio > kRefactorRcond) {
             rcond_ = ratio;
             return true;
         }
         lu_.clear();  // pivots no longer fit: start afresh
-        unscale_rows();
     }
     // A full factorization picks new pivots: new scale factors first.
     std::fill(row_scale_.begin(), row_scale_.end(), 0.0);
@@ -182,12 +180,13 @@ bool KluSystem::factorize()
         row_scale_[rowind_[k]] = std::max(row_scale_[rowind_[k]], std::abs(values_[k]));
     for (double &r : row_scale_)
         r = r > 0.0 ? 1.0 / r : 1.0;
-    scale_rows();
     ++full_factorizations_;
     klu_numeric *numeric;
     {
         const FlushSubnormals flush;
+        scale_rows();
         numeric = klu_factor(colptr_.data(), rowind_.data(), values_.data(), symbolic_, &common_);
+        unscale_rows();
     }
     if (!numeric) {
         if (common_.status == KLU_OUT_OF_MEMORY)
@@ -202,7 +201,8 @@ bool KluSystem::factorize()
         klu_common &c;
         ~Release() { klu_free_numeric(&n, &c); }
     } release{numeric, common_};
-    lu_.build(N_, colptr_.data(), rowind_.data(), symbolic_, numeric, &common_);
+    lu_.build(N_, colptr_.data(), rowind_.data(), row_scale_.data(), symbolic_, numeric,
+              &common_);
     rcond_ = lu_.pivot_ratio();
     return rcond_ >= std::numeric_limits<double>::epsilon();
 }
@@ -211,15 +211,17 @@ double KluSystem::rcond_estimate() const
 {
     if (!lu_.ready() || rcond_ <= 0.0)
         return 0.0;
-    // values_ still holds the scaled matrix of the last factorization. klu_condest needs
-    // KLU's own factors of it: made here, on demand (never in a step), with pivots of KLU's
-    // choice. (KLU's prototypes are not const-correct; nothing is written to the matrix.)
+    // The matrix factorized last, its rows scaled as they were for that: klu_condest needs
+    // KLU's own factors of it, made here on demand (never in a step; this allocates), with
+    // pivots of KLU's choice. (KLU's prototypes are not const-correct.)
+    std::vector<double> scaled(values_);
+    for (std::size_t k = 0; k < scaled.size(); ++k)
+        scaled[k] *= row_scale_[rowind_[k]];
     int *colptr = const_cast<int *>(colptr_.data()), *rowind = const_cast<int *>(rowind_.data());
-    double *values = const_cast<double *>(values_.data());
-    klu_numeric *numeric = klu_factor(colptr, rowind, values, symbolic_, &common_);
+    klu_numeric *numeric = klu_factor(colptr, rowind, scaled.data(), symbolic_, &common_);
     if (!numeric)
         return 0.0;
-    const int ok = klu_condest(colptr, values, symbolic_, numeric, &common_);
+    const int ok = klu_condest(colptr, scaled.data(), symbolic_, numeric, &common_);
     klu_free_numeric(&numeric, &common_);
     if (!ok || !(common_.condest > 0.0))
         return 0.0;
@@ -240,10 +242,8 @@ void KluSystem::unscale_rows()
 
 void KluSystem::solve(double *rhs)
 {
-    for (int i = 0; i < N_; ++i)  // (D S) x = D b
-        rhs[i] *= row_scale_[i];
     const FlushSubnormals flush;
-    lu_.solve(rhs);
+    lu_.solve(rhs);  // (D S) x = D b: lu_ scales b
 }
 
 // The pattern of S + S^T without the diagonal, as sorted neighbour lists.

@@ -51,7 +51,8 @@ public:
     void forget_pivots();
     void solve(double *rhs);  // in place, length N
     // Reciprocal 1-norm condition estimate of the matrix factorized last, rows scaled as
-    // factorized (klu_condest: a few solves; on demand, not in steps). 0 if singular.
+    // factorized (KLU factorizes it once more for klu_condest: on demand, never in a step;
+    // allocates). 0 if singular.
     double rcond_estimate() const;
     const char *ordering() const { return ordering_; }
     // The Cholesky factor of S + S^T in AMD's ordering and in RCM's (the count of the latter
@@ -64,7 +65,7 @@ public:
 private:
     std::vector<std::vector<int>> symmetric_adjacency() const;
     std::vector<int> reverse_cuthill_mckee(const std::vector<std::vector<int>> &adj) const;
-    void scale_rows();    // values_ <- D values_
+    void scale_rows();    // values_ <- D values_ (for KLU's full factorization)
     void unscale_rows();  // and back
 
     int N_ = 0;
