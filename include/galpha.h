@@ -618,9 +618,11 @@ typedef enum ga_info {
                                    iteration matrix factorized last, as solved: scaled by
                                    eq. (10) or not; 1/value is its condition number. Dense:
                                    LAPACK's dgecon on the LU factors; sparse: KLU's
-                                   klu_condest, of the matrix with its rows equilibrated as
-                                   KLU factorizes it. Computed when asked for (a few solves),
-                                   never in steps; 0 if the matrix was singular. */
+                                   klu_condest on a factorization made for it, of the matrix
+                                   with its rows equilibrated as factorized. Computed when
+                                   asked for (a few solves; on the sparse path also a
+                                   factorization, which allocates), never in steps; 0 if the
+                                   matrix was singular (or, sparse, memory ran out). */
     GA_INFO_NEWTON_ITERS = 1, /**< Newton iterations of the last ga_step (accepted or not) */
     GA_INFO_NEWTON_RATIO = 2, /**< last increment / tolerance ratio of that step's stopping
                                    test (<= 1 means converged by the relative test) */

@@ -207,14 +207,20 @@ bool KluSystem::factorize()
     return rcond_ >= std::numeric_limits<double>::epsilon();
 }
 
-double KluSystem::rcond_estimate() const
+double KluSystem::rcond_estimate() const noexcept
 {
     if (!lu_.ready() || rcond_ <= 0.0)
         return 0.0;
     // The matrix factorized last, its rows scaled as they were for that: klu_condest needs
-    // KLU's own factors of it, made here on demand (never in a step; this allocates), with
-    // pivots of KLU's choice. (KLU's prototypes are not const-correct.)
-    std::vector<double> scaled(values_);
+    // KLU's own factors of it, made here on demand (never in a step), with pivots of KLU's
+    // choice. This allocates; out of memory there is no estimate (0), as for a singular
+    // matrix. (KLU's prototypes are not const-correct.)
+    std::vector<double> scaled;
+    try {
+        scaled = values_;
+    } catch (const std::bad_alloc &) {
+        return 0.0;
+    }
     for (std::size_t k = 0; k < scaled.size(); ++k)
         scaled[k] *= row_scale_[rowind_[k]];
     int *colptr = const_cast<int *>(colptr_.data()), *rowind = const_cast<int *>(rowind_.data());

@@ -52,8 +52,8 @@ public:
     void solve(double *rhs);  // in place, length N
     // Reciprocal 1-norm condition estimate of the matrix factorized last, rows scaled as
     // factorized (KLU factorizes it once more for klu_condest: on demand, never in a step;
-    // allocates). 0 if singular.
-    double rcond_estimate() const;
+    // allocates). 0 if singular, or if memory ran out.
+    double rcond_estimate() const noexcept;
     const char *ordering() const { return ordering_; }
     // The Cholesky factor of S + S^T in AMD's ordering and in RCM's (the count of the latter
     // stops above 1.5 times the former's entries): what the choice was made on.
