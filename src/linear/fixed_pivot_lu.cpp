@@ -24,7 +24,7 @@ double ratio_of(const double *d, int N)
 }  // namespace
 
 void FixedPivotLU::build(int N, const int *colptr, const int *rowind, const double *row_scale,
-                         klu_symbolic *symbolic, klu_numeric *numeric, klu_common *common)
+                         klu_symbolic *symbolic, klu_numeric *&numeric, klu_common *common)
 {
     ready_ = false;
     N_ = N;
@@ -43,6 +43,7 @@ void FixedPivotLU::build(int N, const int *colptr, const int *rowind, const doub
                      Ui_.data(), Ux_.data(), nullptr, nullptr, nullptr, P_.data(), Q_.data(),
                      nullptr, nullptr, common))
         throw std::logic_error("klu_extract failed");
+    klu_free_numeric(&numeric, common);  // before anything else is allocated: a lower peak
 
     // L without its unit diagonal, compacted in place
     int out = 0;

@@ -20,9 +20,10 @@ class FixedPivotLU {
 public:
     // The orders and patterns of KLU's factorization `numeric` of D A, A the N x N matrix in
     // CSC form (colptr, rowind) and D = diag(row_scale) (no block triangular form, no
-    // scaling by KLU), and its values. Throws std::bad_alloc.
+    // scaling by KLU), and its values. Frees `numeric` (sets it to null) as soon as its
+    // factors are copied. Throws std::bad_alloc (the caller then frees `numeric`).
     void build(int N, const int *colptr, const int *rowind, const double *row_scale,
-               klu_symbolic *symbolic, klu_numeric *numeric, klu_common *common);
+               klu_symbolic *symbolic, klu_numeric *&numeric, klu_common *common);
     bool ready() const { return ready_; }
     void clear() { ready_ = false; }  // the next matrix needs pivots chosen afresh
 

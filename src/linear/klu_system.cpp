@@ -195,7 +195,7 @@ bool KluSystem::factorize()
         return false;  // singular
     }
     // KLU chose the pivots and the patterns of L and U; the factors move to lu_, which
-    // refactorizes and solves from now on. (Freed before anything can throw again.)
+    // refactorizes and solves from now on and frees KLU's; if it throws, this guard does.
     struct Release {
         klu_numeric *&n;
         klu_common &c;
