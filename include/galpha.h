@@ -32,8 +32,8 @@
  *
  * Memory is allocated by ga_create and ga_init (and by options that need more workspace once
  * it exists: ga_set_formulation to index 2, tangent options that call for finite differences,
- * the first adaptive step); ga_step never allocates, except on the sparse path where KLU
- * chooses new pivots, which allocates its factors anew: in the first step after a checkpoint
+ * the first adaptive step); ga_step never allocates, except on the sparse path where new
+ * pivots are chosen, which allocates the factors anew: in the first step after a checkpoint
  * is taken or restored (see ga_get_state), and when a refactorization with the old pivots
  * comes out numerically singular (pivot ratio below 1e-12).
  *
@@ -348,7 +348,7 @@ GA_API ga_status ga_set_predictor(ga_solver *s, int predictor);
  *  up). nnz = 0 declares the matrix identically zero: it is never evaluated (e.g. C_t when the
  *  forces do not depend on the velocities). With patterns for M and Phi_q (and for K_t and C_t
  *  unless neglected), the iteration matrix can be assembled and factorized as a sparse matrix
- *  (SuiteSparse KLU): no dense n x n object exists then, and the cost per step grows linearly
+ *  (galpha's sparse LU in SuiteSparse KLU's ordering): no dense n x n object exists then, and the cost per step grows linearly
  *  with the size for mechanism-like sparsity. Finite-difference tangents with a declared pattern
  *  perturb structurally independent columns together (Curtis-Powell-Reid).
  *  Patterns are declared before ga_init / ga_set_state and copied; indices are 0-based. */
@@ -372,7 +372,8 @@ typedef enum ga_linear_solver {
     GA_LINEAR_DENSE = 1,        /**< dense LU, the kernel chosen at each factorization: the
                                      unblocked one when n + m <= 40 or at most 10 % of the
                                      matrix is nonzero, Eigen's otherwise */
-    GA_LINEAR_SPARSE = 2,       /**< sparse LU (KLU); needs the patterns */
+    GA_LINEAR_SPARSE = 2,       /**< sparse LU (galpha's, in KLU's ordering; named "sparse
+                                     KLU"); needs the patterns */
     GA_LINEAR_DENSE_LAPACK = 3, /**< dense LU by LAPACK dgetrf/dgetrs */
     GA_LINEAR_DENSE_EIGEN = 4,  /**< dense LU by Eigen's (blocked) PartialPivLU */
     GA_LINEAR_DENSE_UNBLOCKED = 5 /**< dense LU by galpha's unblocked kernel, which skips the
@@ -560,7 +561,7 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
  *  controller; a_prev: the a of the step before, for the error estimate); treat it as opaque.
  *  The factorized iteration matrix is not part of it: taking a checkpoint (or restoring one)
  *  makes the next step start with a fresh one, as a restart does; on the sparse path with
- *  pivots chosen afresh too (KLU allocates its factors again in that step), since a new solver
+ *  pivots chosen afresh too (the factors are allocated again in that step), since a new solver
  *  has no earlier pivots to keep. ga_set_state needs callbacks set, allocates like
  *  ga_init (when the solver was not initialized) and makes the solver initialized; dense
  *  output (ga_interpolate) is available again after the next step. */

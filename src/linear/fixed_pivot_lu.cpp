@@ -1,9 +1,7 @@
 #include "fixed_pivot_lu.hpp"
 
-#ifdef GALPHA_HAVE_KLU
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <utility>
 
 namespace ga {
@@ -23,81 +21,140 @@ double ratio_of(const double *d, int N)
 }
 }  // namespace
 
-void FixedPivotLU::build(int N, const int *colptr, const int *rowind, const double *row_scale,
-                         klu_symbolic *symbolic, klu_numeric *&numeric, klu_common *common)
+bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const double *values,
+                             const double *row_scale, const int *diagonal_row, const int *Q,
+                             double expected_entries)
 {
     ready_ = false;
     N_ = N;
     colptr_ = colptr;
-    // KLU's factors straight into the members (no second copy of them at any time)
-    const int lnz = numeric->lnz, unz = numeric->unz;
-    Lp_.resize(N + 1);
-    Li_.resize(lnz);
-    Lx_.resize(lnz);
-    Up_.resize(N + 1);
-    Ui_.resize(unz);
-    Ux_.resize(unz);
-    P_.resize(N);
-    Q_.resize(N);
-    if (!klu_extract(numeric, symbolic, Lp_.data(), Li_.data(), Lx_.data(), Up_.data(),
-                     Ui_.data(), Ux_.data(), nullptr, nullptr, nullptr, P_.data(), Q_.data(),
-                     nullptr, nullptr, common))
-        throw std::logic_error("klu_extract failed");
-    klu_free_numeric(&numeric, common);  // before anything else is allocated: a lower peak
-
-    // L without its unit diagonal, compacted in place
-    int out = 0;
-    for (int k = 0, p = 0; k < N; ++k) {
-        const int end = Lp_[k + 1];
-        Lp_[k] = out;
-        for (; p < end; ++p)
-            if (Li_[p] != k) {
-                Li_[out] = Li_[p];
-                Lx_[out++] = Lx_[p];
-            }
-    }
-    Lp_[N] = out;
-    Li_.resize(out);
-    Lx_.resize(out);
-    // U: the diagonal apart, the rest of each column in place and sorted by row (insertion
-    // sort: columns are short, and nearly sorted)
+    Q_.assign(Q, Q + N);
+    // During the factorization, rows keep their own numbers: row i is the pivot of column
+    // pinv[i] once chosen (-1 before); L's row indices are renumbered at the end.
+    std::vector<int> pinv(N, -1), mark(N, -1), reach(N), stack(N), next(N);
+    work_.assign(N, 0.0);
+    double *x = work_.data();
+    Lp_.assign(N + 1, 0);
+    Up_.assign(N + 1, 0);
     Ud_.assign(N, 0.0);
-    out = 0;
-    for (int j = 0, p = 0; j < N; ++j) {
-        const int end = Up_[j + 1];
-        Up_[j] = out;
-        for (; p < end; ++p) {
-            if (Ui_[p] == j) {
-                Ud_[j] = Ux_[p];
-                continue;
-            }
-            const int i = Ui_[p];
-            const double u = Ux_[p];
-            int q = out++;
-            for (; q > Up_[j] && Ui_[q - 1] > i; --q) {
-                Ui_[q] = Ui_[q - 1];
-                Ux_[q] = Ux_[q - 1];
-            }
-            Ui_[q] = i;
-            Ux_[q] = u;
-        }
-    }
-    Up_[N] = out;
-    Ui_.resize(out);
-    Ux_.resize(out);
+    for (auto *v : {&Li_, &Ui_})
+        v->clear();
+    for (auto *v : {&Lx_, &Ux_})
+        v->clear();
+    const auto expected = static_cast<std::size_t>(std::min(expected_entries, 1e9));
+    Li_.reserve(expected);
+    Lx_.reserve(expected);
+    Ui_.reserve(expected);
+    Ux_.reserve(expected);
 
-    std::vector<int> pinv(N);
-    scale_.resize(N);
-    for (int i = 0; i < N; ++i) {
-        pinv[P_[i]] = i;
-        scale_[i] = row_scale[P_[i]];
+    for (int k = 0; k < N; ++k) {
+        const int col = Q[k];
+        // The rows of column k of L and U: those reached from the entries of A(:, col) through
+        // the columns of L computed so far (depth first, without recursion); reach[top..N)
+        // lists them in an order where every row comes before the rows it updates.
+        int top = N;
+        for (int p = colptr[col]; p < colptr[col + 1]; ++p) {
+            if (mark[rowind[p]] == k)
+                continue;
+            int head = 0;
+            stack[0] = rowind[p];
+            mark[rowind[p]] = k;
+            next[0] = pinv[rowind[p]] >= 0 ? Lp_[pinv[rowind[p]]] : 0;
+            while (head >= 0) {
+                const int i = stack[head], c = pinv[i];
+                const int end = c >= 0 ? Lp_[c + 1] : 0;
+                int q = next[head];
+                while (q < end && mark[Li_[q]] == k)
+                    ++q;
+                if (q < end) {  // descend into an unvisited row
+                    next[head] = q + 1;
+                    const int r = Li_[q];
+                    mark[r] = k;
+                    stack[++head] = r;
+                    next[head] = pinv[r] >= 0 ? Lp_[pinv[r]] : 0;
+                } else {
+                    reach[--top] = i;  // every row below it is listed: finished
+                    --head;
+                }
+            }
+        }
+        // Numeric: x = (D A)(:, col), minus the columns of L of the pivotal rows in reach
+        for (int p = colptr[col]; p < colptr[col + 1]; ++p)
+            x[rowind[p]] = row_scale[rowind[p]] * values[p];
+        for (int t = top; t < N; ++t) {
+            const int i = reach[t], c = pinv[i];
+            if (c < 0)
+                continue;
+            const double u = x[i];
+            for (int q = Lp_[c]; q < Lp_[c + 1]; ++q)
+                x[Li_[q]] -= Lx_[q] * u;
+        }
+        // The pivot: the diagonal row if its entry is within kDiagonalPreference of the
+        // largest candidate (as KLU's default), else the largest.
+        int pivot = -1;
+        double largest = 0.0;
+        for (int t = top; t < N; ++t) {
+            const int i = reach[t];
+            if (pinv[i] < 0 && std::abs(x[i]) > largest) {
+                largest = std::abs(x[i]);
+                pivot = i;
+            }
+        }
+        const int diagonal = diagonal_row[k];
+        if (pivot >= 0 && mark[diagonal] == k && pinv[diagonal] < 0 &&
+            std::abs(x[diagonal]) >= kDiagonalPreference * largest)
+            pivot = diagonal;
+        if (pivot < 0 || !(largest > 0.0) || !std::isfinite(largest)) {
+            for (int t = top; t < N; ++t)
+                x[reach[t]] = 0.0;
+            return false;  // no usable pivot: singular
+        }
+        const double d = x[pivot];
+        pinv[pivot] = k;
+        Ud_[k] = d;
+        for (int t = top; t < N; ++t) {
+            const int i = reach[t];
+            if (i == pivot) {
+            } else if (pinv[i] >= 0) {  // a pivotal row: an entry of U
+                Ui_.push_back(pinv[i]);
+                Ux_.push_back(x[i]);
+            } else {
+                Li_.push_back(i);
+                Lx_.push_back(x[i] / d);
+            }
+            x[i] = 0.0;
+        }
+        Lp_[k + 1] = static_cast<int>(Li_.size());
+        Up_[k + 1] = static_cast<int>(Ui_.size());
+    }
+
+    // Rows in pivot order: P_[k] is the pivot row of column k, L renumbered accordingly;
+    // each column of U sorted by row (an order the refactorization's updates can follow).
+    P_.resize(N);
+    for (int i = 0; i < N; ++i)
+        P_[pinv[i]] = i;
+    for (int &i : Li_)
+        i = pinv[i];
+    std::vector<std::pair<int, double>> column;
+    for (int j = 0; j < N; ++j) {
+        column.clear();
+        for (int p = Up_[j]; p < Up_[j + 1]; ++p)
+            column.emplace_back(Ui_[p], Ux_[p]);
+        std::sort(column.begin(), column.end());
+        for (int p = Up_[j], t = 0; p < Up_[j + 1]; ++p, ++t) {
+            Ui_[p] = column[t].first;
+            Ux_[p] = column[t].second;
+        }
     }
     a_row_.resize(colptr[N]);
     for (int p = 0; p < colptr[N]; ++p)
         a_row_[p] = pinv[rowind[p]];
-    work_.assign(N, 0.0);
+    scale_.resize(N);
+    for (int i = 0; i < N; ++i)
+        scale_[i] = row_scale[P_[i]];
     pivot_ratio_ = ratio_of(Ud_.data(), N);
     ready_ = true;
+    return true;
 }
 
 // Column j of P D A Q = L U, left-looking: scatter column Q_[j] of D A into the dense work
@@ -162,4 +219,3 @@ void FixedPivotLU::solve(double *rhs)
 }
 
 }  // namespace ga
-#endif

@@ -1,16 +1,17 @@
-// Sparse LU factors of a matrix whose pattern and pivot sequence are fixed: the row and column
-// orders and the patterns of L and U are taken once from a factorization that chose them
-// (KLU's, with partial pivoting), and every later matrix on the same pattern is refactorized
-// and solved by a left-looking kernel over those index lists.
+// Sparse LU factors of a matrix whose pattern is fixed, with a pivot sequence that is kept
+// between full factorizations: factorize() chooses the pivots (threshold partial pivoting,
+// in a column order given by the caller -- KLU's fill-reducing ordering), refactor() computes
+// the factors of new values on the same pattern with the same pivots, solve() solves.
+// Left-looking throughout (Gilbert and Peierls; Davis, Direct Methods for Sparse Linear
+// Systems, ch. 6), over index lists that refactorizations and solves only read.
 //
-// Why not klu_refactor and klu_solve: on the small systems of mechanisms their general
-// bookkeeping costs more than the arithmetic. On Andrews' squeezer in 31 coordinates (61
-// unknowns, 177 entries, 341 in L and U) KLU took 11 000 instructions to refactorize and 5 600
-// to solve (docs/design-notes.md has the figures with this kernel).
+// Why not KLU's klu_factor, klu_refactor and klu_solve, which do the same arithmetic: on the
+// small systems of mechanisms their general bookkeeping costs more than the arithmetic (on
+// Andrews' squeezer in 31 coordinates, 61 unknowns, a refactorization took 13 500
+// instructions and a solve 5 700; here 8 400 and 4 400), at 100 000 chain links the solves
+// streamed the factors more slowly, and taking KLU's factors over would hold them twice at
+// every full factorization (docs/design-notes.md).
 #pragma once
-
-#ifdef GALPHA_HAVE_KLU
-#include <klu.h>
 
 #include <vector>
 
@@ -18,18 +19,26 @@ namespace ga {
 
 class FixedPivotLU {
 public:
-    // The orders and patterns of KLU's factorization `numeric` of D A, A the N x N matrix in
-    // CSC form (colptr, rowind) and D = diag(row_scale) (no block triangular form, no
-    // scaling by KLU), and its values. Frees `numeric` (sets it to null) as soon as its
-    // factors are copied. Throws std::bad_alloc (the caller then frees `numeric`).
-    void build(int N, const int *colptr, const int *rowind, const double *row_scale,
-               klu_symbolic *symbolic, klu_numeric *&numeric, klu_common *common);
+    // Rows within kDiagonalPreference of the largest candidate keep the diagonal pivot (the
+    // row the ordering put there), as KLU's default: it keeps the fill of the ordering.
+    static constexpr double kDiagonalPreference = 1e-3;
+
+    // LU factors of D A with pivots chosen now: A the N x N matrix in CSC form (colptr,
+    // rowind, values; the pattern must stay alive and fixed while these factors are used),
+    // D = diag(row_scale), column k of the factors from column Q[k] of A, whose diagonal row
+    // is diagonal_row[k]. expected_entries: of L and of U each (storage reserved; more is
+    // allocated as needed). false if a column has no nonzero pivot candidate (singular; the
+    // factors are then not ready). Allocates; throws std::bad_alloc.
+    bool factorize(int N, const int *colptr, const int *rowind, const double *values,
+                   const double *row_scale, const int *diagonal_row, const int *Q,
+                   double expected_entries);
     bool ready() const { return ready_; }
     void clear() { ready_ = false; }  // the next matrix needs pivots chosen afresh
 
-    // LU factors of D A for a new matrix A on the pattern given to build() (values in its CSC
-    // order), with the same pivots and row scaling D. Returns min |u_ii| / max |u_ii| (0 if a pivot is zero or not
-    // finite): a small value says the old pivots no longer fit these values.
+    // LU factors of D A for new values of A on the pattern given to factorize() (in its CSC
+    // order), with the same pivots and row scaling D. Never allocates. Returns
+    // min |u_ii| / max |u_ii| (0 if a pivot is zero or not finite): a small value says the
+    // old pivots no longer fit these values.
     double refactor(const double *values);
     // The pivot ratio of the factors at hand, as refactor() returns it.
     double pivot_ratio() const { return pivot_ratio_; }
@@ -40,7 +49,7 @@ public:
 private:
     bool ready_ = false;
     int N_ = 0;
-    const int *colptr_ = nullptr;  // the caller's pattern (KluSystem keeps it alive and fixed)
+    const int *colptr_ = nullptr;  // the caller's pattern
     std::vector<int> P_, Q_;       // row i of P A Q is row P_[i] of A; column j is column Q_[j]
     std::vector<int> a_row_;       // for each entry of A (CSC order): its row in P A Q
     std::vector<double> scale_;    // D, row i of P A Q scaled by scale_[i]
@@ -53,4 +62,3 @@ private:
 };
 
 }  // namespace ga
-#endif

@@ -3,6 +3,7 @@
 #ifdef GALPHA_HAVE_KLU
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <new>
 
@@ -18,7 +19,7 @@ constexpr double kBandFillAllowance = 1.5;
 // A refactorization with the old pivots is kept while its pivot ratio stays above this.
 constexpr double kRefactorRcond = 1e-12;
 
-// Subnormal numbers flushed to zero inside KLU's numeric kernels, and the caller's two mode
+// Subnormal numbers flushed to zero inside the numeric kernels of the LU, and the caller's two mode
 // bits put back on the way out (no user code runs inside them; exception flags raised there
 // stay raised). Factors of long chains hold entries that decay geometrically along the chain
 // through every decade down to the subnormal range, where the processor is some 100 times
@@ -181,28 +182,15 @@ bool KluSystem::factorize()
     for (double &r : row_scale_)
         r = r > 0.0 ? 1.0 / r : 1.0;
     ++full_factorizations_;
-    klu_numeric *numeric;
-    {
-        const FlushSubnormals flush;
-        scale_rows();
-        numeric = klu_factor(colptr_.data(), rowind_.data(), values_.data(), symbolic_, &common_);
-        unscale_rows();
-    }
-    if (!numeric) {
-        if (common_.status == KLU_OUT_OF_MEMORY)
-            throw std::bad_alloc();
+    // in the order KLU's analysis chose; storage for the fill it was chosen on
+    const double expected =
+        std::strcmp(ordering_, "RCM") == 0 ? rcm_fill_.entries : amd_fill_.entries;
+    const FlushSubnormals flush;
+    if (!lu_.factorize(N_, colptr_.data(), rowind_.data(), values_.data(), row_scale_.data(),
+                       symbolic_->P, symbolic_->Q, expected)) {
         rcond_ = 0.0;
         return false;  // singular
     }
-    // KLU chose the pivots and the patterns of L and U; the factors move to lu_, which
-    // refactorizes and solves from now on and frees KLU's; if it throws, this guard does.
-    struct Release {
-        klu_numeric *&n;
-        klu_common &c;
-        ~Release() { klu_free_numeric(&n, &c); }
-    } release{numeric, common_};
-    lu_.build(N_, colptr_.data(), rowind_.data(), row_scale_.data(), symbolic_, numeric,
-              &common_);
     rcond_ = lu_.pivot_ratio();
     return rcond_ >= std::numeric_limits<double>::epsilon();
 }
@@ -232,18 +220,6 @@ double KluSystem::rcond_estimate() const noexcept
     if (!ok || !(common_.condest > 0.0))
         return 0.0;
     return 1.0 / common_.condest;
-}
-
-void KluSystem::scale_rows()
-{
-    for (std::size_t k = 0; k < values_.size(); ++k)
-        values_[k] *= row_scale_[rowind_[k]];
-}
-
-void KluSystem::unscale_rows()
-{
-    for (std::size_t k = 0; k < values_.size(); ++k)
-        values_[k] /= row_scale_[rowind_[k]];
 }
 
 void KluSystem::solve(double *rhs)

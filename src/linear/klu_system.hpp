@@ -1,10 +1,11 @@
-// A square sparse matrix whose pattern is fixed once, factorized with SuiteSparse KLU:
-// symbolic analysis at setup (KLU's AMD ordering, or reverse Cuthill-McKee when it fills
-// little more), a numeric factorization with partial pivoting the first time (klu_factor), then
-// refactorizations and solves with the same pivot order and patterns by FixedPivotLU -- no
-// allocation. If a refactorization comes out poorly conditioned (pivots chosen for other
-// values), the matrix is factorized afresh with new pivots (this rare path allocates).
-// Shared by the sparse saddle-point backend and the sparse stabilized index-2 system.
+// A square sparse matrix whose pattern is fixed once: ordered at setup by SuiteSparse KLU's
+// analysis (its AMD ordering, or reverse Cuthill-McKee when that fills little more), then
+// factorized by FixedPivotLU -- pivots chosen by partial pivoting at the first factorization,
+// refactorizations and solves with the same pivots afterwards, no allocation. If a
+// refactorization comes out poorly conditioned (pivots chosen for other values), the matrix
+// is factorized afresh with new pivots (this rare path allocates). KLU also estimates the
+// condition number on demand. Shared by the sparse saddle-point backend and the sparse
+// stabilized index-2 system.
 #pragma once
 
 #ifdef GALPHA_HAVE_KLU
@@ -65,8 +66,6 @@ public:
 private:
     std::vector<std::vector<int>> symmetric_adjacency() const;
     std::vector<int> reverse_cuthill_mckee(const std::vector<std::vector<int>> &adj) const;
-    void scale_rows();    // values_ <- D values_ (for KLU's full factorization)
-    void unscale_rows();  // and back
 
     int N_ = 0;
     std::vector<int> colptr_, rowind_;

@@ -1,7 +1,8 @@
-// The sparse system behind the sparse path (src/linear/klu_system.hpp), tested directly: galpha
-// scales the rows itself and keeps the scale factors through KLU's refactorizations, and falls
-// back to a fresh factorization (new pivots, new scale factors) when the old pivots no longer
-// fit. The oracle is Eigen's dense LU of the same matrix, an independent implementation.
+// The sparse system behind the sparse path (src/linear/klu_system.hpp), tested directly: its
+// LU (fixed_pivot_lu.hpp) chooses pivots in a full factorization, keeps them and the row scale
+// factors through the refactorizations, and falls back to a fresh factorization (new pivots,
+// new scale factors) when the old pivots no longer fit. The oracle is Eigen's dense LU of the
+// same matrix, an independent implementation.
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cstdio>
