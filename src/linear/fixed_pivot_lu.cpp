@@ -19,6 +19,42 @@ double ratio_of(const double *d, int N)
     }
     return finite == 0.0 && hi > 0.0 ? lo / hi : 0.0;
 }
+
+// The rows of column k of L and U: those reached from the rows of A's column [first, last)
+// through the columns of L computed so far (row i leads to the rows of L(:, pinv[i]) once
+// it is a pivot row), depth first without recursion. Returns top: reach[top..N) lists them in
+// an order where every row comes before the rows it updates. mark[i] == k: row i is listed.
+int reach_of(int k, const int *first, const int *last, const int *Lp, const int *Li,
+             const int *pinv, int *mark, int *reach, int *stack, int *next, int N)
+{
+    int top = N;
+    for (const int *row = first; row != last; ++row) {
+        if (mark[*row] == k)
+            continue;
+        int head = 0;
+        stack[0] = *row;
+        mark[*row] = k;
+        next[0] = pinv[*row] >= 0 ? Lp[pinv[*row]] : 0;
+        while (head >= 0) {
+            const int i = stack[head], c = pinv[i];
+            const int end = c >= 0 ? Lp[c + 1] : 0;
+            int q = next[head];
+            while (q < end && mark[Li[q]] == k)
+                ++q;
+            if (q < end) {  // descend into an unvisited row
+                next[head] = q + 1;
+                const int r = Li[q];
+                mark[r] = k;
+                stack[++head] = r;
+                next[head] = pinv[r] >= 0 ? Lp[pinv[r]] : 0;
+            } else {
+                reach[--top] = i;  // every row below it is listed: finished
+                --head;
+            }
+        }
+    }
+    return top;
+}
 }  // namespace
 
 bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const double *values,
@@ -37,10 +73,10 @@ bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const 
     Lp_.assign(N + 1, 0);
     Up_.assign(N + 1, 0);
     Ud_.assign(N, 0.0);
-    for (auto *v : {&Li_, &Ui_})
-        v->clear();
-    for (auto *v : {&Lx_, &Ux_})
-        v->clear();
+    Li_.clear();
+    Lx_.clear();
+    Ui_.clear();
+    Ux_.clear();
     const auto expected = static_cast<std::size_t>(std::min(expected_entries, 1e9));
     Li_.reserve(expected);
     Lx_.reserve(expected);
@@ -49,35 +85,9 @@ bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const 
 
     for (int k = 0; k < N; ++k) {
         const int col = Q[k];
-        // The rows of column k of L and U: those reached from the entries of A(:, col) through
-        // the columns of L computed so far (depth first, without recursion); reach[top..N)
-        // lists them in an order where every row comes before the rows it updates.
-        int top = N;
-        for (int p = colptr[col]; p < colptr[col + 1]; ++p) {
-            if (mark[rowind[p]] == k)
-                continue;
-            int head = 0;
-            stack[0] = rowind[p];
-            mark[rowind[p]] = k;
-            next[0] = pinv[rowind[p]] >= 0 ? Lp_[pinv[rowind[p]]] : 0;
-            while (head >= 0) {
-                const int i = stack[head], c = pinv[i];
-                const int end = c >= 0 ? Lp_[c + 1] : 0;
-                int q = next[head];
-                while (q < end && mark[Li_[q]] == k)
-                    ++q;
-                if (q < end) {  // descend into an unvisited row
-                    next[head] = q + 1;
-                    const int r = Li_[q];
-                    mark[r] = k;
-                    stack[++head] = r;
-                    next[head] = pinv[r] >= 0 ? Lp_[pinv[r]] : 0;
-                } else {
-                    reach[--top] = i;  // every row below it is listed: finished
-                    --head;
-                }
-            }
-        }
+        const int top = reach_of(k, rowind + colptr[col], rowind + colptr[col + 1], Lp_.data(),
+                                 Li_.data(), pinv.data(), mark.data(), reach.data(),
+                                 stack.data(), next.data(), N);
         // Numeric: x = (D A)(:, col), minus the columns of L of the pivotal rows in reach
         for (int p = colptr[col]; p < colptr[col + 1]; ++p)
             x[rowind[p]] = row_scale[rowind[p]] * values[p];
@@ -114,11 +124,10 @@ bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const 
         Ud_[k] = d;
         for (int t = top; t < N; ++t) {
             const int i = reach[t];
-            if (i == pivot) {
-            } else if (pinv[i] >= 0) {  // a pivotal row: an entry of U
+            if (pinv[i] >= 0 && i != pivot) {  // an earlier pivot row: an entry of U
                 Ui_.push_back(pinv[i]);
                 Ux_.push_back(x[i]);
-            } else {
+            } else if (pinv[i] < 0) {  // not yet a pivot row: an entry of L
                 Li_.push_back(i);
                 Lx_.push_back(x[i] / d);
             }
