@@ -447,14 +447,23 @@ ga_status Solver::factorize(double h, bool tangents_K, bool tangents_C, bool tan
     const bool ok = formulation == GA_INDEX2_STABILIZED
                         ? S2_.factorize(M_, C, K, J_, B_, tangent_Z ? &Z_ : nullptr, params, h)
                         : S_.factorize_step(M_, C, K, J_, params, h, scaling);
-    if (!ok)
-        return diag.fail(GA_ERR_SINGULAR,
-                         "iteration matrix S_t%s is singular (rcond = %.3g) in Newton iteration "
-                         "%d of the step from t = %.17g with h = %g",
-                         formulation == GA_INDEX2_STABILIZED ? " (stabilized index-2)"
-                         : scaling                           ? " (scaled, eq. 10)"
-                                                             : " (unscaled)",
-                         last_rcond(), iter, accepted_.t, h);
+    if (!ok) {
+        diag.fail(GA_ERR_SINGULAR,
+                  "iteration matrix S_t%s is singular (rcond = %.3g) in Newton iteration %d of "
+                  "the step from t = %.17g with h = %g",
+                  formulation == GA_INDEX2_STABILIZED ? " (stabilized index-2)"
+                  : scaling                           ? " (scaled, eq. 10)"
+                                                      : " (unscaled)",
+                  last_rcond(), iter, accepted_.t, h);
+        // Beyond the first iteration the matrix is that of an iterate Newton moved to, which
+        // a diverging iteration (h too large for the motion) can carry into a singular
+        // configuration that the model never passes through.
+        if (iter > 1)
+            diag.append(", at an iterate the iteration moved to (last increment / tolerance "
+                        "= %.3g): if the iteration was diverging, a smaller h may help",
+                        convergence_.ratio());
+        return GA_ERR_SINGULAR;
+    }
     jacobian_valid_ = true;
     jacobian_h_ = h;
     theta_prev_ = -1.0;

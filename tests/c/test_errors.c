@@ -35,6 +35,8 @@ typedef struct faulty {
     int rc;          /* return code to inject (0: inject a value instead) */
     double value;    /* value written into the output when rc == 0 */
     int zero_jacobian;
+    int zero_jacobian_from; /* > 0: Phi_q = 0 from this Jacobian call on (jacobian_calls) */
+    int jacobian_calls;
     ga_solver *self; /* for the re-entrancy test */
     ga_status reentry_status;
     int reentry_calls;
@@ -79,7 +81,8 @@ static int f_jacobian(double t, const double *q, double *J, void *u)
 {
     faulty *f = u;
     pendulum_jacobian(t, q, J, &f->p);
-    if (f->zero_jacobian)
+    ++f->jacobian_calls;
+    if (f->zero_jacobian || (f->zero_jacobian_from > 0 && f->jacobian_calls >= f->zero_jacobian_from))
         J[0] = J[1] = 0.0;
     return inject(f, JACOBIAN, J);
 }
@@ -185,6 +188,7 @@ static void failing_step(fixture *x, ga_status expected, const char *part)
     /* recovery: the same step again, without the fault, equals the undisturbed run */
     x->model.site = NONE;
     x->model.zero_jacobian = 0;
+    x->model.zero_jacobian_from = 0;
     continues_undisturbed(x, before, len);
 }
 
@@ -634,7 +638,7 @@ static void callback_failures_in_index2_steps(void **state)
         {JACOBIAN, 0, NAN, GA_ERR_NONFINITE, "constraint Jacobian Phi_q(0,0)"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
-        faulty model = {{1.0, 1.0, 9.81}, NONE, 0, 0.0, 0, NULL, GA_OK, 0};
+        faulty model = {{1.0, 1.0, 9.81}, NONE, 0, 0.0, 0, 0, 0, NULL, GA_OK, 0};
         ga_solver *s = NULL;
         double q[2], v[2], before[STATE_MAX], after[STATE_MAX];
         pendulum_state(&model.p, 1.0, 0.5, q, v);
@@ -664,6 +668,29 @@ static void singular_iteration_matrix(void **state)
     fixture *x = *state;
     x->model.zero_jacobian = 1; /* Phi_q = 0: the saddle-point matrix is singular */
     failing_step(x, GA_ERR_SINGULAR, "iteration matrix S_t (scaled, eq. 10) is singular");
+}
+
+/* Singular only at an iterate Newton moved to (full Newton rebuilds the matrix at every
+ * iteration; Phi_q vanishes from the step's second Jacobian call on): the message says where,
+ * and what may be behind it. */
+static void singular_iteration_matrix_at_a_later_iterate(void **state)
+{
+    fixture *x = *state;
+    assert_int_equal(ga_set_jacobian_reuse(x->s, GA_REUSE_NEVER), GA_OK);
+    x->model.jacobian_calls = 0;
+    x->model.zero_jacobian_from = 2;
+    double before[STATE_MAX], after[STATE_MAX];
+    const size_t len = snapshot(x->s, before);
+    assert_int_equal(ga_step(x->s, 0.01), GA_ERR_SINGULAR);
+    expect_message(x->s, "is singular (rcond = 0) in Newton iteration 2");
+    expect_message(x->s, "at an iterate the iteration moved to");
+    expect_message(x->s, "a smaller h may help");
+    snapshot(x->s, after);
+    assert_memory_equal(before, after, len * sizeof(double));
+    /* recovery, with the default modified Newton the reference solver uses */
+    x->model.zero_jacobian_from = 0;
+    assert_int_equal(ga_set_jacobian_reuse(x->s, GA_REUSE_AUTO), GA_OK);
+    continues_undisturbed(x, before, len);
 }
 
 static void newton_not_converged_in_max_iter(void **state)
@@ -933,6 +960,7 @@ int main(void)
         T(overflow_in_the_newton_increment),
         cmocka_unit_test(failure_in_the_corrected_start),
         T(singular_iteration_matrix),
+        T(singular_iteration_matrix_at_a_later_iterate),
         T(newton_not_converged_in_max_iter),
         T(newton_diverges_with_wrong_tangent),
         T(callback_calling_its_own_solver_is_refused),
