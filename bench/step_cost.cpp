@@ -6,6 +6,7 @@
 //
 //   step_cost scenes [tol]     -> CSV on stdout
 //   step_cost chain N [steps]  -> one CSV line on stdout
+//   step_cost scene_steps NAME [tol] | scene_limit NAME [tol] [reps]  -> for callgrind
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -214,6 +215,34 @@ int main(int argc, char **argv)
         }
         return 0;
     }
+    if ((mode == "scene_steps" || mode == "scene_limit") && argc > 2) {
+        // For instruction counts under callgrind: a scene's fixed-step run (collect inside
+        // ga_step; prints the number of steps), or after it `reps` calls of the unavoidable
+        // work (collect inside Solver::unavoidable_work; scripts/bench.sh takes the
+        // difference of two counts of reps, so that nothing but those calls is counted).
+        const std::string name = argv[2];
+        const double tol = argc > 3 ? std::atof(argv[3]) : 1e-6;
+        const int reps = argc > 4 ? std::atoi(argv[4]) : 1000;
+        for (const Scene &sc : paper_scenes()) {
+            if (sc.name != name)
+                continue;
+            ga_solver *s = make(sc, sc.declare ? GA_LINEAR_SPARSE : GA_LINEAR_DENSE, tol);
+            if (ga_init(s, 0.0, sc.q0.data(), sc.v0.data()))
+                return 1;
+            const long steps = std::lround(sc.t_end / sc.h);
+            for (long k = 0; k < steps; ++k)
+                if (ga_step(s, sc.h))
+                    return 1;
+            if (mode == "scene_limit")
+                for (int k = 0; k < reps; ++k)
+                    s->core.unavoidable_work(sc.h);
+            std::printf("%ld\n", steps);
+            ga_free(s);
+            return 0;
+        }
+        std::fprintf(stderr, "unknown scene %s\n", name.c_str());
+        return 2;
+    }
     if (mode == "chain_steps" && argc > 2) {
         // just the steps (for instruction counting under callgrind --toggle-collect=ga_step)
         const int links = std::atoi(argv[2]);
@@ -244,6 +273,6 @@ int main(int argc, char **argv)
         return 0;
     }
     std::fprintf(stderr, "usage: step_cost scenes [tol] | step_cost chain N [steps] [tol] "
-                         "[formulation]\n");
+                         "[formulation] | step_cost scene_steps|scene_limit NAME [tol] [reps]\n");
     return 2;
 }

@@ -34,6 +34,25 @@ if command -v valgrind >/dev/null; then
             awk -F, '{printf "%s,%.0f\n", $1, $2 / 10}' >> "$out/chain_instructions.csv"
     done
 fi
+if command -v valgrind >/dev/null; then
+    echo "per-step cost in instructions (callgrind): what the timing ratios cannot resolve"
+    collected() {  # instructions collected inside function $1 by step_cost's remaining arguments
+        local fn=$1; shift
+        valgrind --tool=callgrind --toggle-collect="$fn" --callgrind-out-file=/dev/null \
+            "$b/step_cost" "$@" 2>&1 | sed -n "s/.*Collected : \([0-9]*\).*/\1/p"
+    }
+    echo "scene,newton_tol,instructions_per_step,limit_instructions,ratio" > "$out/step_instructions.csv"
+    for sc in slider_crank andrews7 andrews31 andrews31_sparse; do
+        steps=$("$b/step_cost" scene_steps "$sc" 1e-6)
+        step=$(collected ga_step scene_steps "$sc" 1e-6)
+        # the limit: the difference between 2000 and 1000 calls, per call
+        l1=$(collected 'ga::Solver::unavoidable_work*' scene_limit "$sc" 1e-6 1000)
+        l2=$(collected 'ga::Solver::unavoidable_work*' scene_limit "$sc" 1e-6 2000)
+        awk -v sc="$sc" -v n="$steps" -v s="$step" -v a="$l1" -v b="$l2" \
+            'BEGIN { l = (b - a) / 1000; printf "%s,1e-06,%.0f,%.0f,%.3f\n", sc, s / n, l, s / n / l }' \
+            >> "$out/step_instructions.csv"
+    done
+fi
 echo "linear algebra"
 "$b/linear_algebra" > "$out/linear_algebra.csv"
 echo "work-precision against IDA"

@@ -64,6 +64,10 @@ if sc:
     ax.legend()
     ax.set_title("Cost per step against the unavoidable work (paper's scenes, fixed h)")
     save(fig, "step_cost.png")
+for r in rows("step_instructions.csv"):
+    print("  step instructions %-17s tol %-6s %8.0f per step, limit %7.0f, ratio %5.2f" % (
+        r["scene"], r["newton_tol"], num(r["instructions_per_step"]),
+        num(r["limit_instructions"]), num(r["ratio"])))
 
 # ---- chain scaling ------------------------------------------------------------------------------
 ch = rows("chain.csv")
@@ -84,7 +88,7 @@ if ch:
     ax[1].set(xlabel="links N", ylabel="MiB")
     ax[1].legend()
     ax[1].grid(True, which="both", lw=0.3)
-    fig.suptitle("N-link chain, sparse path (KLU), h = 1e-3, 10 steps")
+    fig.suptitle("N-link chain, sparse path, h = 1e-3, 10 steps")
     save(fig, "chain.png")
     i1, i2 = list(N).index(1000), list(N).index(100000)
     print("  chain: time per step %.3g us at N = 1000, %.3g us at N = 100000: %.0f-fold; peak "
