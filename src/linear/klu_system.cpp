@@ -3,7 +3,6 @@
 #ifdef GALPHA_HAVE_KLU
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <new>
 
@@ -91,10 +90,9 @@ KluSystem::KluSystem()
     // the augmented index-2 system of a 3000-link chain (KLU then orders and pivots the
     // whole matrix; the chain's index-3 steps cost the same).
     common_.btf = 0;
-    // Row scaling by the largest entry of each row, as KLU's default, but done here and kept
-    // from one full factorization to the next: a refactorization keeps its pivots, which a
-    // new scaling would not change, and KLU's scaling pass (with its checks of the pattern)
-    // cost a quarter of each refactorization of a small system.
+    // Row scaling by the largest entry of each row, as KLU's default, but galpha's, kept from
+    // one full factorization to the next (a refactorization keeps its pivots, which a new
+    // scaling would not change): KLU is only given scaled matrices (klu_condest).
     common_.scale = -1;
 }
 
@@ -140,6 +138,7 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries)
         order = reverse_cuthill_mckee(adj);
         rcm_fill_ = cholesky_fill(adj, order, kBandFillAllowance * amd_fill_.entries);
     }
+    expected_entries_ = amd_fill_.entries;
     if (rcm_fill_.entries > kBandFillAllowance * amd_fill_.entries ||
         rcm_fill_.flops > kBandFillAllowance * amd_fill_.flops)
         return;
@@ -149,6 +148,7 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries)
         klu_free_symbolic(&symbolic_, &common_);
         symbolic_ = banded;
         ordering_ = "RCM";
+        expected_entries_ = rcm_fill_.entries;
     }
 }
 
@@ -182,12 +182,9 @@ bool KluSystem::factorize()
     for (double &r : row_scale_)
         r = r > 0.0 ? 1.0 / r : 1.0;
     ++full_factorizations_;
-    // in the order KLU's analysis chose; storage for the fill it was chosen on
-    const double expected =
-        std::strcmp(ordering_, "RCM") == 0 ? rcm_fill_.entries : amd_fill_.entries;
     const FlushSubnormals flush;
     if (!lu_.factorize(N_, colptr_.data(), rowind_.data(), values_.data(), row_scale_.data(),
-                       symbolic_->P, symbolic_->Q, expected)) {
+                       symbolic_->P, symbolic_->Q, expected_entries_)) {
         rcond_ = 0.0;
         return false;  // singular
     }

@@ -78,6 +78,7 @@ private:
     double rcond_ = 0.0;  // min |U_ii| / max |U_ii| (as klu_rcond): decides singularity
     const char *ordering_ = "AMD";
     CholeskyFill amd_fill_, rcm_fill_;
+    double expected_entries_ = 0.0;  // in L (and in U) with the ordering taken: storage reserved
     int full_factorizations_ = 0;
 };
 
