@@ -32,10 +32,11 @@
  *
  * Memory is allocated by ga_create and ga_init (and by options that need more workspace once
  * it exists: ga_set_formulation to index 2, tangent options that call for finite differences,
- * the first adaptive step); ga_step never allocates, except on the sparse path where new
- * pivots are chosen, which allocates the factors anew: in the first step after a checkpoint
- * is taken or restored (see ga_get_state), and when a refactorization with the old pivots
- * comes out numerically singular (pivot ratio below 1e-12).
+ * the first adaptive step); ga_step never allocates. On the sparse path the storage of the
+ * LU factors is reserved when the patterns are set up, from the fill of the ordering; a step
+ * that chooses new pivots (the first after a checkpoint is taken or restored, see
+ * ga_get_state, or one whose refactorization with the old pivots comes out numerically
+ * singular, pivot ratio below 1e-12) allocates only if its factors fill more than that.
  *
  * ## Conventions
  *  - Every function that can fail returns a ::ga_status (0 = GA_OK, negative = error);
@@ -561,7 +562,7 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
  *  controller; a_prev: the a of the step before, for the error estimate); treat it as opaque.
  *  The factorized iteration matrix is not part of it: taking a checkpoint (or restoring one)
  *  makes the next step start with a fresh one, as a restart does; on the sparse path with
- *  pivots chosen afresh too (the factors are allocated again in that step), since a new solver
+ *  pivots chosen afresh too (in the storage the factors already have), since a new solver
  *  has no earlier pivots to keep. ga_set_state needs callbacks set, allocates like
  *  ga_init (when the solver was not initialized) and makes the solver initialized; dense
  *  output (ga_interpolate) is available again after the next step. */

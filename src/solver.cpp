@@ -212,10 +212,10 @@ void Solver::setup_index2()
         prefactor_index2();
 }
 
-// KLU allocates its factors and picks its pivots in the first numeric factorization; for the
-// sparse index-2 system that happens here, with the matrices of the current state, and not in
-// the first step (which then refactorizes without allocating). Without C_t and K_t the matrix
-// does not depend on h. A failure here is no error: the step factorizes afresh.
+// The sparse LU picks its pivots in its first numeric factorization; for the sparse index-2
+// system that happens here, with the matrices of the current state, and not in the first
+// step (which then only refactorizes). Without C_t and K_t the matrix does not depend on h.
+// A failure here is no error: the step factorizes afresh.
 void Solver::prefactor_index2()
 {
     if (!S2_.sparse())

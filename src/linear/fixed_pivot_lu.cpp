@@ -57,6 +57,22 @@ int reach_of(int k, const int *first, const int *last, const int *Lp, const int 
 }
 }  // namespace
 
+void FixedPivotLU::reserve(int N, int nnz, double expected_entries)
+{
+    for (auto *v : {&pinv_, &mark_, &reach_, &stack_, &next_, &P_, &Q_})
+        v->reserve(N);
+    for (auto *v : {&Lp_, &Up_})
+        v->reserve(N + 1);
+    for (auto *v : {&work_, &Ud_, &scale_})
+        v->reserve(N);
+    a_row_.reserve(nnz);
+    const auto expected = static_cast<std::size_t>(std::min(expected_entries, 1e9));
+    Li_.reserve(expected);
+    Lx_.reserve(expected);
+    Ui_.reserve(expected);
+    Ux_.reserve(expected);
+}
+
 bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const double *values,
                              const double *row_scale, const int *diagonal_row, const int *Q,
                              double expected_entries)
@@ -66,8 +82,15 @@ bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const 
     colptr_ = colptr;
     Q_.assign(Q, Q + N);
     // During the factorization, rows keep their own numbers: row i is the pivot of column
-    // pinv[i] once chosen (-1 before); L's row indices are renumbered at the end.
-    std::vector<int> pinv(N, -1), mark(N, -1), reach(N), stack(N), next(N);
+    // pinv[i] once chosen (-1 before); L's row indices are renumbered at the end. The
+    // workspace and the factors' storage stay from one full factorization to the next: new
+    // pivots allocate only where they fill more than earlier ones did.
+    pinv_.assign(N, -1);
+    mark_.assign(N, -1);
+    reach_.resize(N);
+    stack_.resize(N);
+    next_.resize(N);
+    int *pinv = pinv_.data(), *mark = mark_.data(), *reach = reach_.data();
     work_.assign(N, 0.0);
     double *x = work_.data();
     Lp_.assign(N + 1, 0);
@@ -77,17 +100,12 @@ bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const 
     Lx_.clear();
     Ui_.clear();
     Ux_.clear();
-    const auto expected = static_cast<std::size_t>(std::min(expected_entries, 1e9));
-    Li_.reserve(expected);
-    Lx_.reserve(expected);
-    Ui_.reserve(expected);
-    Ux_.reserve(expected);
+    reserve(N, colptr[N], expected_entries);  // no allocation if reserved before
 
     for (int k = 0; k < N; ++k) {
         const int col = Q[k];
         const int top = reach_of(k, rowind + colptr[col], rowind + colptr[col + 1], Lp_.data(),
-                                 Li_.data(), pinv.data(), mark.data(), reach.data(),
-                                 stack.data(), next.data(), N);
+                                 Li_.data(), pinv, mark, reach, stack_.data(), next_.data(), N);
         // Numeric: x = (D A)(:, col), minus the columns of L of the pivotal rows in reach
         for (int p = colptr[col]; p < colptr[col + 1]; ++p)
             x[rowind[p]] = row_scale[rowind[p]] * values[p];
@@ -144,15 +162,17 @@ bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const 
         P_[pinv[i]] = i;
     for (int &i : Li_)
         i = pinv[i];
-    std::vector<std::pair<int, double>> column;
-    for (int j = 0; j < N; ++j) {
-        column.clear();
-        for (int p = Up_[j]; p < Up_[j + 1]; ++p)
-            column.emplace_back(Ui_[p], Ux_[p]);
-        std::sort(column.begin(), column.end());
-        for (int p = Up_[j], t = 0; p < Up_[j + 1]; ++p, ++t) {
-            Ui_[p] = column[t].first;
-            Ux_[p] = column[t].second;
+    for (int j = 0; j < N; ++j) {  // insertion sort: the columns are short
+        for (int p = Up_[j] + 1; p < Up_[j + 1]; ++p) {
+            const int i = Ui_[p];
+            const double u = Ux_[p];
+            int q = p;
+            for (; q > Up_[j] && Ui_[q - 1] > i; --q) {
+                Ui_[q] = Ui_[q - 1];
+                Ux_[q] = Ux_[q - 1];
+            }
+            Ui_[q] = i;
+            Ux_[q] = u;
         }
     }
     a_row_.resize(colptr[N]);

@@ -28,10 +28,15 @@ public:
     // D = diag(row_scale), column k of the factors from column Q[k] of A, whose diagonal row
     // is diagonal_row[k]. expected_entries: of L and of U each (storage reserved; more is
     // allocated as needed). false if a column has no nonzero pivot candidate (singular; the
-    // factors are then not ready). Allocates; throws std::bad_alloc.
+    // factors are then not ready). Allocates the first time, and later only where new pivots
+    // fill more than earlier ones; throws std::bad_alloc.
     bool factorize(int N, const int *colptr, const int *rowind, const double *values,
                    const double *row_scale, const int *diagonal_row, const int *Q,
                    double expected_entries);
+    // Allocates up front what factorize() needs for an N x N matrix with nnz entries whose
+    // factors hold expected_entries each (at setup: the first factorization then allocates
+    // only if it fills more). Throws std::bad_alloc.
+    void reserve(int N, int nnz, double expected_entries);
     bool ready() const { return ready_; }
     void clear() { ready_ = false; }  // the next matrix needs pivots chosen afresh
 
@@ -58,6 +63,7 @@ private:
     std::vector<int> Lp_, Li_, Up_, Ui_;
     std::vector<double> Lx_, Ux_, Ud_;
     std::vector<double> work_;  // dense column, all zero between calls
+    std::vector<int> pinv_, mark_, reach_, stack_, next_;  // workspace of factorize()
     double pivot_ratio_ = 0.0;
 };
 

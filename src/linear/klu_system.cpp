@@ -139,17 +139,19 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries)
         rcm_fill_ = cholesky_fill(adj, order, kBandFillAllowance * amd_fill_.entries);
     }
     expected_entries_ = amd_fill_.entries;
-    if (rcm_fill_.entries > kBandFillAllowance * amd_fill_.entries ||
-        rcm_fill_.flops > kBandFillAllowance * amd_fill_.flops)
-        return;
-    klu_symbolic *banded = klu_analyze_given(N, colptr_.data(), rowind_.data(), order.data(),
-                                             order.data(), &common_);
-    if (banded) {
-        klu_free_symbolic(&symbolic_, &common_);
-        symbolic_ = banded;
-        ordering_ = "RCM";
-        expected_entries_ = rcm_fill_.entries;
+    if (rcm_fill_.entries <= kBandFillAllowance * amd_fill_.entries &&
+        rcm_fill_.flops <= kBandFillAllowance * amd_fill_.flops) {
+        klu_symbolic *banded = klu_analyze_given(N, colptr_.data(), rowind_.data(),
+                                                 order.data(), order.data(), &common_);
+        if (banded) {
+            klu_free_symbolic(&symbolic_, &common_);
+            symbolic_ = banded;
+            ordering_ = "RCM";
+            expected_entries_ = rcm_fill_.entries;
+        }
     }
+    // the factors' storage now: the first factorization allocates only if it fills more
+    lu_.reserve(N, static_cast<int>(rowind_.size()), expected_entries_);
 }
 
 int KluSystem::slot(int row, int col) const

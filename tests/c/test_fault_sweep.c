@@ -220,9 +220,8 @@ static ga_solver *restarted(const config *cf, faulty_chain *f, const double *buf
  * never saw the failure, its kept matrix dropped (setting the reuse mode again does that; a
  * failure does too). With dense linear algebra it also equals the next step of a new solver
  * restarted from a checkpoint of that state. On the sparse path a restart, like any
- * checkpoint, also makes KLU choose new pivots, which the failed solver keeps (a failed step
- * does not allocate): there the two agree to round-off (test_checkpoint.c restarts sparse
- * runs bit-identically). */
+ * checkpoint, also makes the LU choose new pivots, which the failed solver keeps: there the
+ * two agree to round-off (test_checkpoint.c restarts sparse runs bit-identically). */
 static void leaves_no_trace(ga_solver *s, const config *cf, faulty_chain *f)
 {
     faulty_chain quiet = *f;
