@@ -199,6 +199,8 @@ ga_status Solver::setup()
     workspace_ready_ = true;
     if (formulation == GA_INDEX2_STABILIZED)
         setup_index2();
+    // The factors' storage after every setup, so that it does not add to their peak.
+    S_.reserve_factors();
     return GA_OK;
 }
 
@@ -206,8 +208,10 @@ ga_status Solver::setup()
 // formulation is chosen, or when it is chosen later (ga_set_formulation), never in a step.
 void Solver::setup_index2()
 {
-    if (!S2_.ready())
+    if (!S2_.ready()) {
         S2_.setup(n_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_, active_ptr());
+        S2_.reserve_factors();
+    }
     if (initialized_)
         prefactor_index2();
 }
@@ -228,9 +232,11 @@ void Solver::prefactor_index2()
 // so that fixed-step runs do not pay for a second factorization workspace.
 void Solver::setup_projection()
 {
-    if (m_ > 0 && !P_.ready())
+    if (m_ > 0 && !P_.ready()) {
         P_.setup(sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Auto),
                  n_, m_, M_, J_, K_, C_, active_ptr());
+        P_.reserve_factors();
+    }
 }
 
 ga_status Solver::evaluate_mass(double t, const Vec &q)

@@ -45,6 +45,10 @@ public:
     // The next factorization chooses its pivots (and the sparse row scaling) afresh, as in a
     // new solver; a dense LU does so at every factorization anyway.
     virtual void forget_pivots() {}
+    // Allocates now the storage of the factors that factorize() would otherwise allocate in
+    // its first call (the sparse LU: from the fill of the ordering). Called once all setups
+    // are done, so that it never adds to the peak of their temporary memory.
+    virtual void reserve_factors() {}
 };
 
 // Auto: per factorization, the unblocked kernel for small or mostly-zero S, Eigen's otherwise.

@@ -452,6 +452,14 @@ void Index2Matrix::forget_pivots()
 #endif
 }
 
+void Index2Matrix::reserve_factors()
+{
+#ifdef GALPHA_HAVE_KLU
+    if (sparse_)
+        sparse_->S.reserve_factors();
+#endif
+}
+
 const char *Index2Matrix::name() const
 {
     if (sparse_)

@@ -63,6 +63,7 @@ public:
     const char *name() const;
     // The next factorization picks its pivots afresh (LinearBackend::forget_pivots).
     void forget_pivots();
+    void reserve_factors();  // LinearBackend::reserve_factors
 
 private:
     struct Dense;

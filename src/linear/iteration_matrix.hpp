@@ -41,6 +41,12 @@ public:
         if (backend_)
             backend_->forget_pivots();
     }
+    // LinearBackend::reserve_factors
+    void reserve_factors()
+    {
+        if (backend_)
+            backend_->reserve_factors();
+    }
 
 private:
     int n_ = 0, m_ = 0;

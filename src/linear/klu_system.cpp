@@ -118,6 +118,7 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries)
     for (int j = 0; j < N; ++j)
         colptr_[j + 1] += colptr_[j];
     values_.assign(entries.size(), 0.0);
+    std::vector<std::pair<int, int>>().swap(entries);  // freed before the factors' storage
     row_scale_.assign(N, 1.0);
     // Two orderings: KLU's AMD (least fill) and reverse Cuthill-McKee (a band). For
     // mechanism-like sparsity both fill about the same, and the band keeps KLU's pivoting in
@@ -150,8 +151,11 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries)
             expected_entries_ = rcm_fill_.entries;
         }
     }
-    // the factors' storage now: the first factorization allocates only if it fills more
-    lu_.reserve(N, static_cast<int>(rowind_.size()), expected_entries_);
+}
+
+void KluSystem::reserve_factors()
+{
+    lu_.reserve(N_, static_cast<int>(rowind_.size()), expected_entries_);
 }
 
 int KluSystem::slot(int row, int col) const

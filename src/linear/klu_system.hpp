@@ -50,6 +50,9 @@ public:
     // The next factorize() is a full one (new pivots and row scaling, KLU's factors allocated
     // again) instead of a refactorization with the pivots of an earlier matrix.
     void forget_pivots();
+    // The LU's workspace and the storage of its factors, for the fill of the ordering: the
+    // first factorization then allocates only if it fills more. Throws std::bad_alloc.
+    void reserve_factors();
     void solve(double *rhs);  // in place, length N
     // Reciprocal 1-norm condition estimate of the matrix factorized last, rows scaled as
     // factorized (KLU factorizes it once more for klu_condest: on demand, never in a step;

@@ -124,6 +124,7 @@ public:
     double rcond() const override { return S_.rcond_estimate(); }
     const char *name() const override { return "sparse KLU"; }
     void forget_pivots() override { S_.forget_pivots(); }
+    void reserve_factors() override { S_.reserve_factors(); }
 
 private:
     int n_ = 0, m_ = 0;
