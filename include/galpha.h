@@ -33,7 +33,7 @@
  * Memory is allocated by ga_create and ga_init (and by options that need more workspace once
  * it exists: ga_set_formulation to index 2, tangent options that call for finite differences,
  * the first adaptive step); ga_step never allocates. On the sparse path the storage of the
- * LU factors is reserved when the patterns are set up, from the fill of the ordering; a step
+ * LU factors is reserved with the workspace (ga_init), from the fill of the ordering; a step
  * that chooses new pivots (the first after a checkpoint is taken or restored, see
  * ga_get_state, or one whose refactorization with the old pivots comes out numerically
  * singular, pivot ratio below 1e-12) allocates only if its factors fill more than that.

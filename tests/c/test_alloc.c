@@ -219,10 +219,10 @@ static int chain_force_maybe_failing(double t, const double *q, const double *v,
 
 /* A checkpoint on the sparse path: the step after it chooses new pivots, as a restarted solver
  * does (a full factorization, the path a refactorization that comes out numerically singular
- * takes too). The factors' storage is reserved at setup from the fill of the ordering, so
- * that step allocates nothing (new pivots would only if they filled more); nor do the steps
- * after it, failed steps (which keep the pivots) included, nor the first step of a new solver
- * restored from the checkpoint. Index 3 and the stabilized index 2. */
+ * takes too). The factors' storage is reserved with the workspace, from the fill of the
+ * ordering, so that step allocates nothing (new pivots would only if they filled more); nor
+ * do the steps after it, failed steps (which keep the pivots) included, nor the first step of
+ * a new solver restored from the checkpoint. Index 3 and the stabilized index 2. */
 static void no_sparse_allocation_after_a_checkpoint(void **state)
 {
     (void)state;
