@@ -73,9 +73,10 @@ void FixedPivotLU::reserve(int N, int nnz, double expected_entries)
     Ux_.reserve(expected);
 }
 
-bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const double *values,
-                             const double *row_scale, const int *diagonal_row, const int *Q,
-                             double expected_entries)
+FixedPivotLU::Outcome FixedPivotLU::factorize(int N, const int *colptr, const int *rowind,
+                                              const double *values, const double *row_scale,
+                                              const int *diagonal_row, const int *Q,
+                                              double expected_entries, double fill_budget)
 {
     ready_ = false;
     N_ = N;
@@ -135,7 +136,7 @@ bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const 
         if (pivot < 0 || !(largest > 0.0) || !std::isfinite(largest)) {
             for (int t = top; t < N; ++t)
                 x[reach[t]] = 0.0;
-            return false;  // no usable pivot: singular
+            return Outcome::Singular;  // no usable pivot
         }
         const double d = x[pivot];
         pinv[pivot] = k;
@@ -153,6 +154,9 @@ bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const 
         }
         Lp_[k + 1] = static_cast<int>(Li_.size());
         Up_[k + 1] = static_cast<int>(Ui_.size());
+        if (fill_budget > 0.0 &&
+            static_cast<double>(std::max(Li_.size(), Ui_.size())) > fill_budget)
+            return Outcome::OverBudget;  // the work column is all zero again here
     }
 
     // Rows in pivot order: P_[k] is the pivot row of column k, L renumbered accordingly;
@@ -183,7 +187,7 @@ bool FixedPivotLU::factorize(int N, const int *colptr, const int *rowind, const 
         scale_[i] = row_scale[P_[i]];
     pivot_ratio_ = ratio_of(Ud_.data(), N);
     ready_ = true;
-    return true;
+    return Outcome::Factorized;
 }
 
 // Column j of P D A Q = L U, left-looking: scatter column Q_[j] of D A into the dense work

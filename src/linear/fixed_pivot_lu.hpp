@@ -23,16 +23,19 @@ public:
     // row the ordering put there), as KLU's default: it keeps the fill of the ordering.
     static constexpr double kDiagonalPreference = 1e-3;
 
+    enum class Outcome { Factorized, Singular, OverBudget };
     // LU factors of D A with pivots chosen now: A the N x N matrix in CSC form (colptr,
     // rowind, values; the pattern must stay alive and fixed while these factors are used),
     // D = diag(row_scale), column k of the factors from column Q[k] of A, whose diagonal row
     // is diagonal_row[k]. expected_entries: of L and of U each (storage reserved; more is
-    // allocated as needed). false if a column has no nonzero pivot candidate (singular; the
-    // factors are then not ready). Allocates the first time, and later only where new pivots
-    // fill more than earlier ones; throws std::bad_alloc.
-    bool factorize(int N, const int *colptr, const int *rowind, const double *values,
-                   const double *row_scale, const int *diagonal_row, const int *Q,
-                   double expected_entries);
+    // allocated as needed). Singular: a column has no nonzero pivot candidate. OverBudget: L
+    // or U grew past fill_budget entries (0: no budget) -- the pivots the values called for
+    // undo the ordering, and another ordering may do better. The factors are ready only when
+    // Factorized. Allocates the first time, and later only where new pivots fill more than
+    // earlier ones; throws std::bad_alloc.
+    Outcome factorize(int N, const int *colptr, const int *rowind, const double *values,
+                      const double *row_scale, const int *diagonal_row, const int *Q,
+                      double expected_entries, double fill_budget);
     // Allocates up front what factorize() needs for an N x N matrix with nnz entries whose
     // factors hold expected_entries each (at setup: the first factorization then allocates
     // only if it fills more). Throws std::bad_alloc.

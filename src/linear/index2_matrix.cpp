@@ -64,16 +64,16 @@ Index2Matrix::~Index2Matrix() = default;
 
 void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const ModelMatrix &M,
                          const ModelMatrix &J, const ModelMatrix &K, const ModelMatrix &C,
-                         const unsigned char *active)
+                         const unsigned char *active, bool amd_first)
 {
     active_ = active;
 #ifdef GALPHA_HAVE_KLU
     if (sparse) {
-        sparse_ = setup_sparse(n, m, M, J, K, C, active != nullptr);
+        sparse_ = setup_sparse(n, m, M, J, K, C, active != nullptr, amd_first);
         return;
     }
 #else
-    (void)sparse, (void)M, (void)J, (void)K, (void)C;
+    (void)sparse, (void)M, (void)J, (void)K, (void)C, (void)amd_first;
 #endif
     auto d = std::make_unique<Dense>();
     d->n = n;
@@ -112,9 +112,11 @@ std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
                                                                  const ModelMatrix &J,
                                                                  const ModelMatrix &K,
                                                                  const ModelMatrix &C,
-                                                                 bool with_inactive)
+                                                                 bool with_inactive,
+                                                                 bool amd_first)
 {
     auto s = std::make_unique<Sparse>();
+    const auto start = amd_first ? KluSystem::Ordering::Amd : KluSystem::Ordering::Auto;
     s->n = n;
     s->m = m;
     const std::vector<int> &Jr = J.row_index(), &Jc = J.col_index();
@@ -185,7 +187,7 @@ std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
     }
 
     if (s->reduced) {
-        s->S.setup(n + 2 * m, std::move(entries));
+        s->S.setup(n + 2 * m, std::move(entries), start);
         s->M = slots(M, false, 0, 0);
         s->C = slots(C, false, 0, 0);
         s->K = slots(K, false, 0, 0);
@@ -218,7 +220,7 @@ std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
                 entries.emplace_back(2 * n + i, 2 * n + i);
                 entries.emplace_back(2 * n + m + i, 2 * n + m + i);
             }
-        s->S.setup(2 * n + 2 * m, std::move(entries));
+        s->S.setup(2 * n + 2 * m, std::move(entries), start);
         s->K = slots(K, false, 0, 0);
         s->M = slots(M, false, 0, w0);
         s->C = slots(C, false, 0, w0);
@@ -466,6 +468,15 @@ const char *Index2Matrix::name() const
         return "sparse KLU (stabilized index-2)";
     return dense_ && !dense_->unblocked ? "dense Eigen LU (stabilized index-2)"
                                         : "dense unblocked LU (stabilized index-2)";
+}
+
+const char *Index2Matrix::ordering() const
+{
+#ifdef GALPHA_HAVE_KLU
+    if (sparse_)
+        return sparse_->S.ordering();
+#endif
+    return "";
 }
 
 }  // namespace ga

@@ -43,10 +43,11 @@ public:
     // Allocates everything (patterns of M, J, K, C: their layouts; B has J's). active: m
     // flags owned by the caller (null: every constraint active); an inactive constraint's
     // rows and columns (lambda_bar and eta_bar) are those of the identity, its right-hand side
-    // 0. dense_kind: the dense LU (Lapack counts as Eigen). Throws std::bad_alloc.
+    // 0. dense_kind: the dense LU (Lapack counts as Eigen). amd_first (tests): the sparse LU
+    // starts from AMD's ordering even where the band would be chosen. Throws std::bad_alloc.
     void setup(int n, int m, bool sparse, DenseKind dense_kind, const ModelMatrix &M,
                const ModelMatrix &J, const ModelMatrix &K, const ModelMatrix &C,
-               const unsigned char *active);
+               const unsigned char *active, bool amd_first = false);
     bool ready() const { return dense_ || sparse_; }
     bool sparse() const { return sparse_ != nullptr; }
     // sparse, in the reduced (n + 2m) form (else the augmented one, or dense)
@@ -61,6 +62,7 @@ public:
                const ModelMatrix &B, Vec &d, Vec &w, Vec &dlambda, Vec &eta_bar);
     double rcond() const;
     const char *name() const;
+    const char *ordering() const;  // sparse: the ordering in use ("AMD", "RCM"); else ""
     // The next factorization picks its pivots afresh (LinearBackend::forget_pivots).
     void forget_pivots();
     void reserve_factors();  // LinearBackend::reserve_factors
@@ -70,7 +72,8 @@ private:
     struct Sparse;
     static std::unique_ptr<Sparse> setup_sparse(int n, int m, const ModelMatrix &M,
                                                 const ModelMatrix &J, const ModelMatrix &K,
-                                                const ModelMatrix &C, bool with_inactive);
+                                                const ModelMatrix &C, bool with_inactive,
+                                                bool amd_first);
     const unsigned char *active_ = nullptr;
     std::unique_ptr<Dense> dense_;
     std::unique_ptr<Sparse> sparse_;

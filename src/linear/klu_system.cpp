@@ -17,6 +17,11 @@ namespace {
 constexpr double kBandFillAllowance = 1.5;
 // A refactorization with the old pivots is kept while its pivot ratio stays above this.
 constexpr double kRefactorRcond = 1e-12;
+// A full factorization whose L or U passes this many times the entries the ordering's
+// Cholesky count expects is stopped, and the other ordering taken: the pivots the values call
+// for undo the ordering (AMD's on the reduced index-2 system of a chain: 8x the count at 100
+// links, 22x at 300, 70x at 1 000, growing like N^2). Measured otherwise: at most 1.1x.
+constexpr double kFillBudget = 4.0;
 
 // Subnormal numbers flushed to zero inside the numeric kernels of the LU, and the caller's two mode
 // bits put back on the way out (no user code runs inside them; exception flags raised there
@@ -102,7 +107,7 @@ KluSystem::~KluSystem()
         klu_free_symbolic(&symbolic_, &common_);
 }
 
-void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries)
+void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries, Ordering start)
 {
     N_ = N;
     for (auto &e : entries)
@@ -127,35 +132,37 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries)
     // take the band unless it fills much more or costs many more operations to factorize (a
     // mesh in two or three dimensions, where the band is wide and fills solid: 3 to 6 times
     // slower refactorizations on 100 x 100 to 200 x 200 grids). Both orderings are measured
-    // alike (cholesky_fill): KLU estimates the fill of its own ordering only.
+    // alike (cholesky_fill): KLU estimates the fill of its own ordering only. The count is
+    // that of diagonal pivots; where pivoting undoes the ordering taken, the first full
+    // factorization finds out and takes the other one (factorize(), kFillBudget).
     symbolic_ = klu_analyze(N, colptr_.data(), rowind_.data(), &common_);
     if (!symbolic_)
         throw std::bad_alloc();
-    std::vector<int> order;
+    orders_[0].assign(symbolic_->Q, symbolic_->Q + N);  // AMD's, rows and columns alike
     {
         const std::vector<std::vector<int>> adj = symmetric_adjacency();  // freed before
-        amd_fill_ = cholesky_fill(adj, std::vector<int>(symbolic_->Q, symbolic_->Q + N),
-                                  std::numeric_limits<double>::infinity());
-        order = reverse_cuthill_mckee(adj);
-        rcm_fill_ = cholesky_fill(adj, order, kBandFillAllowance * amd_fill_.entries);
+        amd_fill_ = cholesky_fill(adj, orders_[0], std::numeric_limits<double>::infinity());
+        orders_[1] = reverse_cuthill_mckee(adj);
+        rcm_fill_ = cholesky_fill(adj, orders_[1], kBandFillAllowance * amd_fill_.entries);
     }
-    expected_entries_ = amd_fill_.entries;
-    if (rcm_fill_.entries <= kBandFillAllowance * amd_fill_.entries &&
-        rcm_fill_.flops <= kBandFillAllowance * amd_fill_.flops) {
-        klu_symbolic *banded = klu_analyze_given(N, colptr_.data(), rowind_.data(),
-                                                 order.data(), order.data(), &common_);
-        if (banded) {
-            klu_free_symbolic(&symbolic_, &common_);
-            symbolic_ = banded;
-            ordering_ = "RCM";
-            expected_entries_ = rcm_fill_.entries;
-        }
+    expected_[0] = amd_fill_.entries;
+    expected_[1] = rcm_fill_.entries;  // a lower bound where the count stopped
+    const bool band = rcm_fill_.entries <= kBandFillAllowance * amd_fill_.entries &&
+                      rcm_fill_.flops <= kBandFillAllowance * amd_fill_.flops;
+    in_use_ = start == Ordering::Band || (start == Ordering::Auto && band) ? 1 : 0;
+    switched_ = false;
+    if (in_use_ == 1) {
+        klu_free_symbolic(&symbolic_, &common_);
+        symbolic_ = klu_analyze_given(N, colptr_.data(), rowind_.data(), orders_[1].data(),
+                                      orders_[1].data(), &common_);
+        if (!symbolic_)
+            throw std::bad_alloc();
     }
 }
 
 void KluSystem::reserve_factors()
 {
-    lu_.reserve(N_, static_cast<int>(rowind_.size()), expected_entries_);
+    lu_.reserve(N_, static_cast<int>(rowind_.size()), expected_[in_use_]);
 }
 
 int KluSystem::slot(int row, int col) const
@@ -189,8 +196,20 @@ bool KluSystem::factorize()
         r = r > 0.0 ? 1.0 / r : 1.0;
     ++full_factorizations_;
     const FlushSubnormals flush;
-    if (!lu_.factorize(N_, colptr_.data(), rowind_.data(), values_.data(), row_scale_.data(),
-                       symbolic_->P, symbolic_->Q, expected_entries_)) {
+    auto factorize_in = [this](int which, double budget) {
+        const int *order = orders_[which].data();
+        return lu_.factorize(N_, colptr_.data(), rowind_.data(), values_.data(),
+                             row_scale_.data(), order, order, expected_[which], budget);
+    };
+    auto outcome = factorize_in(in_use_, switched_ ? 0.0 : kFillBudget * expected_[in_use_]);
+    if (outcome == FixedPivotLU::Outcome::OverBudget) {
+        // Pivoting undid this ordering: the other one, for good (this allocates its storage).
+        in_use_ = 1 - in_use_;
+        switched_ = true;
+        symbolic_stale_ = true;
+        outcome = factorize_in(in_use_, 0.0);
+    }
+    if (outcome != FixedPivotLU::Outcome::Factorized) {
         rcond_ = 0.0;
         return false;  // singular
     }
@@ -215,6 +234,15 @@ double KluSystem::rcond_estimate() const noexcept
     for (std::size_t k = 0; k < scaled.size(); ++k)
         scaled[k] *= row_scale_[rowind_[k]];
     int *colptr = const_cast<int *>(colptr_.data()), *rowind = const_cast<int *>(rowind_.data());
+    if (symbolic_stale_) {  // the LU switched ordering: KLU's analysis follows
+        int *order = const_cast<int *>(orders_[in_use_].data());
+        klu_symbolic *now = klu_analyze_given(N_, colptr, rowind, order, order, &common_);
+        if (!now)
+            return 0.0;
+        klu_free_symbolic(&symbolic_, &common_);
+        symbolic_ = now;
+        symbolic_stale_ = false;
+    }
     klu_numeric *numeric = klu_factor(colptr, rowind, scaled.data(), symbolic_, &common_);
     if (!numeric)
         return 0.0;

@@ -37,9 +37,11 @@ public:
     KluSystem(const KluSystem &) = delete;
     KluSystem &operator=(const KluSystem &) = delete;
 
+    // Which ordering the LU starts from: the one chosen by fill (Auto), or one forced (tests).
+    enum class Ordering { Auto, Amd, Band };
     // The pattern: (row, column) of every structural entry of the N x N matrix, duplicates
     // allowed. Throws std::bad_alloc.
-    void setup(int N, std::vector<std::pair<int, int>> entries);
+    void setup(int N, std::vector<std::pair<int, int>> entries, Ordering start = Ordering::Auto);
     // Position of entry (row, col) of the pattern in values() (setup time only).
     int slot(int row, int col) const;
     // The entries, in the order of the pattern: the caller assembles them before factorize().
@@ -47,8 +49,8 @@ public:
 
     // false if singular or numerically singular. Throws std::bad_alloc.
     bool factorize();
-    // The next factorize() is a full one (new pivots and row scaling, KLU's factors allocated
-    // again) instead of a refactorization with the pivots of an earlier matrix.
+    // The next factorize() is a full one (new pivots and row scaling) instead of a
+    // refactorization with the pivots of an earlier matrix.
     void forget_pivots();
     // The LU's workspace and the storage of its factors, for the fill of the ordering: the
     // first factorization then allocates only if it fills more. Throws std::bad_alloc.
@@ -58,7 +60,7 @@ public:
     // factorized (KLU factorizes it once more for klu_condest: on demand, never in a step;
     // allocates). 0 if singular, or if memory ran out.
     double rcond_estimate() const noexcept;
-    const char *ordering() const { return ordering_; }
+    const char *ordering() const { return names_[in_use_]; }  // "AMD" or "RCM", in use now
     // The Cholesky factor of S + S^T in AMD's ordering and in RCM's (the count of the latter
     // stops above 1.5 times the former's entries): what the choice was made on.
     const CholeskyFill &amd_fill() const { return amd_fill_; }
@@ -76,12 +78,21 @@ private:
     std::vector<double> row_scale_;  // D: 1 / the largest entry of each row at the last full
                                      // factorization
     mutable klu_common common_;  // klu_condest writes its result here
-    klu_symbolic *symbolic_ = nullptr;
-    FixedPivotLU lu_;     // the factors, with the pivots of KLU's last full factorization
+    // KLU's analysis in the ordering in use (for klu_condest); rebuilt on demand after a
+    // switch of ordering, which happens in a step
+    mutable klu_symbolic *symbolic_ = nullptr;
+    mutable bool symbolic_stale_ = false;
+    FixedPivotLU lu_;     // the factors, with the pivots of the last full factorization
     double rcond_ = 0.0;  // min |U_ii| / max |U_ii| (as klu_rcond): decides singularity
-    const char *ordering_ = "AMD";
     CholeskyFill amd_fill_, rcm_fill_;
-    double expected_entries_ = 0.0;  // in L (and in U) with the ordering taken: storage reserved
+    // The two orderings (AMD's, the band), their names and the entries of L (and of U) their
+    // Cholesky counts expect; the LU uses in_use_, and the other once if pivoting makes the
+    // first fill far beyond its count (factorize()).
+    std::vector<int> orders_[2];
+    const char *names_[2] = {"AMD", "RCM"};
+    double expected_[2] = {0.0, 0.0};
+    int in_use_ = 0;
+    bool switched_ = false;
     int full_factorizations_ = 0;
 };
 
