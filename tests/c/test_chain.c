@@ -306,6 +306,60 @@ static int recording_force(double t, const double *q, const double *v, double *f
     return chain_force(t, q, v, f, u);
 }
 
+/* A singular iteration matrix in the middle of a sparse run (Phi_q = 0 from the callback, for
+ * one step): GA_ERR_SINGULAR, the state bit-identical, and once Phi_q is back the next step
+ * equals that of a new solver restored from a checkpoint of the same state (both choose new
+ * pivots), index 3 and 2. */
+static int jacobian_vanishes; /* the test's switch for the callback below */
+static int vanishing_jacobian(double t, const double *q, double *J, void *user)
+{
+    const int st = chain_jacobian(t, q, J, user);
+    if (jacobian_vanishes)
+        memset(J, 0, sizeof(double) * (size_t)chain_pattern(user, GA_MATRIX_JACOBIAN, NULL, NULL));
+    return st;
+}
+
+static void singular_matrix_mid_run_sparse(void **state)
+{
+    (void)state;
+    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+        chain c = chain_make(20);
+        double q[60], v[60];
+        chain_initial(&c, q, v);
+        ga_solver *s = chain_solver(&c, 1), *r = chain_solver(&c, 1);
+        for (ga_solver *x = s; x; x = x == s ? r : NULL) {
+            assert_int_equal(ga_set_callbacks(x, chain_mass, chain_force, chain_constraint,
+                                              vanishing_jacobian, &c),
+                             GA_OK);
+            assert_int_equal(ga_set_linear_solver(x, GA_LINEAR_SPARSE), GA_OK);
+            assert_int_equal(ga_set_formulation(x, formulation), GA_OK);
+        }
+        jacobian_vanishes = 0;
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        for (int i = 0; i < 5; ++i)
+            assert_int_equal(ga_step(s, 1e-3), GA_OK);
+        double before[512], after[512];
+        size_t len = 0;
+        assert_int_equal(ga_state_size(s, &len), GA_OK);
+        assert_true(len <= 512);
+        assert_int_equal(ga_get_state(s, before, len), GA_OK);
+        jacobian_vanishes = 1;
+        assert_int_equal(ga_step(s, 1e-3), GA_ERR_SINGULAR);
+        assert_non_null(strstr(ga_last_error(s), "is singular"));
+        jacobian_vanishes = 0;
+        assert_int_equal(ga_get_state(s, after, len), GA_OK);
+        assert_memory_equal(before, after, len * sizeof(double));
+        assert_int_equal(ga_set_state(r, before, len), GA_OK);
+        assert_int_equal(ga_step(s, 1e-3), GA_OK);
+        assert_int_equal(ga_step(r, 1e-3), GA_OK);
+        assert_int_equal(ga_get_state(s, after, len), GA_OK);
+        assert_int_equal(ga_get_state(r, before, len), GA_OK);
+        assert_memory_equal(before, after, len * sizeof(double));
+        ga_free(s);
+        ga_free(r);
+    }
+}
+
 static void callers_floating_point_mode_is_kept(void **state)
 {
     (void)state;
@@ -352,6 +406,7 @@ int main(void)
         cmocka_unit_test(callers_floating_point_mode_is_kept),
 #endif
         cmocka_unit_test(sparse_and_dense_solvers_agree),
+        cmocka_unit_test(singular_matrix_mid_run_sparse),
         cmocka_unit_test(sparse_and_dense_index2_agree),
         cmocka_unit_test(index2_on_a_sparse_solver_set_up_already),
         cmocka_unit_test(grouped_finite_differences_match_exact_tangent),
