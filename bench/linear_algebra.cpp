@@ -1,5 +1,7 @@
 // The dense LUs (Eigen's blocked PartialPivLU, LAPACK's dgetrf/dgetrs, galpha's unblocked
-// kernel) against each other and against the sparse KLU path, on real iteration matrices:
+// kernel) against each other and against the sparse path (galpha's sparse LU in KLU's
+// ordering; its rows are named "klu" for continuity with earlier runs), on real iteration
+// matrices:
 // those of the paper's scenes (dense) and of the N-link chain (dense and sparse, from the same
 // declared pattern); and, for the other end of the range, saddle-point matrices without zeros
 // (full mass matrix, full constraint Jacobian: "full"), where blocking pays. Factorization

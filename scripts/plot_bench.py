@@ -102,15 +102,16 @@ if ch:
 la = rows("linear_algebra.csv")
 if la:
     fig, ax = plt.subplots(1, 2, figsize=(13, 4.8))
-    styles = (("unblocked", "d-"), ("eigen", "o-"), ("lapack", "s-"), ("klu", "^-"),
+    styles = (("unblocked", "d-"), ("eigen", "o-"), ("lapack", "s-"),
+              ("klu", "^-", "sparse path (KLU's ordering, galpha's LU)"),
               ("eigen_sparselu", "v-"))
     for panel, matrix, title in ((0, "chain", "mechanism matrices: the chain (2-7 % nonzero)"),
                                  (1, "full", "saddle-point matrices without zeros")):
-        for backend, style in styles:
+        for backend, style, *label in styles:
             pts = sorted((num(r["size"]), num(r["factorize_us"])) for r in la
                          if r["backend"] == backend and r["matrix"] == matrix)
             if pts:
-                ax[panel].loglog(*zip(*pts), style, label=backend)
+                ax[panel].loglog(*zip(*pts), style, label=label[0] if label else backend)
         ax[panel].set(xlabel="unknowns n + m", ylabel="assembly + factorization [us]",
                       title=title)
         ax[panel].grid(True, which="both", lw=0.3)
@@ -122,7 +123,7 @@ if la:
     ax[0].legend(title="gray: paper's scenes, dense")
     ax[1].legend()
     fig.suptitle("LU of the iteration matrix: galpha's unblocked kernel, Eigen, reference "
-                 "LAPACK (dense); KLU, Eigen SparseLU (sparse)")
+                 "LAPACK (dense); galpha's sparse LU, Eigen SparseLU (sparse)")
     save(fig, "linear_algebra.png")
 
 
