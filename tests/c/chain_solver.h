@@ -24,4 +24,16 @@ static inline ga_solver *chain_solver(chain *c, int exact_tangent)
     return s;
 }
 
+/* The chain on the sparse path in the given formulation, exact K_t, with force and Jacobian
+ * callbacks of the test's (wrappers that inject faults or record what they see). */
+static inline ga_solver *sparse_chain_solver(chain *c, ga_force_fn force, ga_jacobian_fn jacobian,
+                                             int formulation)
+{
+    ga_solver *s = chain_solver(c, 1);
+    assert_int_equal(ga_set_callbacks(s, chain_mass, force, chain_constraint, jacobian, c), GA_OK);
+    assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    return s;
+}
+
 #endif

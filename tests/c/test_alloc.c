@@ -230,12 +230,8 @@ static void no_sparse_allocation_after_a_checkpoint(void **state)
         chain c = chain_make(50);
         double q[150], v[150];
         chain_initial(&c, q, v);
-        ga_solver *s = chain_solver(&c, 1);
-        assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force_maybe_failing,
-                                          chain_constraint, chain_jacobian, &c),
-                         GA_OK);
-        assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
-        assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+        ga_solver *s =
+            sparse_chain_solver(&c, chain_force_maybe_failing, chain_jacobian, formulation);
         assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
         for (int i = 0; i < 5; ++i)
             assert_int_equal(ga_step(s, 1e-3), GA_OK);
@@ -269,9 +265,7 @@ static void no_sparse_allocation_after_a_checkpoint(void **state)
         assert_int_equal(first, 0);
         assert_int_equal(allocations, 0);
         /* a new solver restored from the checkpoint */
-        ga_solver *r = chain_solver(&c, 1);
-        assert_int_equal(ga_set_linear_solver(r, GA_LINEAR_SPARSE), GA_OK);
-        assert_int_equal(ga_set_formulation(r, formulation), GA_OK);
+        ga_solver *r = sparse_chain_solver(&c, chain_force, chain_jacobian, formulation);
         assert_int_equal(ga_set_state(r, ckpt, len), GA_OK);
         allocations = 0;
         armed = 1;

@@ -326,14 +326,8 @@ static void singular_matrix_mid_run_sparse(void **state)
         chain c = chain_make(20);
         double q[60], v[60];
         chain_initial(&c, q, v);
-        ga_solver *s = chain_solver(&c, 1), *r = chain_solver(&c, 1);
-        for (ga_solver *x = s; x; x = x == s ? r : NULL) {
-            assert_int_equal(ga_set_callbacks(x, chain_mass, chain_force, chain_constraint,
-                                              vanishing_jacobian, &c),
-                             GA_OK);
-            assert_int_equal(ga_set_linear_solver(x, GA_LINEAR_SPARSE), GA_OK);
-            assert_int_equal(ga_set_formulation(x, formulation), GA_OK);
-        }
+        ga_solver *s = sparse_chain_solver(&c, chain_force, vanishing_jacobian, formulation),
+                  *r = sparse_chain_solver(&c, chain_force, vanishing_jacobian, formulation);
         jacobian_vanishes = 0;
         assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
         for (int i = 0; i < 5; ++i)
@@ -378,12 +372,7 @@ static void callers_floating_point_mode_is_kept(void **state)
             const unsigned caller = mode ? original | flush_to_zero : original & ~flush_to_zero;
             _mm_setcsr(caller);
             chain_initial(&c, q, v);
-            ga_solver *s = chain_solver(&c, 1);
-            assert_int_equal(ga_set_callbacks(s, chain_mass, recording_force, chain_constraint,
-                                              chain_jacobian, &c),
-                             GA_OK);
-            assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
-            assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+            ga_solver *s = sparse_chain_solver(&c, recording_force, chain_jacobian, formulation);
             seen_count = 0;
             assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
             for (int k = 0; k < 5; ++k)
