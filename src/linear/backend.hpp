@@ -39,7 +39,7 @@ public:
     virtual bool factorize(const SaddleBlocks &b) = 0;
     virtual void solve(Vec &rhs) = 0;  // in place, length n + m
     // Reciprocal condition estimate of the last factorization (dense: LAPACK dgecon, 1-norm;
-    // sparse: KLU's min |U_ii| / max |U_ii|).
+    // sparse: KLU's klu_condest, 1-norm, on a factorization made for it).
     virtual double rcond() const = 0;
     virtual const char *name() const = 0;
     // The next factorization chooses its pivots (and the sparse row scaling) afresh, as in a

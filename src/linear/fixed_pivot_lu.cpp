@@ -4,20 +4,23 @@
 #include <cmath>
 #include <utility>
 
+#include "../types.hpp"
+
 namespace ga {
 
 namespace {
 // min |d_i| / max |d_i|; 0 if an entry is not finite or all are zero
 double ratio_of(const double *d, int N)
 {
-    double lo = HUGE_VAL, hi = 0.0, finite = 0.0;
+    if (!all_finite(d, N))
+        return 0.0;
+    double lo = HUGE_VAL, hi = 0.0;
     for (int i = 0; i < N; ++i) {
         const double a = std::abs(d[i]);
         lo = a < lo ? a : lo;
         hi = a > hi ? a : hi;
-        finite += 0.0 * d[i];  // stays 0 unless some d_i is Inf or NaN
     }
-    return finite == 0.0 && hi > 0.0 ? lo / hi : 0.0;
+    return hi > 0.0 ? lo / hi : 0.0;
 }
 
 // The rows of column k of L and U: those reached from the rows of A's column [first, last)
