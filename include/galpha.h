@@ -257,7 +257,8 @@ GA_API ga_status ga_get_params(const ga_solver *s, double *alpha_m, double *alph
  *  The test is on the Newton increments, relative and per quantity: a step is converged when
  *  the last increments satisfy |dq| <= tol |q|, |beta' dq| <= tol |qdd| and
  *  |dlambda| <= tol |lambda| (max-norms), or when the iteration has stagnated at round-off
- *  (|dq| within a few ulps of |q| and no more contraction). Why not the paper's absolute test
+ *  (|dq| within a few ulps of |q|: once, if the matrix was factorized in this step near the
+ *  current q, otherwise twice in a row). Why not the paper's absolute test
  *  on the scaled residual: the residual of the dynamics is scaled by beta h^2, so once h is
  *  small the test accepts unconverged accelerations and multipliers (at h = 1e-6 it accepts
  *  the predictor with lambda = 0). An increment test in the units of each quantity keeps its

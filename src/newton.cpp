@@ -53,11 +53,18 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &s
     if (theta >= 0.0 && theta < 1.0 && eta * theta / (1.0 - theta) <= 1.0)
         return Verdict::Converged;
 
-    // Round-off exit: positions no longer move. With q fixed the equations are linear in qdd
-    // and lambda, so the iteration after the first such increment has already corrected them.
+    // Round-off exit: positions no longer move. With q fixed the equations are linear in
+    // lambda (qdd follows q, eq. 7), so the update that found q in place has corrected lambda
+    // as far as the matrix's Phi_q^T is that of the current q: at once if the matrix is of
+    // this step and q has moved within the tolerance since (the accelerations' increment dw
+    // at round-off too, for the index-2 form, where it differs from dq); otherwise after a
+    // second such increment.
     const double roundoff = 64.0 * std::numeric_limits<double>::epsilon() * q_norm;
     const bool dq_at_roundoff = dq_norm <= roundoff;
-    const bool stop = dq_at_roundoff && previous_dq_at_roundoff_;
+    moved_since_matrix_ += relative(dq_norm, tol, q_norm);
+    const bool matrix_current =
+        fresh_matrix_ && moved_since_matrix_ <= 1.0 && size.dw <= roundoff;
+    const bool stop = dq_at_roundoff && (previous_dq_at_roundoff_ || matrix_current);
     previous_dq_at_roundoff_ = dq_at_roundoff;
     if (stop)
         return Verdict::Converged;

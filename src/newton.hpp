@@ -13,9 +13,17 @@
 //     eta theta / (1 - theta), is <= 1 (theta from the last two increments; in the first
 //     iteration with a reused matrix, from the previous step, as SUNDIALS IDA does), or
 //   - the iteration has reached round-off: two successive position increments within a few
-//     ulps of |q|. This exit is needed because index-3 accelerations and multipliers are only
-//     determined to ~eps |q| / (beta h^2) (paper, sec. 3.3), which exceeds tol |lambda| once h
-//     is small enough.
+//     ulps of |q|, or one if the matrix was factorized in this step at an iterate within
+//     tol |q| of the current one. This exit is needed because index-3 accelerations and
+//     multipliers are only determined to ~eps |q| / (beta h^2) (paper, sec. 3.3), which
+//     exceeds tol |lambda| once h is small enough or |q| large (a chain of 10 000 links at
+//     h = 1e-3 and tol = 1e-10: increments of lambda stay at ~4e5 tol |lambda|).
+//     Why one can suffice: an increment that leaves q in place was computed from a residual
+//     at (nearly) the final q, where the equations are linear in lambda; the update solved
+//     them with the matrix's Phi_q^T, exact up to the change of Phi_q since the
+//     factorization. With a matrix of this step that change is within the tolerance, so a
+//     further iteration would only add round-off of the same size (measured: the third
+//     increment equals the second to 1 %).
 // Verdict Slow: at the measured rate the iteration cannot reach the tolerance within a budget
 // of 4 iterations with one matrix (the criterion of SciPy's Radau, with IDA's maxcor), so a
 // reused matrix should be rebuilt now rather than iterated on.
@@ -47,6 +55,8 @@ public:
         rate_ = -1.0;
         previous_dq_at_roundoff_ = false;
         with_matrix_ = 0;
+        fresh_matrix_ = false;
+        moved_since_matrix_ = 0.0;
     }
     // The iteration matrix was rebuilt: rates across the change mean nothing.
     void matrix_changed()
@@ -54,6 +64,8 @@ public:
         previous_ratio_ = -1.0;
         theta_prev_ = -1.0;
         with_matrix_ = 0;
+        fresh_matrix_ = true;
+        moved_since_matrix_ = 0.0;
     }
 
     // size.dq: of the position increment; size.dw: of the increment that moves the
@@ -72,6 +84,8 @@ private:
     double ratio_ = 0.0, previous_ratio_ = -1.0, theta_prev_ = -1.0, rate_ = -1.0;
     bool previous_dq_at_roundoff_ = false;
     int with_matrix_ = 0;  // iterations with the current matrix in this step
+    bool fresh_matrix_ = false;        // the matrix was factorized in this step
+    double moved_since_matrix_ = 0.0;  // sum of |dq| / (tol |q|) since then
 };
 
 }  // namespace ga

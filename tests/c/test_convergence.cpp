@@ -1,0 +1,116 @@
+// The Newton stopping test (src/newton.hpp), fed update sizes directly: the round-off exit.
+// The numbers are those of a chain of 10 000 links at h = 1e-3, tol = 1e-10 (|q| = 1e4): after
+// the first update the positions are converged, but the multipliers keep moving by ~4e5 tol
+// |lambda|, the round-off of accelerations known to eps |q| / (beta h^2). Whether one update
+// at round-off ends the step depends on where the matrix comes from (newton.hpp's comment).
+#include <limits>
+
+#include "newton.hpp"
+
+// cmocka last: its fail() macro would clash with the standard library's
+#include <cstdarg>
+#include <cstddef>
+#include <cstdint>
+#include <csetjmp>
+extern "C" {
+#include <cmocka.h>
+}
+
+namespace {
+
+using ga::ConvergenceTest;
+using ga::UpdateSizes;
+using Verdict = ConvergenceTest::Verdict;
+
+constexpr double kTol = 1e-10, kBetaPrime = 3.3e6, kQ = 1e4, kQdd = 10.0, kLambda = 1e5;
+constexpr double kUlp = std::numeric_limits<double>::epsilon();
+
+// An update of positions by dq (the accelerations move by beta' dq) and multipliers by dl.
+UpdateSizes update(double dq, double dl)
+{
+    UpdateSizes u;
+    u.dq = u.dw = dq;
+    u.dlambda = dl;
+    u.q = kQ;
+    u.qdd = kQdd;
+    u.lambda = kLambda;
+    return u;
+}
+
+// first update from the predictor: positions off by 5e-3 tol |q|, multipliers by 3e9 tol
+const UpdateSizes kFirst = update(5e-3 * kTol * kQ, 3e9 * kTol * kLambda);
+// then at round-off: positions by 1 ulp of |q|, multipliers by 4e5 tol |lambda|
+const UpdateSizes kAtRoundoff = update(kUlp * kQ, 4e5 * kTol * kLambda);
+
+void fresh_matrix_ends_at_the_first_roundoff_update(void **state)
+{
+    (void)state;
+    ConvergenceTest c;
+    c.reset(-1.0);
+    c.matrix_changed();  // factorized in this step, at the predictor
+    assert_true(c.check(kTol, kFirst, kBetaPrime) == Verdict::Continue);
+    // the rate (4e5 / 3e9) predicts an error of 53 tol: not converged by the rate test, but
+    // at round-off with the matrix of this step
+    assert_true(c.check(kTol, kAtRoundoff, kBetaPrime) == Verdict::Converged);
+}
+
+void old_matrix_needs_a_second_roundoff_update(void **state)
+{
+    (void)state;
+    ConvergenceTest c;
+    c.reset(-1.0);  // a matrix of an earlier step: its Phi_q is not that of this q
+    assert_true(c.check(kTol, kFirst, kBetaPrime) == Verdict::Continue);
+    assert_true(c.check(kTol, kAtRoundoff, kBetaPrime) == Verdict::Continue);
+    assert_true(c.check(kTol, kAtRoundoff, kBetaPrime) == Verdict::Converged);
+}
+
+void fresh_matrix_far_from_the_iterate_needs_a_second(void **state)
+{
+    (void)state;
+    ConvergenceTest c;
+    c.reset(-1.0);
+    c.matrix_changed();
+    // the first update moved q by 3 tol |q| after the factorization
+    assert_true(c.check(kTol, update(3.0 * kTol * kQ, 3e9 * kTol * kLambda), kBetaPrime) ==
+                Verdict::Continue);
+    assert_true(c.check(kTol, kAtRoundoff, kBetaPrime) == Verdict::Continue);
+    assert_true(c.check(kTol, kAtRoundoff, kBetaPrime) == Verdict::Converged);
+}
+
+void index2_waits_for_its_newmark_increment(void **state)
+{
+    (void)state;
+    ConvergenceTest c;
+    c.reset(-1.0);
+    c.matrix_changed();
+    assert_true(c.check(kTol, kFirst, kBetaPrime) == Verdict::Continue);
+    UpdateSizes u = kAtRoundoff;
+    u.dw = 1e3 * kUlp * kQ;  // the accelerations' increment still above round-off
+    assert_true(c.check(kTol, u, kBetaPrime) == Verdict::Continue);
+}
+
+void a_new_step_forgets_the_fresh_matrix(void **state)
+{
+    (void)state;
+    ConvergenceTest c;
+    c.reset(-1.0);
+    c.matrix_changed();
+    assert_true(c.check(kTol, kFirst, kBetaPrime) == Verdict::Continue);
+    c.reset(-1.0);  // next step, same matrix
+    assert_true(c.check(kTol, kFirst, kBetaPrime) == Verdict::Continue);
+    assert_true(c.check(kTol, kAtRoundoff, kBetaPrime) == Verdict::Continue);
+}
+
+}  // namespace
+
+int main()
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(fresh_matrix_ends_at_the_first_roundoff_update),
+        cmocka_unit_test(old_matrix_needs_a_second_roundoff_update),
+        cmocka_unit_test(fresh_matrix_far_from_the_iterate_needs_a_second),
+        cmocka_unit_test(index2_waits_for_its_newmark_increment),
+        cmocka_unit_test(a_new_step_forgets_the_fresh_matrix),
+    };
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
