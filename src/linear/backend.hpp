@@ -38,6 +38,15 @@ public:
     // Assemble and factorize; false if singular or numerically singular.
     virtual bool factorize(const SaddleBlocks &b) = 0;
     virtual void solve(Vec &rhs) = 0;  // in place, length n + m
+    // [x1; x2 * div2] = S^{-1} [c1 b1; c2 b2] without a vector of length n + m in between
+    // (b1, x1 of length n; b2, x2 of m; b is read whole before x is written, so they may be
+    // the same vectors). false: not offered, use solve().
+    virtual bool solve_blocks(const Vec &b1, double c1, const Vec &b2, double c2, Vec &x1,
+                              Vec &x2, double div2)
+    {
+        (void)b1, (void)c1, (void)b2, (void)c2, (void)x1, (void)x2, (void)div2;
+        return false;
+    }
     // Reciprocal condition estimate of the last factorization (dense: LAPACK dgecon, 1-norm;
     // sparse: KLU's klu_condest, 1-norm, on a factorization made for it).
     virtual double rcond() const = 0;

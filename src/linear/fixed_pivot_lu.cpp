@@ -62,7 +62,7 @@ int reach_of(int k, const int *first, const int *last, const int *Lp, const int 
 
 void FixedPivotLU::reserve(int N, int nnz, double expected_entries)
 {
-    for (auto *v : {&pinv_, &mark_, &reach_, &stack_, &next_, &P_, &Q_})
+    for (auto *v : {&pinv_, &mark_, &reach_, &stack_, &next_, &P_, &Q_, &qinv_})
         v->reserve(N);
     for (auto *v : {&Lp_, &Up_})
         v->reserve(N + 1);
@@ -85,6 +85,9 @@ FixedPivotLU::Outcome FixedPivotLU::factorize(int N, const int *colptr, const in
     N_ = N;
     colptr_ = colptr;
     Q_.assign(Q, Q + N);
+    qinv_.resize(N);
+    for (int k = 0; k < N; ++k)
+        qinv_[Q[k]] = k;
     // During the factorization, rows keep their own numbers: row i is the pivot of column
     // pinv[i] once chosen (-1 before); L's row indices are renumbered at the end. The
     // workspace and the factors' storage stay from one full factorization to the next: new
@@ -233,10 +236,48 @@ double FixedPivotLU::refactor(const double *values)
 void FixedPivotLU::solve(double *rhs)
 {
     double *w = work_.data();
-    const int *Lp = Lp_.data(), *Li = Li_.data(), *Up = Up_.data(), *Ui = Ui_.data();
-    const double *Lx = Lx_.data(), *Ux = Ux_.data();
     for (int i = 0; i < N_; ++i)
         w[i] = scale_[i] * rhs[P_[i]];
+    sweeps(w);
+    for (int k = 0; k < N_; ++k) {
+        rhs[Q_[k]] = w[k];
+        w[k] = 0.0;  // the work column stays zero between calls (refactor relies on it)
+    }
+}
+
+// As solve(), walking b and x in their own order: row r of b goes to row pinv_[r] of w,
+// column c of x comes from row qinv_[c] of z (clearing it, as solve() does).
+void FixedPivotLU::solve_blocks(const double *b1, double c1, const double *b2, double c2,
+                                int n1, double *x1, double *x2, double div2)
+{
+    double *w = work_.data();
+    const int *pinv = pinv_.data(), *qinv = qinv_.data();
+    const double *D = scale_.data();
+    for (int r = 0; r < n1; ++r) {
+        const int i = pinv[r];
+        w[i] = D[i] * (c1 * b1[r]);
+    }
+    for (int r = n1; r < N_; ++r) {
+        const int i = pinv[r];
+        w[i] = D[i] * (c2 * b2[r - n1]);
+    }
+    sweeps(w);
+    for (int c = 0; c < n1; ++c) {
+        const int k = qinv[c];
+        x1[c] = w[k];
+        w[k] = 0.0;
+    }
+    for (int c = n1; c < N_; ++c) {
+        const int k = qinv[c];
+        x2[c - n1] = w[k] / div2;
+        w[k] = 0.0;
+    }
+}
+
+void FixedPivotLU::sweeps(double *w) const
+{
+    const int *Lp = Lp_.data(), *Li = Li_.data(), *Up = Up_.data(), *Ui = Ui_.data();
+    const double *Lx = Lx_.data(), *Ux = Ux_.data();
     for (int k = 0; k < N_; ++k) {
         const double y = w[k];
         for (int q = Lp[k]; q < Lp[k + 1]; ++q)
@@ -247,10 +288,6 @@ void FixedPivotLU::solve(double *rhs)
         w[k] = z;
         for (int p = Up[k]; p < Up[k + 1]; ++p)
             w[Ui[p]] -= Ux[p] * z;
-    }
-    for (int k = 0; k < N_; ++k) {
-        rhs[Q_[k]] = w[k];
-        w[k] = 0.0;  // the work column stays zero between calls (refactor relies on it)
     }
 }
 

@@ -60,6 +60,10 @@ bool IterationMatrix::factorize_projection(const ModelMatrix &J)
 
 void IterationMatrix::solve(const Vec &r1, const Vec &r2, Vec &x1, Vec &x2, double row_scale)
 {
+    // D_L r in, D_R x_bar out, straight from and into the caller's vectors where the backend
+    // can (the sparse LU): no pass over an n + m vector each way
+    if (!active_ && backend_->solve_blocks(r1, -row_scale, r2, -1.0, x1, x2, row_scale))
+        return;
     rhs_.head(n_) = -row_scale * r1;  // D_L r
     if (m_ > 0) {
         rhs_.tail(m_) = -r2;

@@ -259,6 +259,13 @@ void KluSystem::solve(double *rhs)
     lu_.solve(rhs);  // (D S) x = D b: lu_ scales b
 }
 
+void KluSystem::solve_blocks(const double *b1, double c1, const double *b2, double c2, int n1,
+                             double *x1, double *x2, double div2)
+{
+    const FlushSubnormals flush;
+    lu_.solve_blocks(b1, c1, b2, c2, n1, x1, x2, div2);
+}
+
 // The pattern of S + S^T without the diagonal, as sorted neighbour lists.
 std::vector<std::vector<int>> KluSystem::symmetric_adjacency() const
 {

@@ -56,6 +56,9 @@ public:
     // first factorization then allocates only if it fills more. Throws std::bad_alloc.
     void reserve_factors();
     void solve(double *rhs);  // in place, length N
+    // the same with b and x in two blocks (FixedPivotLU::solve_blocks)
+    void solve_blocks(const double *b1, double c1, const double *b2, double c2, int n1,
+                      double *x1, double *x2, double div2);
     // Reciprocal 1-norm condition estimate of the matrix factorized last, rows scaled as
     // factorized (KLU factorizes it once more for klu_condest: on demand, never in a step;
     // allocates). 0 if singular, or if memory ran out.

@@ -120,6 +120,12 @@ public:
     }
 
     void solve(Vec &rhs) override { S_.solve(rhs.data()); }
+    bool solve_blocks(const Vec &b1, double c1, const Vec &b2, double c2, Vec &x1, Vec &x2,
+                      double div2) override
+    {
+        S_.solve_blocks(b1.data(), c1, b2.data(), c2, n_, x1.data(), x2.data(), div2);
+        return true;
+    }
 
     double rcond() const override { return S_.rcond_estimate(); }
     const char *name() const override { return "sparse KLU"; }

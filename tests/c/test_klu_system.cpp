@@ -224,6 +224,16 @@ void random_patterns_against_dense_lu(void **)
             const double ratio = (x - x_ref).norm() / x_ref.norm() / limit;
             assert_true(ratio < N);  // growth near 1: far below N
             worst = std::max(worst, ratio);
+            // b and x in two blocks: bit for bit what the copies in and out around solve() give
+            const int n1 = N / 3;
+            const Eigen::VectorXd b1 = b.head(n1), b2 = b.tail(N - n1);
+            Eigen::VectorXd x1(n1), x2(N - n1), y(N);
+            S.solve_blocks(b1.data(), -0.7, b2.data(), -1.0, n1, x1.data(), x2.data(), 2.5);
+            y.head(n1) = -0.7 * b1;
+            y.tail(N - n1) = -b2;
+            S.solve(y.data());
+            assert_true((x1.array() == y.head(n1).array()).all());
+            assert_true((x2.array() == (y.tail(N - n1) / 2.5).array()).all());
             ++matrices;
         }
         full += S.full_factorizations();
