@@ -22,7 +22,7 @@ bool recoverable(ga_status st)
 }  // namespace
 
 // Weighted RMS norm of the local error estimates of the step just computed (trial_ from
-// accepted_ with a_n_), over positions and velocities; multipliers are not part of it, as in
+// accepted_ with a_n), over positions and velocities; multipliers are not part of it, as in
 // index-aware DAE codes (sec. 1.5d).
 //   positions (sec. 1.5a): e_q = h^2 (beta + delta_alpha/2 - 1/6) (a_{n+1} - a_n)
 //   velocities (sec. 1.5b): e_v = C_v h^3 qdddd with C_v = 1/12 - delta_alpha^2
@@ -41,10 +41,11 @@ double Solver::error_norm(double h)
     const double cq = h * h * (p.beta + 0.5 * da - 1.0 / 6.0);
     const double cv = 1.0 / 12.0 - da * da + da * (p.alpha_m - 0.5);
     Vec &eq = dq_, &ev = dw_;  // scratch
-    eq = cq * (x.a - a_n_);
+    const Vec &a_n = *a_start_;
+    eq = cq * (x.a - a_n);
     if (s.h_last > 0.0)
         ev = (cv * h * h * h / (0.5 * (h + s.h_last))) *
-             ((x.a - a_n_) / h - (s.a - s.a_prev) / s.h_last);
+             ((x.a - a_n) / h - (s.a - s.a_prev) / s.h_last);
     else
         ev.setZero();
     if (m_ > 0 && P_.ready()) {

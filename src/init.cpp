@@ -188,6 +188,7 @@ ga_status Solver::starting_values(double h)
     }
     qdd_tmp_ = 0.5 * (x.a - x.a_prev);  // h qddd_0
     a_n_ = s.qdd + delta_alpha * qdd_tmp_;
+    a_start_ = &a_n_;
     if (formulation == GA_INDEX3 && m_ > 0) {
         // [M Phi_q^T; Phi_q 0] [dv; dlambda] = [0; Phi_q l_0 / h] at the start
         if (auto st = consistent_accelerations(s.t, s.q, s.v, x.qdd, x.lambda))
@@ -198,6 +199,7 @@ ga_status Solver::starting_values(double h)
         rq_.setZero();
         S_.solve(rq_, phi_, dw_, dlambda_);
         v_n_ = s.v + dw_;
+        v_start_ = &v_n_;
     }
     return GA_OK;
 }

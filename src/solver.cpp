@@ -120,7 +120,6 @@ Solver::Solver(int n, int m)
     previous_.allocate(n, m);
     a_n_.setZero(n);
     v_n_.setZero(n);
-    lambda_n_.setZero(m);
     M_.set_dense(n, n);
     J_.set_dense(m, n);
     K_.set_dense(n, n);
@@ -313,18 +312,18 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     // The start of the step. a_n carries the shift delta_alpha h_last; rescaled to the h of
     // this step the scheme stays second order under any sequence of step sizes (ALGORITHMS.md
     // sec. 1.2): a_n <- qdd_n + (h / h_last) (a_n - qdd_n).
-    if (rescale_a && s.h_last > 0.0 && h != s.h_last)
+    a_start_ = &s.a;
+    v_start_ = &s.v;
+    if (rescale_a && s.h_last > 0.0 && h != s.h_last) {
         a_n_ = s.qdd + (h / s.h_last) * (s.a - s.qdd);
-    else
-        a_n_ = s.a;
-    v_n_ = s.v;
-    lambda_n_ = s.lambda;
+        a_start_ = &a_n_;
+    }
     const bool long_after_short = s.h_last > 0.0 && h > kShortStepRatio * s.h_last;
     if ((start_pending_ || long_after_short) && corrected_start) {
-        if (auto st = starting_values(h))
+        if (auto st = starting_values(h))  // sets a_start_ and, in index 3, v_start_
             return st;
     } else if (long_after_short) {
-        a_n_ = s.qdd;
+        a_start_ = &s.qdd;
     }
 
     // After a reused matrix was too slow, the next steps start with a fresh one; how many
@@ -367,9 +366,14 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
                          max_iter, s.t, h, convergence_.ratio());
     State &x = trial_;  // finite: every Newton update checked it
     const Params &p = params;
-    // Algorithm 1, last line: a_{n+1} from eq. (3) with the converged qdd_{n+1}.
-    x.a = (p.alpha_f * s.qdd - p.alpha_m * a_n_ + (1.0 - p.alpha_f) * x.qdd) / (1.0 - p.alpha_m);
-    x.a_prev = a_n_;
+    // Algorithm 1, last line: a_{n+1} from eq. (3) with the converged qdd_{n+1}; a_n kept for
+    // the error estimate of the next step (one pass for both)
+    const Vec &a_n = *a_start_;
+    for (Eigen::Index i = 0; i < n_; ++i) {
+        x.a[i] = (p.alpha_f * s.qdd[i] - p.alpha_m * a_n[i] + (1.0 - p.alpha_f) * x.qdd[i]) /
+                 (1.0 - p.alpha_m);
+        x.a_prev[i] = a_n[i];
+    }
     x.t = s.t + h;
     x.h_last = h;
     if (convergence_.rate() >= 0.0)
@@ -421,7 +425,7 @@ ga_status Solver::sliver_step(double h)
     x.a = s.a + qdd_tmp_;
     x.a_prev = s.a_prev + qdd_tmp_;
     x.h_last = s.h_last;
-    a_n_ = x.a;  // for the error estimate of adaptive steps: none from this step
+    a_start_ = &x.a;  // for the error estimate of adaptive steps: none from this step
     last_newton_iters_ = 0;
     return GA_OK;
 }
@@ -488,32 +492,49 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
     const double row_scale = step_row_scale(p, h, scaling);
     const bool index2 = formulation == GA_INDEX2_STABILIZED;
     const State &s = accepted_;
-    const Vec &a_n = a_n_, &v_n = v_n_;
+    const Vec &a_n = *a_start_, &v_n = *v_start_;
     State &x = trial_;
     const double t1 = s.t + h;
 
     // Predictor (Algorithm 1, lines 1-7). The paper starts from qdd_{n+1} = 0, lambda = 0;
     // the others start from a_{n+1} = a_n, or from qdd extrapolated linearly; lambda_n.
-    // All iterate to the same solution.
+    // All iterate to the same solution. One pass over the vectors (at 100 000 chain links
+    // the separate passes moved 40 MB per step).
     const double delta_alpha = p.alpha_m - p.alpha_f;
-    if (predictor == GA_PREDICTOR_ZERO) {
-        x.qdd.setZero();
-        x.lambda.setZero();
-    } else if (predictor == GA_PREDICTOR_EXTRAPOLATE && delta_alpha != 0.0 && s.h_last > 0.0) {
-        // a_n - qdd_n = delta_alpha h_last qddd + O(h^2) (ALGORITHMS.md sec. 0), hence
-        // qdd(t_n + h) = qdd_n + (h / h_last) (a_n - qdd_n) / delta_alpha + O(h^2).
-        x.qdd = s.qdd + (h / (s.h_last * delta_alpha)) * (s.a - s.qdd);
-        x.lambda = lambda_n_;
-    } else {
-        x.qdd = (a_n - p.alpha_f * s.qdd) / (1.0 - p.alpha_f);
-        x.lambda = lambda_n_;
+    enum { Zero, Extrapolate, ConstantA } start = ConstantA;
+    if (predictor == GA_PREDICTOR_ZERO)
+        start = Zero;
+    else if (predictor == GA_PREDICTOR_EXTRAPOLATE && delta_alpha != 0.0 && s.h_last > 0.0)
+        start = Extrapolate;
+    // a_n - qdd_n = delta_alpha h_last qddd + O(h^2) (ALGORITHMS.md sec. 0), hence
+    // qdd(t_n + h) = qdd_n + (h / h_last) (a_n - qdd_n) / delta_alpha + O(h^2).
+    const double slope = start == Extrapolate ? h / (s.h_last * delta_alpha) : 0.0;
+    bool finite = true;
+    for (Eigen::Index i = 0; i < n_; i += kBlock) {  // blocks in L1: one trip to memory
+        const Eigen::Index len = std::min(kBlock, n_ - i);
+        const auto qdd_n = s.qdd.segment(i, len), an = a_n.segment(i, len);
+        auto qdd = x.qdd.segment(i, len), a = x.a.segment(i, len), q = x.q.segment(i, len),
+             v = x.v.segment(i, len);
+        if (start == Zero)
+            qdd.setZero();
+        else if (start == Extrapolate)
+            qdd = qdd_n + slope * (s.a.segment(i, len) - qdd_n);
+        else
+            qdd = (an - p.alpha_f * qdd_n) / (1.0 - p.alpha_f);
+        a = (p.alpha_f * qdd_n - p.alpha_m * an + (1.0 - p.alpha_f) * qdd) / (1.0 - p.alpha_m);
+        q = s.q.segment(i, len) + h * v_n.segment(i, len) +
+            (h * h) * ((0.5 - p.beta) * an + p.beta * a);                               // eq. (4)
+        v = v_n.segment(i, len) + h * ((1.0 - p.gamma) * an + p.gamma * a);            // eq. (5)
+        finite = finite && all_finite(q.data(), len) && all_finite(v.data(), len) &&
+                 all_finite(qdd.data(), len);
     }
-    x.a = (p.alpha_f * s.qdd - p.alpha_m * a_n + (1.0 - p.alpha_f) * x.qdd) / (1.0 - p.alpha_m);
-    x.q = s.q + h * v_n + (h * h) * ((0.5 - p.beta) * a_n + p.beta * x.a);  // eq. (4)
-    x.v = v_n + h * ((1.0 - p.gamma) * a_n + p.gamma * x.a);               // eq. (5)
+    if (start == Zero)
+        x.lambda.setZero();
+    else
+        x.lambda = s.lambda;  // finite, as every accepted state
     // The iteration starts from a finite iterate (the updates keep it so or report it): a
     // predictor can overflow where the accepted state is huge or h is.
-    if (!all_finite(x.q) || !all_finite(x.v) || !all_finite(x.qdd) || !all_finite(x.lambda))
+    if (!finite)
         return diag.fail(GA_ERR_NONFINITE,
                          "predicted Newton iterate is not finite in the step from t = %.17g "
                          "with h = %g",
