@@ -206,6 +206,7 @@ double FixedPivotLU::refactor(const double *values)
     const double *D = scale_.data();
     const int *Lp = Lp_.data(), *Li = Li_.data(), *Up = Up_.data(), *Ui = Ui_.data();
     double *Lx = Lx_.data(), *Ux = Ux_.data(), *Ud = Ud_.data();
+    double lo = HUGE_VAL, hi = 0.0, overflow = 0.0;  // the pivot ratio on the way (ratio_of)
     for (int j = 0; j < N_; ++j) {
         const int col = Q_[j];
         for (int p = colptr_[col]; p < colptr_[col + 1]; ++p) {
@@ -223,12 +224,16 @@ double FixedPivotLU::refactor(const double *values)
         const double d = x[j];
         x[j] = 0.0;
         Ud[j] = d;
+        const double size = std::abs(d);
+        lo = size < lo ? size : lo;
+        hi = size > hi ? size : hi;
+        overflow += 0.0 * d;
         for (int q = Lp[j]; q < Lp[j + 1]; ++q) {
             Lx[q] = x[Li[q]] / d;
             x[Li[q]] = 0.0;
         }
     }
-    pivot_ratio_ = ratio_of(Ud, N_);
+    pivot_ratio_ = overflow == 0.0 && hi > 0.0 ? lo / hi : 0.0;
     return pivot_ratio_;
 }
 
