@@ -161,7 +161,7 @@ ga_status Model::mass(double t, const Vec &q, ModelMatrix &M)
     return check_finite(M.data(), M.size(), message_rows(M), "mass matrix M", t);
 }
 
-ga_status Model::force(double t, const Vec &q, const Vec &v, Vec &f)
+ga_status Model::force(double t, const Vec &q, const Vec &v, Vec &f, Check check)
 {
     if (!cb.force) {  // no applied forces: nothing to evaluate, nothing to count
         f.setZero();
@@ -171,7 +171,7 @@ ga_status Model::force(double t, const Vec &q, const Vec &v, Vec &f)
     if (auto st = callback_status(cb.force(t, q.data(), v.data(), f.data(), cb.user), "force",
                                   t))
         return st;
-    return check_finite(f.data(), n_, 0, "force f", t);
+    return check == Check::Now ? check_finite(f.data(), n_, 0, "force f", t) : GA_OK;
 }
 
 ga_status Model::constraint(double t, const Vec &q, Vec &phi)
@@ -185,13 +185,25 @@ ga_status Model::constraint(double t, const Vec &q, Vec &phi)
     return check_finite(phi.data(), m_, 0, "constraint Phi", t);
 }
 
-ga_status Model::jacobian(double t, const Vec &q, ModelMatrix &J)
+ga_status Model::jacobian(double t, const Vec &q, ModelMatrix &J, Check check)
 {
     if (m_ == 0 || J.zero())
         return GA_OK;
     count(counters_, GA_COUNT_JACOBIAN_EVALS);
     if (auto st = callback_status(cb.jacobian(t, q.data(), J.data(), cb.user), "jacobian", t))
         return st;
+    if (check == Check::Deferred)
+        return GA_OK;
+    return check_finite(J.data(), J.size(), message_rows(J), "constraint Jacobian Phi_q", t);
+}
+
+ga_status Model::check_deferred(double t, const Vec &f, const ModelMatrix &J)
+{
+    if (cb.force)
+        if (auto st = check_finite(f.data(), n_, 0, "force f", t))
+            return st;
+    if (m_ == 0 || J.zero())
+        return GA_OK;
     return check_finite(J.data(), J.size(), message_rows(J), "constraint Jacobian Phi_q", t);
 }
 

@@ -436,15 +436,23 @@ ga_status Solver::residual(double t, const State &x)
 {
     ga_status st = evaluate_mass(t, x.q);
     if (!st)
-        st = model.force(t, x.q, x.v, f_);
+        st = model.force(t, x.q, x.v, f_, Model::Check::Deferred);
     if (!st)
         st = model.constraint(t, x.q, phi_);
     if (!st)
-        st = model.jacobian(t, x.q, J_);
+        st = model.jacobian(t, x.q, J_, Model::Check::Deferred);
     if (st)
         return st;
     Model::dynamics_residual(M_, x.qdd, f_, J_, x.lambda, rq_);
     count(counters, GA_COUNT_RESIDUALS);
+    // f and Phi_q are checked through r^q, which every entry of both enters (a NaN or an Inf
+    // makes a NaN or an Inf of every product and sum it enters); x is finite.
+    if (!all_finite(rq_)) {
+        if ((st = model.check_deferred(t, f_, J_)))
+            return st;
+        return diag.fail(GA_ERR_NONFINITE,
+                         "residual r^q = M qdd - f + Phi_q^T lambda overflows at t = %.17g", t);
+    }
     return GA_OK;
 }
 

@@ -539,6 +539,18 @@ static void nan_and_inf_in_callback_outputs(void **state)
     }
 }
 
+/* Finite callback outputs whose residual overflows (M(0,0) = 1e308 times an acceleration of
+ * g): the check of r^q, which also stands in for the checks of f and Phi_q, reports it as
+ * such, the state kept and the run going on without the fault. */
+static void overflow_in_the_residual(void **state)
+{
+    fixture *x = *state;
+    x->model.site = MASS;
+    x->model.rc = 0;
+    x->model.value = 1e308;
+    failing_step(x, GA_ERR_NONFINITE, "residual r^q = M qdd - f + Phi_q^T lambda overflows");
+}
+
 /* The Phi_t callback is called in every Newton iteration of a stabilized index-2 step: its
  * failures (fatal, recoverable, NaN, Inf) are reported like any callback's, the state kept. */
 /* Finite callback outputs whose Newton increment overflows (a force of 1e308 against the small
@@ -958,6 +970,7 @@ int main(void)
         T(recoverable_callback_failure),
         T(nan_and_inf_in_callback_outputs),
         T(overflow_in_the_newton_increment),
+        T(overflow_in_the_residual),
         cmocka_unit_test(failure_in_the_corrected_start),
         T(singular_iteration_matrix),
         T(singular_iteration_matrix_at_a_later_iterate),
