@@ -368,6 +368,15 @@ typedef enum ga_matrix {
 GA_API ga_status ga_set_pattern(ga_solver *s, int which, int nnz, const int *rows,
                                 const int *cols);
 
+/** The same pattern in compressed-column form, as sparse libraries hold it (SciPy's
+ *  csc_matrix, SuiteSparse, Eigen's SparseMatrix): colptr has cols + 1 entries, colptr[0] = 0
+ *  and non-decreasing, nnz = colptr[cols]; column j holds the rows rowind[colptr[j] ..
+ *  colptr[j + 1] - 1]. The callback writes the values in that order (column by column), so a
+ *  CSC matrix's value array can be filled as it is. cols = n (every matrix has n columns).
+ *  Errors: as ga_set_pattern, and GA_ERR_ARG for colptr NULL, colptr[0] != 0 or decreasing. */
+GA_API ga_status ga_set_pattern_csc(ga_solver *s, int which, const int *colptr,
+                                    const int *rowind);
+
 typedef enum ga_linear_solver {
     GA_LINEAR_AUTO = 0,         /**< sparse when the patterns allow it and n + m >= 10, dense
                                      otherwise (default; measured in bench/linear_algebra) */

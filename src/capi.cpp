@@ -4,6 +4,7 @@
 #include <cmath>
 #include <exception>
 #include <new>
+#include <vector>
 
 #include "galpha.h"
 #include "params.hpp"
@@ -278,25 +279,54 @@ GA_API ga_status ga_set_constant_mass(ga_solver *s, int on)
     });
 }
 
+namespace {
+// The checks and the declaration shared by both forms of ga_set_pattern.
+ga_status declare_pattern(ga::Solver &c, int which, int nnz, const int *rows, const int *cols)
+{
+    if (which < GA_MATRIX_MASS || which > GA_MATRIX_DAMPING)
+        return c.diag.fail(GA_ERR_ARG, "unknown matrix %d", which);
+    if (c.setup_done())
+        return c.diag.fail(GA_ERR_STATE, "patterns are declared before ga_init");
+    if (nnz < 0 || (nnz > 0 && (!rows || !cols)))
+        return c.diag.fail(GA_ERR_ARG, "pattern with nnz = %d needs rows and cols", nnz);
+    const int nr = which == GA_MATRIX_JACOBIAN ? c.m() : c.n(), nc = c.n();
+    if (which == GA_MATRIX_JACOBIAN && c.m() == 0)
+        return c.diag.fail(GA_ERR_ARG, "m = 0: there is no constraint Jacobian");
+    for (int k = 0; k < nnz; ++k)
+        if (rows[k] < 0 || rows[k] >= nr || cols[k] < 0 || cols[k] >= nc)
+            return c.diag.fail(GA_ERR_ARG, "pattern entry %d = (%d, %d) is outside the "
+                               "%d x %d matrix", k, rows[k], cols[k], nr, nc);
+    c.matrix(static_cast<ga_matrix>(which)).set_pattern(nr, nc, rows, cols, nnz);
+    return GA_OK;
+}
+}  // namespace
+
 GA_API ga_status ga_set_pattern(ga_solver *s, int which, int nnz, const int *rows,
                                 const int *cols)
 {
+    return guarded(s, [&](ga::Solver &c) { return declare_pattern(c, which, nnz, rows, cols); });
+}
+
+GA_API ga_status ga_set_pattern_csc(ga_solver *s, int which, const int *colptr,
+                                    const int *rowind)
+{
     return guarded(s, [&](ga::Solver &c) {
-        if (which < GA_MATRIX_MASS || which > GA_MATRIX_DAMPING)
-            return c.diag.fail(GA_ERR_ARG, "unknown matrix %d", which);
-        if (c.setup_done())
-            return c.diag.fail(GA_ERR_STATE, "patterns are declared before ga_init");
-        if (nnz < 0 || (nnz > 0 && (!rows || !cols)))
-            return c.diag.fail(GA_ERR_ARG, "pattern with nnz = %d needs rows and cols", nnz);
-        const int nr = which == GA_MATRIX_JACOBIAN ? c.m() : c.n(), nc = c.n();
-        if (which == GA_MATRIX_JACOBIAN && c.m() == 0)
-            return c.diag.fail(GA_ERR_ARG, "m = 0: there is no constraint Jacobian");
-        for (int k = 0; k < nnz; ++k)
-            if (rows[k] < 0 || rows[k] >= nr || cols[k] < 0 || cols[k] >= nc)
-                return c.diag.fail(GA_ERR_ARG, "pattern entry %d = (%d, %d) is outside the "
-                                   "%d x %d matrix", k, rows[k], cols[k], nr, nc);
-        c.matrix(static_cast<ga_matrix>(which)).set_pattern(nr, nc, rows, cols, nnz);
-        return GA_OK;
+        if (!colptr)
+            return c.diag.fail(GA_ERR_ARG, "pattern in CSC form needs colptr");
+        if (colptr[0] != 0)
+            return c.diag.fail(GA_ERR_ARG, "colptr[0] = %d, not 0", colptr[0]);
+        const int nc = c.n();
+        for (int j = 0; j < nc; ++j)
+            if (colptr[j + 1] < colptr[j])
+                return c.diag.fail(GA_ERR_ARG, "colptr decreases at column %d (%d -> %d)", j,
+                                   colptr[j], colptr[j + 1]);
+        // triplets in the same order: the callback's values are the CSC value array
+        const int nnz = colptr[nc];
+        std::vector<int> cols(static_cast<std::size_t>(nnz));
+        for (int j = 0; j < nc; ++j)
+            for (int k = colptr[j]; k < colptr[j + 1]; ++k)
+                cols[static_cast<std::size_t>(k)] = j;
+        return declare_pattern(c, which, nnz, rowind, cols.data());
     });
 }
 

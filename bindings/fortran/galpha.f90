@@ -272,6 +272,13 @@ module galpha
        integer(c_int), value :: which, nnz
        integer(c_int), intent(in) :: rows(*), cols(*)  ! 0-based, as in C
      end function ga_set_pattern
+     integer(c_int) function ga_set_pattern_csc(s, which, colptr, rowind) &
+          bind(C, name="ga_set_pattern_csc")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: which
+       integer(c_int), intent(in) :: colptr(*), rowind(*)  ! 0-based, as in C
+     end function ga_set_pattern_csc
      integer(c_int) function ga_set_linear_solver(s, solver) bind(C, name="ga_set_linear_solver")
        import :: c_int, c_ptr
        type(c_ptr), value :: s
@@ -354,7 +361,8 @@ module galpha
        ga_set_scaling, ga_set_predictor, ga_set_init_mode, ga_init, ga_step, ga_get_t, &
        ga_get_h_last, ga_get_q, ga_get_v, ga_get_qdd, ga_get_lambda, ga_get_a, &
        ga_state_size, ga_get_state, ga_set_state, ga_get_counter, ga_reset_counters, ga_get_info, &
-       ga_set_jacobian_reuse, ga_set_constant_mass, ga_set_pattern, ga_set_linear_solver, &
+       ga_set_jacobian_reuse, ga_set_constant_mass, ga_set_pattern, ga_set_pattern_csc, &
+       ga_set_linear_solver, &
        ga_linear_solver_name, ga_set_formulation, ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
@@ -387,6 +395,11 @@ module galpha
      !> fills size(rows) values in this order (GA_ERR_ARG, without a message, if rows and cols
      !> differ in size)
      procedure :: set_pattern => solver_set_pattern
+     !> set_pattern_csc(which, colptr, rowind): the same in compressed-column form with Fortran
+     !> (1-based) numbers, colptr(1) = 1 and size(colptr) = n + 1 (the Harwell-Boeing layout);
+     !> the callback fills the values column by column (GA_ERR_ARG, without a message, if
+     !> size(colptr) /= n + 1 or rowind is shorter than colptr(n + 1) - 1)
+     procedure :: set_pattern_csc => solver_set_pattern_csc
      procedure :: set_constant_mass => solver_set_constant_mass
      procedure :: set_linear_solver => solver_set_linear_solver
      procedure :: linear_solver_name => solver_linear_solver_name
@@ -559,6 +572,28 @@ contains
     c0 = cols - 1
     status = ga_set_pattern(this%handle, which, int(size(rows), c_int), r0, c0)
   end function solver_set_pattern
+
+  integer(c_int) function solver_set_pattern_csc(this, which, colptr, rowind) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: which
+    integer(c_int), intent(in) :: colptr(:), rowind(:)
+    integer(c_int), allocatable :: p0(:), r0(:)
+    integer(c_int) :: n, m
+    status = ga_get_size(this%handle, n, m)
+    if (status /= GA_OK) return
+    if (size(colptr) /= n + 1) then
+       status = GA_ERR_ARG
+       return
+    end if
+    if (size(rowind) < colptr(n + 1) - 1) then
+       status = GA_ERR_ARG
+       return
+    end if
+    p0 = colptr - 1  ! the C API counts from 0
+    r0 = rowind - 1
+    if (size(r0) == 0) r0 = [0_c_int]  ! a valid address for an empty pattern
+    status = ga_set_pattern_csc(this%handle, which, p0, r0)
+  end function solver_set_pattern_csc
 
   integer(c_int) function solver_set_constant_mass(this, on) result(status)
     class(galpha_solver), intent(inout) :: this

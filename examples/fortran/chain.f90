@@ -162,7 +162,9 @@ program chain
   call jacobian_pattern(rows, cols)
 
   call check(s%create(n, m), "create")
-  call check(s%set_pattern(GA_MATRIX_MASS, diagonal, diagonal), "set_pattern M")
+  ! M in compressed-column form, as sparse libraries hold it: column j holds row j
+  call check(s%set_pattern_csc(GA_MATRIX_MASS, [(i, i = 1, n + 1)], diagonal), &
+       "set_pattern_csc M")
   call check(s%set_pattern(GA_MATRIX_JACOBIAN, rows, cols), "set_pattern Phi_q")
   call check(s%set_pattern(GA_MATRIX_STIFFNESS, angles, angles), "set_pattern K_t")
   call check(s%set_pattern(GA_MATRIX_DAMPING, none, none), "set_pattern C_t")  ! C_t = 0

@@ -388,6 +388,111 @@ static void callers_floating_point_mode_is_kept(void **state)
 }
 #endif
 
+/* ga_set_pattern_csc: the chain's patterns declared in compressed-column form (the Jacobian's
+ * values then come column by column) run bit for bit as the same entries declared as triplets
+ * in that order; and the solution is the chain's with its own (row-wise) triplets, up to the
+ * order of the sums in Phi_q^T lambda. */
+typedef struct csc_chain {
+    chain c; /* first: the scene's callbacks take the user pointer as a chain */
+    int *perm; /* CSC position k holds the value at triplet position perm[k] */
+    double *scratch;
+} csc_chain;
+
+static int csc_jacobian(double t, const double *q, double *J, void *user)
+{
+    csc_chain *x = user;
+    const int rc = chain_jacobian(t, q, x->scratch, &x->c);
+    const int nnz = chain_pattern(&x->c, GA_MATRIX_JACOBIAN, NULL, NULL);
+    for (int k = 0; k < nnz; ++k)
+        J[k] = x->scratch[x->perm[k]];
+    return rc;
+}
+
+static void run_csc_chain(int how, double *q, double *lambda) /* 0 triplets, 1 CSC, 2 own */
+{
+    enum { L = 40, N = 3 * L, M = 2 * L };
+    csc_chain x = {chain_make(L), NULL, NULL};
+    const int nnz = chain_pattern(&x.c, GA_MATRIX_JACOBIAN, NULL, NULL);
+    int *rows = malloc(sizeof(int) * nnz), *cols = malloc(sizeof(int) * nnz);
+    int *rowind = malloc(sizeof(int) * nnz), *colsort = malloc(sizeof(int) * nnz);
+    int colptr[N + 1] = {0}, next[N];
+    x.perm = malloc(sizeof(int) * nnz);
+    x.scratch = malloc(sizeof(double) * nnz);
+    chain_pattern(&x.c, GA_MATRIX_JACOBIAN, rows, cols);
+    for (int k = 0; k < nnz; ++k) /* counting sort by column, stable */
+        ++colptr[cols[k] + 1];
+    for (int j = 0; j < N; ++j) {
+        colptr[j + 1] += colptr[j];
+        next[j] = colptr[j];
+    }
+    for (int k = 0; k < nnz; ++k) {
+        const int p = next[cols[k]]++;
+        x.perm[p] = k;
+        rowind[p] = rows[k];
+        colsort[p] = cols[k];
+    }
+    int diag_ptr[N + 1], diag_row[N], th_ptr[N + 1], th_row[L], empty[N + 1];
+    for (int j = 0; j <= N; ++j) {
+        diag_ptr[j] = j;
+        empty[j] = 0;
+        th_ptr[j] = j / 3; /* column 3i + 2 (the angle of link i) holds row 3i + 2 */
+    }
+    for (int i = 0; i < N; ++i)
+        diag_row[i] = i;
+    for (int i = 0; i < L; ++i)
+        th_row[i] = 3 * i + 2;
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(N, M, &s), GA_OK);
+    if (how == 1) {
+        assert_int_equal(ga_set_pattern_csc(s, GA_MATRIX_MASS, diag_ptr, diag_row), GA_OK);
+        assert_int_equal(ga_set_pattern_csc(s, GA_MATRIX_JACOBIAN, colptr, rowind), GA_OK);
+        assert_int_equal(ga_set_pattern_csc(s, GA_MATRIX_STIFFNESS, th_ptr, th_row), GA_OK);
+        assert_int_equal(ga_set_pattern_csc(s, GA_MATRIX_DAMPING, empty, NULL), GA_OK);
+    } else {
+        assert_int_equal(chain_declare_patterns(&x.c, s), GA_OK);
+        if (how == 0)
+            assert_int_equal(ga_set_pattern(s, GA_MATRIX_JACOBIAN, nnz, rowind, colsort), GA_OK);
+    }
+    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
+                                      how == 2 ? chain_jacobian : csc_jacobian, &x),
+                     GA_OK);
+    assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
+    assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    double q0[N], v0[N];
+    chain_initial(&x.c, q0, v0);
+    assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+    for (int k = 0; k < 30; ++k)
+        assert_int_equal(ga_step(s, 1e-3), GA_OK);
+    assert_int_equal(ga_get_q(s, q), GA_OK);
+    assert_int_equal(ga_get_lambda(s, lambda), GA_OK);
+    ga_free(s);
+    free(rows);
+    free(cols);
+    free(rowind);
+    free(colsort);
+    free(x.perm);
+    free(x.scratch);
+}
+
+static void csc_patterns_run_as_their_triplets(void **state)
+{
+    (void)state;
+    enum { L = 40, N = 3 * L, M = 2 * L };
+    double q[3][N], lambda[3][M];
+    for (int how = 0; how < 3; ++how)
+        run_csc_chain(how, q[how], lambda[how]);
+    assert_memory_equal(q[0], q[1], sizeof q[0]);
+    assert_memory_equal(lambda[0], lambda[1], sizeof lambda[0]);
+    double lmax = 0.0;
+    for (int i = 0; i < M; ++i)
+        lmax = fmax(lmax, fabs(lambda[2][i]));
+    printf("  CSC declaration = its triplets bit for bit; against the row-wise triplets: |dq| "
+           "%.1e, |dlambda| %.1e of %.1e\n",
+           max_abs_diff(q[1], q[2], N), max_abs_diff(lambda[1], lambda[2], M), lmax);
+    assert_true(max_abs_diff(q[1], q[2], N) < 1e-12);
+    assert_true(max_abs_diff(lambda[1], lambda[2], M) < 1e-6 * lmax);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -395,6 +500,7 @@ int main(void)
         cmocka_unit_test(callers_floating_point_mode_is_kept),
 #endif
         cmocka_unit_test(sparse_and_dense_solvers_agree),
+        cmocka_unit_test(csc_patterns_run_as_their_triplets),
         cmocka_unit_test(singular_matrix_mid_run_sparse),
         cmocka_unit_test(sparse_and_dense_index2_agree),
         cmocka_unit_test(index2_on_a_sparse_solver_set_up_already),

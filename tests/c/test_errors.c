@@ -239,6 +239,7 @@ static void null_pointers_are_refused(void **state)
     assert_int_equal(ga_init(NULL, 0.0, &d, &d), GA_ERR_ARG);
     assert_int_equal(ga_set_rho_inf(NULL, 0.5), GA_ERR_ARG);
     assert_int_equal(ga_get_t(NULL, &d), GA_ERR_ARG);
+    assert_int_equal(ga_set_pattern_csc(NULL, GA_MATRIX_MASS, NULL, NULL), GA_ERR_ARG);
     assert_int_equal(ga_get_t(x->s, NULL), GA_ERR_ARG);
     assert_int_equal(ga_get_q(x->s, NULL), GA_ERR_ARG);
     assert_int_equal(ga_get_v(x->s, NULL), GA_ERR_ARG);
@@ -352,6 +353,9 @@ static void bad_options_are_refused(void **state)
     expect_message(x->s, "chosen before ga_init");
     assert_int_equal(ga_set_pattern(x->s, GA_MATRIX_MASS, 1, rows, rows), GA_ERR_STATE);
     expect_message(x->s, "declared before ga_init");
+    const int colptr[3] = {0, 1, 1};
+    assert_int_equal(ga_set_pattern_csc(x->s, GA_MATRIX_MASS, colptr, rows), GA_ERR_STATE);
+    expect_message(x->s, "declared before ga_init");
     /* queries with a bad key or no output */
     assert_int_equal(ga_get_info(x->s, GA_INFO_COUNT, &d), GA_ERR_ARG);
     assert_int_equal(ga_get_info(x->s, -1, &d), GA_ERR_ARG);
@@ -391,6 +395,23 @@ static void bad_patterns_are_refused(void **state)
     assert_int_equal(ga_set_pattern(s, GA_MATRIX_JACOBIAN, 2, r, c), GA_ERR_ARG);
     expect_message(s, "outside the 1 x 2 matrix");
     assert_int_equal(ga_set_pattern(s, GA_MATRIX_JACOBIAN, 2, c, r), GA_ERR_ARG);
+    /* the same checks in compressed-column form, and its own */
+    const int ptr_ok[3] = {0, 1, 2}, ptr_base1[3] = {1, 2, 3}, ptr_down[3] = {0, 2, 1};
+    const int ptr_jac[3] = {0, 1, 2};
+    assert_int_equal(ga_set_pattern_csc(s, GA_MATRIX_MASS, NULL, r), GA_ERR_ARG);
+    expect_message(s, "needs colptr");
+    assert_int_equal(ga_set_pattern_csc(s, GA_MATRIX_MASS, ptr_base1, r), GA_ERR_ARG);
+    expect_message(s, "colptr[0] = 1, not 0");
+    assert_int_equal(ga_set_pattern_csc(s, GA_MATRIX_MASS, ptr_down, r), GA_ERR_ARG);
+    expect_message(s, "colptr decreases at column 1 (2 -> 1)");
+    assert_int_equal(ga_set_pattern_csc(s, GA_MATRIX_MASS, ptr_ok, NULL), GA_ERR_ARG);
+    expect_message(s, "needs rows and cols");
+    assert_int_equal(ga_set_pattern_csc(s, 9, ptr_ok, r), GA_ERR_ARG);
+    expect_message(s, "unknown matrix 9");
+    assert_int_equal(ga_set_pattern_csc(s, GA_MATRIX_STIFFNESS, ptr_ok, r_neg), GA_ERR_ARG);
+    expect_message(s, "pattern entry 1 = (-1, 1) is outside the 2 x 2 matrix");
+    assert_int_equal(ga_set_pattern_csc(s, GA_MATRIX_JACOBIAN, ptr_jac, r), GA_ERR_ARG);
+    expect_message(s, "pattern entry 1 = (1, 1) is outside the 1 x 2 matrix");
     assert_int_equal(ga_set_pattern(s, GA_MATRIX_JACOBIAN, 1, r, c), GA_OK);
     /* the sparse solver asked for without the pattern of M (K_t and C_t by differences need
      * theirs too) */

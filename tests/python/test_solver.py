@@ -387,6 +387,38 @@ def test_declared_patterns_take_the_sparse_path():
     assert runs["sparse"][3]["damping_evals"] == 0
 
 
+def test_csc_patterns_run_as_their_triplets():
+    # a compressed-column pattern (what scipy.sparse.csc_matrix holds: indptr, indices)
+    # declares the entries column by column: the same run as those triplets
+    from types import SimpleNamespace
+    csc = {"mass": SimpleNamespace(format="csc", indptr=[0, 1, 2], indices=[0, 1]),
+           "jacobian": SimpleNamespace(format="csc", indptr=[0, 1, 2], indices=[0, 0]),
+           "stiffness": SimpleNamespace(format="csc", indptr=[0, 1, 2], indices=[0, 1]),
+           "damping": SimpleNamespace(format="csc", indptr=[0, 0, 0], indices=[])}
+    triplets = {"mass": ([0, 1], [0, 1]), "jacobian": ([0, 0], [0, 1]),
+                "stiffness": ([0, 1], [0, 1]), "damping": ([], [])}
+    runs = []
+    for patterns in (csc, triplets):
+        with galpha.Solver(2, 1, sparse_mass, force, constraint, sparse_jacobian,
+                           patterns=patterns, linear_solver=galpha.GA_LINEAR_SPARSE) as s:
+            s.init(0.0, Q0, V0)
+            for _ in range(100):
+                s.step(5e-3)
+            runs.append((s.q.copy(), s.lam.copy(), s.stats["damping_evals"]))
+    assert np.array_equal(runs[0][0], runs[1][0]) and np.array_equal(runs[0][1], runs[1][1])
+    assert runs[0][2] == 0  # the empty column pointers declare C_t = 0
+    with pytest.raises(galpha.ArgumentError, match="colptr decreases"):
+        galpha.Solver(2, 1, mass, force, constraint, jacobian,
+                      patterns={"mass": SimpleNamespace(indptr=[0, 2, 1], indices=[0, 1])})
+    with pytest.raises(ValueError, match="2 column pointers, not n \\+ 1 = 3"):
+        galpha.Solver(2, 1, mass, force, constraint, jacobian,
+                      patterns={"mass": SimpleNamespace(indptr=[0, 1], indices=[0])})
+    with pytest.raises(ValueError, match="format 'csr', not csc"):
+        galpha.Solver(2, 1, mass, force, constraint, jacobian,
+                      patterns={"mass": SimpleNamespace(format="csr", indptr=[0, 1, 2],
+                                                        indices=[0, 1])})
+
+
 def test_bad_patterns_are_refused():
     with pytest.raises(galpha.ArgumentError, match="outside the 2 x 2 matrix"):
         galpha.Solver(2, 1, mass, force, constraint, jacobian, patterns={"mass": ([0, 2], [0, 1])})

@@ -158,6 +158,7 @@ _SIGNATURES = {
     "ga_set_jacobian_reuse": (_I, [_S, _I]),
     "ga_set_constant_mass": (_I, [_S, _I]),
     "ga_set_pattern": (_I, [_S, _I, _I, _P(_I), _P(_I)]),
+    "ga_set_pattern_csc": (_I, [_S, _I, _P(_I), _P(_I)]),
     "ga_set_linear_solver": (_I, [_S, _I]),
     "ga_linear_solver_name": (ctypes.c_char_p, [_S]),
     "ga_set_formulation": (_I, [_S, _I]),

@@ -54,7 +54,10 @@ class Solver:
         Sparsity patterns for the sparse path (ga_set_pattern): {"mass" | "jacobian" |
         "stiffness" | "damping": (rows, cols)}, 0-based index arrays of equal length nnz. The
         callback of a matrix with a pattern receives a 1-D array of its nnz values in that
-        order instead of the dense matrix; an empty pattern declares the matrix zero.
+        order instead of the dense matrix; an empty pattern declares the matrix zero. A
+        pattern may also be given in compressed-column form (ga_set_pattern_csc): any object
+        with `indptr` and `indices` (a scipy.sparse csc_matrix, say; n + 1 column pointers),
+        whose values then come column by column, as the `data` of such a matrix.
     rho_inf, params, newton, tangent_mode, scaling, predictor, init_mode, formulation, redundant,
     tolerances, reuse, constant_mass, linear_solver, rescale, corrected_start, step_limits,
     initial_step
@@ -87,10 +90,28 @@ class Solver:
         v = self._view
         # declared patterns first: they decide the shape the callbacks see
         nnz = {}
-        for name, (rows, cols) in (patterns or {}).items():
+        for name, pattern in (patterns or {}).items():
             if name not in _PATTERN_MATRICES:
                 raise ValueError(f"unknown matrix {name!r} in patterns (one of "
                                  f"{', '.join(_PATTERN_MATRICES)})")
+            if hasattr(pattern, "indptr") and hasattr(pattern, "indices"):
+                if getattr(pattern, "format", "csc") != "csc":
+                    raise ValueError(f"pattern of {name}: format {pattern.format!r}, not csc")
+                indptr = np.ascontiguousarray(pattern.indptr, dtype=np.intc).ravel()
+                indices = np.ascontiguousarray(pattern.indices, dtype=np.intc).ravel()
+                if indptr.size != n + 1:
+                    raise ValueError(f"pattern of {name}: {indptr.size} column pointers, "
+                                     f"not n + 1 = {n + 1}")
+                if indices.size < (indptr[-1] if indptr[-1] > 0 else 0):
+                    raise ValueError(f"pattern of {name}: {indices.size} row indices, but "
+                                     f"the column pointers end at {indptr[-1]}")
+                ip = ctypes.POINTER(ctypes.c_int)
+                self._check(_ffi.ga_set_pattern_csc(self._ptr, _PATTERN_MATRICES[name],
+                                                    indptr.ctypes.data_as(ip),
+                                                    indices.ctypes.data_as(ip)))
+                nnz[name] = int(indptr[-1])
+                continue
+            rows, cols = pattern
             rows = np.ascontiguousarray(rows, dtype=np.intc).ravel()
             cols = np.ascontiguousarray(cols, dtype=np.intc).ravel()
             if rows.size != cols.size:
