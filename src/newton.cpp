@@ -62,8 +62,10 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &s
     const double roundoff = 64.0 * std::numeric_limits<double>::epsilon() * q_norm;
     const bool dq_at_roundoff = dq_norm <= roundoff;
     moved_since_matrix_ += relative(dq_norm, tol, q_norm);
+    // "within the tolerance" is within round-off where the tolerance is below it
+    const double moved_limit = std::max(1.0, 64.0 * std::numeric_limits<double>::epsilon() / tol);
     const bool matrix_current =
-        fresh_matrix_ && moved_since_matrix_ <= 1.0 && size.dw <= roundoff;
+        fresh_matrix_ && moved_since_matrix_ <= moved_limit && size.dw <= roundoff;
     const bool stop = dq_at_roundoff && (previous_dq_at_roundoff_ || matrix_current);
     previous_dq_at_roundoff_ = dq_at_roundoff;
     if (stop)

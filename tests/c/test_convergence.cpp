@@ -77,6 +77,27 @@ void fresh_matrix_far_from_the_iterate_needs_a_second(void **state)
     assert_true(c.check(kTol, kAtRoundoff, kBetaPrime) == Verdict::Converged);
 }
 
+void tolerance_below_roundoff_moves_within_roundoff(void **state)
+{
+    (void)state;
+    // tol = 1e-16, below 64 ulps: "q has moved within the tolerance since the factorization"
+    // means within round-off then (full Newton: a matrix at every iterate, whose own update
+    // is the only move)
+    constexpr double tol = 1e-16;
+    ConvergenceTest c;
+    c.reset(-1.0);
+    c.matrix_changed();
+    assert_true(c.check(tol, update(10.0 * kUlp * kQ, 3e9 * kTol * kLambda), kBetaPrime) ==
+                Verdict::Converged);
+    // a move beyond round-off since the factorization: a second update at round-off needed
+    c.reset(-1.0);
+    c.matrix_changed();
+    assert_true(c.check(tol, update(1e3 * kUlp * kQ, 3e9 * kTol * kLambda), kBetaPrime) ==
+                Verdict::Continue);
+    assert_true(c.check(tol, kAtRoundoff, kBetaPrime) == Verdict::Continue);
+    assert_true(c.check(tol, kAtRoundoff, kBetaPrime) == Verdict::Converged);
+}
+
 void index2_waits_for_its_newmark_increment(void **state)
 {
     (void)state;
@@ -109,6 +130,7 @@ int main()
         cmocka_unit_test(fresh_matrix_ends_at_the_first_roundoff_update),
         cmocka_unit_test(old_matrix_needs_a_second_roundoff_update),
         cmocka_unit_test(fresh_matrix_far_from_the_iterate_needs_a_second),
+        cmocka_unit_test(tolerance_below_roundoff_moves_within_roundoff),
         cmocka_unit_test(index2_waits_for_its_newmark_increment),
         cmocka_unit_test(a_new_step_forgets_the_fresh_matrix),
     };
