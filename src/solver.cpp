@@ -506,8 +506,8 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
 
     // Predictor (Algorithm 1, lines 1-7). The paper starts from qdd_{n+1} = 0, lambda = 0;
     // the others start from a_{n+1} = a_n, or from qdd extrapolated linearly; lambda_n.
-    // All iterate to the same solution. One pass over the vectors (at 100 000 chain links
-    // the separate passes moved 40 MB per step).
+    // All iterate to the same solution. One pass over the vectors, in blocks: at 100 000
+    // chain links they do not stay in the cache from one pass to the next.
     const double delta_alpha = p.alpha_m - p.alpha_f;
     enum { Zero, Extrapolate, ConstantA } start = ConstantA;
     if (predictor == GA_PREDICTOR_ZERO)

@@ -61,8 +61,8 @@ public:
     // The same for a right-hand side and a solution kept in two blocks of their callers: rows
     // [0, n1) of b are c1 b1, the others c2 b2; x1 gets rows [0, n1) of x, x2 the others
     // divided by div2. Bit for bit what copying them in and out around solve() gives, without
-    // the two passes over a vector of length N (at 100 000 chain links a fifth of the bytes a
-    // solve moves).
+    // the two passes over a vector of length N (which at 100 000 chain links come from
+    // memory, not the cache).
     void solve_blocks(const double *b1, double c1, const double *b2, double c2, int n1,
                       double *x1, double *x2, double div2);
 
