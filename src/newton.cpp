@@ -59,11 +59,12 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &s
     // this step and q has moved within the tolerance since (the accelerations' increment dw
     // at round-off too, for the index-2 form, where it differs from dq); otherwise after a
     // second such increment.
-    const double roundoff = 64.0 * std::numeric_limits<double>::epsilon() * q_norm;
+    const double ulps = 64.0 * std::numeric_limits<double>::epsilon();
+    const double roundoff = ulps * q_norm;
     const bool dq_at_roundoff = dq_norm <= roundoff;
     moved_since_matrix_ += relative(dq_norm, tol, q_norm);
     // "within the tolerance" is within round-off where the tolerance is below it
-    const double moved_limit = std::max(1.0, 64.0 * std::numeric_limits<double>::epsilon() / tol);
+    const double moved_limit = std::max(1.0, ulps / tol);
     const bool matrix_current =
         fresh_matrix_ && moved_since_matrix_ <= moved_limit && size.dw <= roundoff;
     const bool stop = dq_at_roundoff && (previous_dq_at_roundoff_ || matrix_current);

@@ -14,10 +14,11 @@
 //     iteration with a reused matrix, from the previous step, as SUNDIALS IDA does), or
 //   - the iteration has reached round-off: two successive position increments within a few
 //     ulps of |q|, or one if the matrix was factorized in this step at an iterate within
-//     tol |q| of the current one (within round-off where tol is below it). This exit is needed because index-3 accelerations and
-//     multipliers are only determined to ~eps |q| / (beta h^2) (paper, sec. 3.3), which
-//     exceeds tol |lambda| once h is small enough or |q| large (a chain of 10 000 links at
-//     h = 1e-3 and tol = 1e-10: increments of lambda stay at ~4e5 tol |lambda|).
+//     tol |q| of the current one (within round-off where tol is below it). This exit is
+//     needed because index-3 accelerations and multipliers are only determined to
+//     ~eps |q| / (beta h^2) (paper, sec. 3.3), which exceeds tol |lambda| once h is small
+//     enough or |q| large (a chain of 10 000 links at h = 1e-3 and tol = 1e-10: increments
+//     of lambda stay at ~4e5 tol |lambda|).
 //     Why one can suffice: an increment that leaves q in place was computed from a residual
 //     at (nearly) the final q, where the equations are linear in lambda; the update solved
 //     them with the matrix's Phi_q^T, exact up to the change of Phi_q since the
