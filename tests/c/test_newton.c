@@ -86,45 +86,6 @@ static ga_solver *start(int pred, step_data *n, double h)
     return s;
 }
 
-/* Below the round-off floor (tol 1e-15 against a floor of ~1e-12 |lambda| and more) a step
- * ends by the round-off exit; with a matrix factorized in the step, at the first position
- * increment at round-off (newton.cpp; the rule itself: test_convergence.cpp). Full Newton, a
- * matrix at every iterate, so that no contraction rate ends the iteration first: the result
- * must be as close to the long-double solution of the step as the floor allows (at h = 1e-3
- * the iteration stops after 2 increments where waiting for a second one at round-off took 3). */
-static void roundoff_exit_keeps_the_floor(void **state)
-{
-    (void)state;
-    const double hs[] = {1e-2, 1e-3, 1e-4};
-    for (size_t k = 0; k < sizeof hs / sizeof hs[0]; ++k) {
-        const double h = hs[k];
-        step_data n;
-        double prm[4], qdd[2], lambda;
-        long long it0, it1;
-        ga_solver *s = start(0, &n, h);
-        assert_int_equal(ga_set_newton(s, 1e-15, 20), GA_OK);
-        assert_int_equal(ga_set_jacobian_reuse(s, GA_REUSE_NEVER), GA_OK);
-        ga_get_params(s, &prm[0], &prm[1], &prm[2], &prm[3]);
-        ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &it0);
-        assert_int_equal(ga_step(s, h), GA_OK);
-        ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &it1);
-        ga_get_qdd(s, qdd);
-        ga_get_lambda(s, &lambda);
-        ga_free(s);
-        long double rq[2], rl;
-        reference_step(&n, h, prm, rq, &rl);
-        const double c = h * h * prm[2] * (1 - prm[1]) / (1 - prm[0]);
-        const double floor = DBL_EPSILON / c; /* as in the test above */
-        const double el = fabs(lambda - (double)rl), ea = fmax(fabs(qdd[0] - (double)rq[0]),
-                                                              fabs(qdd[1] - (double)rq[1]));
-        printf("  h = %-6g tol 1e-15, full Newton: %lld iterations, |lambda - ref| = %.2e, "
-               "|qdd - ref| = %.2e (floor %.1e)\n",
-               h, it1 - it0, el, ea, floor);
-        assert_true(el <= 8.0 * floor);
-        assert_true(ea <= 8.0 * floor);
-    }
-}
-
 /* What the paper's absolute test on the scaled residual sees at the predictor
  * qdd_{n+1} = 0, lambda_{n+1} = 0 (Algorithm 1, lines 1-7). */
 static double paper_scaled_residual_at_zero_predictor(const step_data *n, double h,
@@ -141,39 +102,82 @@ static double paper_scaled_residual_at_zero_predictor(const step_data *n, double
     return sqrt(pow(beta * h * h * rq, 2) + phi * phi);
 }
 
+/* One step of h after start(pred, n, h) -- Newton tolerance tol (0: the default), full Newton
+ * if asked -- against the long-double solution of the same step (reference_step). */
+typedef struct checked_step {
+    long long iterations;
+    double prm[4];            /* alpha_m, alpha_f, beta, gamma */
+    double lambda_error, qdd_error, lambda_ref;
+    double floor;             /* round-off floor of the index-3 multiplier */
+} checked_step;
+
+static checked_step check_step(int pred, double h, double tol, int full_newton, step_data *n)
+{
+    checked_step r;
+    double qdd[2], lambda;
+    long long it0, it1;
+    ga_solver *s = start(pred, n, h);
+    if (tol > 0.0)
+        assert_int_equal(ga_set_newton(s, tol, 20), GA_OK);
+    if (full_newton)
+        assert_int_equal(ga_set_jacobian_reuse(s, GA_REUSE_NEVER), GA_OK);
+    ga_get_params(s, &r.prm[0], &r.prm[1], &r.prm[2], &r.prm[3]);
+    ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &it0);
+    assert_int_equal(ga_step(s, h), GA_OK);
+    ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &it1);
+    ga_get_qdd(s, qdd);
+    ga_get_lambda(s, &lambda);
+    ga_free(s);
+    long double rq[2], rl;
+    reference_step(n, h, r.prm, rq, &rl);
+    r.iterations = it1 - it0;
+    r.lambda_ref = (double)rl;
+    r.lambda_error = fabs(lambda - (double)rl);
+    r.qdd_error = fmax(fabs(qdd[0] - (double)rq[0]), fabs(qdd[1] - (double)rq[1]));
+    /* Phi is known to ~eps |q|^2, which moves q1 by eps |q| and lambda by that over
+     * c = beta h^2 (1-af)/(1-am) */
+    const double c = h * h * r.prm[2] * (1 - r.prm[1]) / (1 - r.prm[0]);
+    r.floor = DBL_EPSILON / c;
+    return r;
+}
+
+/* Below the round-off floor (tol 1e-15 against a floor of ~1e-12 |lambda| and more) a step
+ * ends by the round-off exit; with a matrix factorized in the step, at the first position
+ * increment at round-off (newton.cpp; the rule itself: test_convergence.cpp). Full Newton, a
+ * matrix at every iterate, so that no contraction rate ends the iteration first: the result
+ * must be as close to the long-double solution of the step as the floor allows (at h = 1e-3
+ * the iteration stops after 2 increments where waiting for a second one at round-off took 3). */
+static void roundoff_exit_keeps_the_floor(void **state)
+{
+    (void)state;
+    const double hs[] = {1e-2, 1e-3, 1e-4};
+    for (size_t k = 0; k < sizeof hs / sizeof hs[0]; ++k) {
+        step_data n;
+        const checked_step r = check_step(0, hs[k], 1e-15, 1, &n);
+        printf("  h = %-6g tol 1e-15, full Newton: %lld iterations, |lambda - ref| = %.2e, "
+               "|qdd - ref| = %.2e (floor %.1e)\n",
+               hs[k], r.iterations, r.lambda_error, r.qdd_error, r.floor);
+        assert_true(r.lambda_error <= 8.0 * r.floor);
+        assert_true(r.qdd_error <= 8.0 * r.floor);
+    }
+}
+
 static void step_solution_is_converged_for_every_h(void **state)
 {
     (void)state;
     const double hs[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7};
     for (int pred = 0; pred < 2; ++pred) {
         for (size_t k = 0; k < sizeof hs / sizeof hs[0]; ++k) {
-            const double h = hs[k];
             step_data n;
-            double prm[4], qdd[2], lambda;
-            long long it0, it1;
-            ga_solver *s = start(pred, &n, h);
-            ga_get_params(s, &prm[0], &prm[1], &prm[2], &prm[3]);
-            ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &it0);
-            assert_int_equal(ga_step(s, h), GA_OK);
-            ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &it1);
-            ga_get_qdd(s, qdd);
-            ga_get_lambda(s, &lambda);
-            long double rq[2], rl;
-            reference_step(&n, h, prm, rq, &rl);
-            const double el = fabs(lambda - (double)rl), ea = fmax(fabs(qdd[0] - (double)rq[0]),
-                                                                  fabs(qdd[1] - (double)rq[1]));
-            /* round-off floor of the index-3 multiplier: Phi is known to ~eps |q|^2, which
-             * moves q1 by eps |q| and lambda by that over c = beta h^2 (1-af)/(1-am) */
-            const double c = h * h * prm[2] * (1 - prm[1]) / (1 - prm[0]);
-            const double floor = DBL_EPSILON / c;
+            const checked_step r = check_step(pred, hs[k], 0.0, 0, &n);
             printf("  %s predictor h = %-6g: Newton it %lld, |lambda - ref| = %.2e, |qdd - ref| = "
                    "%.2e (round-off floor %.1e), paper's scaled residual at zero predictor "
                    "%.1e\n",
-                   pred ? "zero    " : "constant", h, it1 - it0, el, ea, floor,
-                   paper_scaled_residual_at_zero_predictor(&n, h, prm));
-            assert_true(el <= 1e-9 * fabs((double)rl) + 8.0 * floor);
-            assert_true(ea <= 1e-9 * 10.0 + 8.0 * floor);
-            ga_free(s);
+                   pred ? "zero    " : "constant", hs[k], r.iterations, r.lambda_error,
+                   r.qdd_error, r.floor,
+                   paper_scaled_residual_at_zero_predictor(&n, hs[k], r.prm));
+            assert_true(r.lambda_error <= 1e-9 * fabs(r.lambda_ref) + 8.0 * r.floor);
+            assert_true(r.qdd_error <= 1e-9 * 10.0 + 8.0 * r.floor);
         }
     }
 }
