@@ -74,10 +74,13 @@ ch = rows("chain.csv")
 if ch:
     N = np.array([num(r["links"]) for r in ch])
     us = np.array([num(r["us_per_step"]) for r in ch])
+    later = np.array([num(r["later_us_per_step"]) for r in ch])
+    nsteps = int(num(ch[0]["steps"]))
     lim = np.array([num(r["limit_us"]) for r in ch])
     mem = np.array([num(r["peak_rss_kib"]) for r in ch]) / 1024.0
     fig, ax = plt.subplots(1, 2, figsize=(12, 4.2))
-    ax[0].loglog(N, us, "o-", label="time per step")
+    ax[0].loglog(N, us, "o-", label="time per step (all %d steps)" % nsteps)
+    ax[0].loglog(N, later, "^-", ms=4, label="steps 2-%d" % nsteps)
     ax[0].loglog(N, lim, "s--", label="limit (one residual + one solve)")
     ax[0].loglog(N, us[0] * N / N[0], "k:", lw=1, label="linear in N")
     ax[0].set(xlabel="links N (3N coordinates, 2N constraints)", ylabel="microseconds")
@@ -88,11 +91,13 @@ if ch:
     ax[1].set(xlabel="links N", ylabel="MiB")
     ax[1].legend()
     ax[1].grid(True, which="both", lw=0.3)
-    fig.suptitle("N-link chain, sparse path, h = 1e-3, 10 steps")
+    fig.suptitle("N-link chain, sparse path, h = 1e-3, %d steps from rest" % nsteps)
     save(fig, "chain.png")
     i1, i2 = list(N).index(1000), list(N).index(100000)
     print("  chain: time per step %.3g us at N = 1000, %.3g us at N = 100000: %.0f-fold; peak "
           "memory %.1f MiB -> %.1f MiB" % (us[i1], us[i2], us[i2] / us[i1], mem[i1], mem[i2]))
+    print("  chain: steps 2-%d %.3g us at N = 1000, %.3g us at N = 100000: %.0f-fold" % (
+        nsteps, later[i1], later[i2], later[i2] / later[i1]))
     ins = {int(num(r["links"])): num(r["instructions_per_step"]) for r in rows("chain_instructions.csv")}
     if 1000 in ins and 100000 in ins:
         print("  chain: instructions per step %.3g at N = 1000, %.3g at N = 100000: %.0f-fold" % (
