@@ -496,8 +496,11 @@ GA_API ga_status ga_set_initial_step(ga_solver *s, double h0);
  *  Use with ga_interpolate for output at user times without shortening steps. The first
  *  adaptive call allocates the workspace of the error estimate's projection (fixed-step runs
  *  do without it); ga_step_adaptive never allocates after that.
- *  Errors: GA_ERR_ARG, GA_ERR_STATE, GA_ERR_STEP_SIZE, fatal callback failures, and the
- *  statuses of ga_step. On failure the state is that of the last accepted step. */
+ *  Errors: GA_ERR_ARG (t_stop not after t; or the index-3 formulation with constraints at
+ *  rho_inf = 1, where each change of h starts a multiplier transient that is never damped and
+ *  the steps would shrink without end: take GA_INDEX2_STABILIZED or rho_inf < 1),
+ *  GA_ERR_STATE, GA_ERR_STEP_SIZE, fatal callback failures, and the statuses of ga_step. On
+ *  failure the state is that of the last accepted step. */
 GA_API ga_status ga_step_adaptive(ga_solver *s, double t_stop);
 
 /** Adaptive steps until t_out (>= t), landing on it exactly (ga_get_t then returns t_out).

@@ -987,6 +987,80 @@ static void fast_rotation_needs_damping_or_index2(void **state)
     assert_true(i2_09 < 0.01);
 }
 
+/* ---- rho_inf = 1: no adaptive steps in index 3 (ALGORITHMS.md 1.4, 6.2) ------------------- */
+/* In index 3 a change of h starts a transient of qdd and lambda with the double root -rho_inf:
+ * at rho_inf = 1 it never decays and the error estimate shrinks the steps without end (a
+ * double pendulum took 11 million steps to t = 0.36 before GA_ERR_STEP_SIZE). The call is
+ * refused before any work; index 2, and a system without constraints, run at rho_inf = 1 in
+ * about as many steps as at 0.9. */
+static int osc_mass(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    M[0] = 1.0;
+    return 0;
+}
+static int osc_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)v, (void)u;
+    f[0] = -100.0 * sin(q[0]);
+    return 0;
+}
+
+static long long adaptive_steps_to(ga_solver *s, double t_end)
+{
+    long long steps = -1;
+    assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+    assert_int_equal(ga_advance(s, t_end), GA_OK);
+    assert_int_equal(ga_get_counter(s, GA_COUNT_STEPS, &steps), GA_OK);
+    return steps;
+}
+
+static long long oscillator_steps(double rho)
+{
+    ga_solver *s = NULL;
+    double q = 1.0, v = 0.0;
+    assert_int_equal(ga_create(1, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, osc_mass, osc_force, NULL, NULL, NULL), GA_OK);
+    assert_int_equal(ga_set_rho_inf(s, rho), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, &q, &v), GA_OK);
+    const long long steps = adaptive_steps_to(s, 5.0);
+    ga_free(s);
+    return steps;
+}
+
+static void rho_one_adaptive_needs_index2_or_no_constraints(void **state)
+{
+    (void)state;
+    ga_solver *s = pendulum_solver(1.0, GA_INDEX3, 1, 1);
+    double before[20], after[20];
+    long long residuals = -1, steps = -1;
+    assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+    assert_int_equal(ga_get_state(s, before, 20), GA_OK);
+    assert_int_equal(ga_step_adaptive(s, 1.0), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "need rho_inf < 1"));
+    assert_int_equal(ga_advance(s, 1.0), GA_ERR_ARG);
+    assert_int_equal(ga_get_state(s, after, 20), GA_OK);
+    assert_memory_equal(before, after, sizeof before);
+    assert_int_equal(ga_get_counter(s, GA_COUNT_RESIDUALS, &residuals), GA_OK);
+    assert_int_equal(ga_get_counter(s, GA_COUNT_STEPS, &steps), GA_OK);
+    assert_true(residuals == 0 && steps == 0);
+    /* fixed steps stay allowed: with the corrected start they converge (test above) */
+    assert_int_equal(ga_step(s, 1e-3), GA_OK);
+    ga_free(s);
+
+    s = pendulum_solver(1.0, GA_INDEX2_STABILIZED, 1, 1);
+    const long long i2_rho1 = adaptive_steps_to(s, 1.0);
+    ga_free(s);
+    s = pendulum_solver(0.9, GA_INDEX2_STABILIZED, 1, 1);
+    const long long i2_rho09 = adaptive_steps_to(s, 1.0);
+    ga_free(s);
+    const long long osc_rho1 = oscillator_steps(1.0), osc_rho09 = oscillator_steps(0.9);
+    printf("  adaptive steps at rho_inf = 1 (0.9): pendulum in index 2 %lld (%lld), oscillator "
+           "without constraints %lld (%lld)\n", i2_rho1, i2_rho09, osc_rho1, osc_rho09);
+    assert_true(i2_rho1 <= 2 * i2_rho09);
+    assert_true(osc_rho1 <= 2 * osc_rho09);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -996,6 +1070,7 @@ int main(void)
         cmocka_unit_test(corrected_start_removes_the_first_order_transient),
         cmocka_unit_test(rho_one_needs_the_corrected_start),
         cmocka_unit_test(fast_rotation_needs_damping_or_index2),
+        cmocka_unit_test(rho_one_adaptive_needs_index2_or_no_constraints),
         cmocka_unit_test(sliver_steps_do_not_derail_the_run),
         cmocka_unit_test(landing_on_t_stop_keeps_the_planned_step),
         cmocka_unit_test(long_step_after_short_ones_starts_afresh),
