@@ -10,7 +10,9 @@
  *   - a failed ga_step or ga_step_adaptive leaves t, q, v, qdd, a and lambda bit-identical;
  *   - a callback's call of ga_step on its own solver is refused with GA_ERR_STATE.
  * Models: a double pendulum in Cartesian coordinates (4 coordinates, 2 constraints), the same
- * with its first constraint stated twice (3, one redundant), and two free particles (none).
+ * with its first constraint stated twice (3, one redundant), and two free particles (none);
+ * a third of the runs declare sparsity patterns and take the sparse path, and pattern
+ * declarations (valid ones, and invalid ones that must be refused) come at random too.
  * ga_advance is left out: it runs as many steps as its interval needs, which at the step
  * limits and tolerances drawn here can be millions (its checks are those of
  * ga_step_adaptive, which it repeats). */
@@ -40,6 +42,7 @@ typedef struct model {
     long calls, fault_at;  /* it fails from its fault_at-th call on */
     ga_solver *s;
     int reentry_allowed;   /* a callback's ga_step on its own solver returned other than STATE */
+    int sparse_M, sparse_J, sparse_K; /* patterns declared: the callbacks write values only */
 } model;
 
 static uint64_t next(model *md)
@@ -72,11 +75,17 @@ static int misbehave(model *md, int callback, double *out, int len)
 
 static int mass(double t, const double *q, double *M, void *user)
 {
+    model *md = user;
     (void)t, (void)q;
+    if (md->sparse_M) {  /* the diagonal */
+        for (int i = 0; i < N; ++i)
+            M[i] = 1.0;
+        return misbehave(md, MASS, M, N);
+    }
     memset(M, 0, sizeof(double) * N * N);
     for (int i = 0; i < N; ++i)
         M[i + i * N] = 1.0;
-    return misbehave(user, MASS, M, N * N);
+    return misbehave(md, MASS, M, N * N);
 }
 static int force(double t, const double *q, const double *v, double *f, void *user)
 {
@@ -100,6 +109,13 @@ static int jacobian(double t, const double *q, double *J, void *user)
     model *md = user;
     const int m = md->m;
     (void)t;
+    if (md->sparse_J) {  /* in the order of J_ROWS, J_COLS */
+        const double values[] = {q[0], q[1], q[0] - q[2], q[1] - q[3], q[2] - q[0], q[3] - q[1],
+                                 q[0], q[1]};
+        const int nnz = m == 3 ? 8 : 6;
+        memcpy(J, values, sizeof(double) * (size_t)nnz);
+        return misbehave(md, JACOBIAN, J, nnz);
+    }
     memset(J, 0, sizeof(double) * (size_t)(m * N));
     J[0] = q[0], J[m] = q[1];
     J[1] = q[0] - q[2], J[1 + m] = q[1] - q[3], J[1 + 2 * m] = q[2] - q[0],
@@ -114,6 +130,13 @@ static int stiffness(double t, const double *q, const double *v, const double *q
 {
     model *md = user;
     (void)t, (void)q, (void)v, (void)qdd;
+    if (md->sparse_K) {  /* in the order of K_ROWS, K_COLS */
+        const double l0 = md->m ? lambda[0] + (md->m == 3 ? lambda[2] : 0.0) : 0.0,
+                     l1 = md->m ? lambda[1] : 0.0;
+        const double values[] = {l0 + l1, l0 + l1, l1, l1, -l1, -l1, -l1, -l1};
+        memcpy(K, values, sizeof values);
+        return misbehave(md, STIFFNESS, K, 8);
+    }
     memset(K, 0, sizeof(double) * N * N);
     if (md->m > 0) {
         const double l0 = lambda[0] + (md->m == 3 ? lambda[2] : 0.0), l1 = lambda[1];
@@ -140,6 +163,52 @@ static int time_derivative(double t, const double *q, double *phi_t, void *user)
     for (int i = 0; i < md->m; ++i)
         phi_t[i] = 0.0;
     return misbehave(md, DT, phi_t, md->m);
+}
+
+/* The patterns the callbacks above write when declared; and ones ga_set_pattern must refuse. */
+static const int M_DIAG[] = {0, 1, 2, 3}, M_COLPTR[] = {0, 1, 2, 3, 4};
+static const int J_ROWS[] = {0, 0, 1, 1, 1, 1, 2, 2}, J_COLS[] = {0, 1, 0, 1, 2, 3, 0, 1};
+static const int K_ROWS[] = {0, 1, 2, 3, 0, 2, 1, 3}, K_COLS[] = {0, 1, 2, 3, 2, 0, 3, 1};
+
+static ga_status declare_pattern(model *md, ga_solver *s, int *must_fail)
+{
+    static const int bad_rows[] = {0, 5, -1, 2}, bad_cols[] = {0, 1, 2, 4};
+    const int k = pick(md, 9);
+    *must_fail = k >= 5;
+    switch (k) {
+    case 0: {
+        const ga_status st = ga_set_pattern(s, GA_MATRIX_MASS, N, M_DIAG, M_DIAG);
+        md->sparse_M |= st == GA_OK;
+        return st;
+    }
+    case 1: {
+        const ga_status st = ga_set_pattern_csc(s, GA_MATRIX_MASS, M_COLPTR, M_DIAG);
+        md->sparse_M |= st == GA_OK;
+        return st;
+    }
+    case 2: {
+        const ga_status st =
+            ga_set_pattern(s, GA_MATRIX_JACOBIAN, md->m == 3 ? 8 : 6, J_ROWS, J_COLS);
+        md->sparse_J |= st == GA_OK;
+        return st;
+    }
+    case 3: {
+        const ga_status st = ga_set_pattern(s, GA_MATRIX_STIFFNESS, 8, K_ROWS, K_COLS);
+        md->sparse_K |= st == GA_OK;
+        return st;
+    }
+    case 4: return ga_set_pattern(s, GA_MATRIX_DAMPING, 0, NULL, NULL);
+    /* each of these must be refused: an index out of range, NULL arrays with entries, an
+     * unknown matrix, a negative count, a decreasing colptr */
+    case 5: return ga_set_pattern(s, pick(md, 4), 4, bad_rows, bad_cols);
+    case 6: return ga_set_pattern(s, pick(md, 4), 3, NULL, M_DIAG);
+    case 7: return ga_set_pattern(s, 4 + pick(md, 3), 4, M_DIAG, M_DIAG);
+    default: {
+        static const int decreasing[] = {0, 2, 1, 3, 4};
+        return pick(md, 2) ? ga_set_pattern(s, GA_MATRIX_MASS, -1, M_DIAG, M_DIAG)
+                           : ga_set_pattern_csc(s, GA_MATRIX_MASS, decreasing, M_DIAG);
+    }
+    }
 }
 
 static double edge_value(model *md)
@@ -190,7 +259,7 @@ static void check_transaction(ga_solver *s, int m, ga_status st, const double *b
                  ga_strerror(st), ga_last_error(s));
 }
 
-static void run_sequence(int seq, long long *calls, long long *steps_ok)
+static void run_sequence(int seq, long long *calls, long long *steps_ok, long long *sparse_ok)
 {
     model md = {0};
     md.rng = 0x9E3779B97F4A7C15ull * (uint64_t)(seq + 1);
@@ -202,6 +271,20 @@ static void run_sequence(int seq, long long *calls, long long *steps_ok)
     assert_int_equal(ga_create(N, md.m, &s), GA_OK);
     md.s = s;
     assert_int_equal(ga_set_callbacks(s, mass, force, constraint, jacobian, &md), GA_OK);
+    if (pick(&md, 3) == 0) {  /* a third of the runs on the sparse path */
+        md.sparse_M = 1;
+        assert_int_equal(ga_set_pattern(s, GA_MATRIX_MASS, N, M_DIAG, M_DIAG), GA_OK);
+        if (md.m > 0) {
+            md.sparse_J = 1;
+            assert_int_equal(
+                ga_set_pattern(s, GA_MATRIX_JACOBIAN, md.m == 3 ? 8 : 6, J_ROWS, J_COLS), GA_OK);
+        }
+        if (pick(&md, 2)) {
+            md.sparse_K = 1;
+            assert_int_equal(ga_set_pattern(s, GA_MATRIX_STIFFNESS, 8, K_ROWS, K_COLS), GA_OK);
+        }
+        assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    }
     const int ops = 5 + pick(&md, MAX_OPS - 5);
     for (int op = 0; op < ops; ++op) {
         if (pick(&md, 6) == 0) {  /* arm a failure (or disarm: NONE) */
@@ -214,7 +297,7 @@ static void run_sequence(int seq, long long *calls, long long *steps_ok)
         ga_status st = GA_OK;
         int changes = 1;
         const char *call = "";
-        switch (pick(&md, 32)) {
+        switch (pick(&md, 36)) {
         case 0: call = "ga_set_rho_inf"; st = ga_set_rho_inf(s, edge_value(&md)); break;
         case 1: {
             const double am = edge_value(&md), af = edge_value(&md), b = edge_value(&md);
@@ -255,7 +338,7 @@ static void run_sequence(int seq, long long *calls, long long *steps_ok)
             st = ga_set_init_mode(s, mode, edge_value(&md));
             break;
         }
-        case 20: case 21: {
+        case 20: case 21: case 34: case 35: {
             const double angle = 0.3 + uniform(&md);
             double q0[N] = {sin(angle), -cos(angle), sin(angle) + 1.0, -cos(angle)}, v0[N] = {0};
             if (pick(&md, 4) == 0)
@@ -273,6 +356,7 @@ static void run_sequence(int seq, long long *calls, long long *steps_ok)
             st = ga_step(s, step_size(&md));
             check_transaction(s, md.m, st, before, len, call, seq);
             *steps_ok += st == GA_OK;
+            *sparse_ok += st == GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
             break;
         }
         case 26: {
@@ -284,6 +368,7 @@ static void run_sequence(int seq, long long *calls, long long *steps_ok)
             st = ga_step_adaptive(s, t_stop);
             check_transaction(s, md.m, st, before, len, call, seq);
             *steps_ok += st == GA_OK;
+            *sparse_ok += st == GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
             break;
         }
         case 27: {
@@ -325,6 +410,14 @@ static void run_sequence(int seq, long long *calls, long long *steps_ok)
             }
             break;
         }
+        case 31: case 32: {
+            int must_fail = 0;
+            call = "ga_set_pattern";
+            st = declare_pattern(&md, s, &must_fail);
+            if (must_fail && st == GA_OK)
+                fail_msg("sequence %d: an invalid pattern was accepted", seq);
+            break;
+        }
         case 30: {
             double value;
             call = "ga_get_info";
@@ -351,12 +444,15 @@ static void run_sequence(int seq, long long *calls, long long *steps_ok)
 static void random_call_sequences_keep_the_contract(void **state)
 {
     (void)state;
-    long long calls = 0, steps_ok = 0;
+    long long calls = 0, steps_ok = 0, sparse_ok = 0;
     for (int seq = 0; seq < SEQUENCES; ++seq)
-        run_sequence(seq, &calls, &steps_ok);
-    printf("  %d sequences, %lld calls, %lld accepted steps\n", SEQUENCES, calls, steps_ok);
-    /* the sequences must reach the stepping code, not only the argument checks */
-    assert_true(steps_ok > SEQUENCES);
+        run_sequence(seq, &calls, &steps_ok, &sparse_ok);
+    printf("  %d sequences, %lld calls, %lld accepted steps (%lld on the sparse path)\n",
+           SEQUENCES, calls, steps_ok, sparse_ok);
+    /* the sequences must reach the stepping code, dense and sparse, not only the checks of
+     * arguments and of the call order */
+    assert_true(steps_ok > SEQUENCES / 2);
+    assert_true(sparse_ok > SEQUENCES / 100);
 }
 
 int main(void)
