@@ -584,8 +584,10 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
 GA_API ga_status ga_state_size(const ga_solver *s, size_t *len);
 /** Errors: GA_ERR_ARG (NULL, len too small), GA_ERR_STATE (before ga_init). */
 GA_API ga_status ga_get_state(const ga_solver *s, double *buf, size_t len);
-/** Errors: GA_ERR_ARG (NULL, wrong length, magic, version or sizes, non-finite values),
- *  GA_ERR_STATE (callbacks not set), GA_ERR_NOMEM. */
+/** Errors: GA_ERR_ARG (NULL, wrong length, magic, version or sizes, non-finite values, or
+ *  step-size entries galpha never writes: h_last or h_next negative or too small to move t,
+ *  err_prev negative, grew other than 0 or 1), GA_ERR_STATE (callbacks not set),
+ *  GA_ERR_NOMEM. */
 GA_API ga_status ga_set_state(ga_solver *s, const double *buf, size_t len);
 /**@}*/
 

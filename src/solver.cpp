@@ -723,6 +723,21 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
     for (std::size_t k = 4; k < len; ++k)
         if (!std::isfinite(buf[k]))
             return diag.fail(GA_ERR_ARG, "checkpoint entry %zu is not finite", k);
+    // The step-size controller's entries as a solver writes them: h_last and h_next are 0 (no
+    // step yet, no proposal) or steps that move t (ga_step refuses others); err_prev is not
+    // negative; grew is a flag. Anything else was not written by galpha, and would fail later,
+    // far from here (h_last = 1e-320 multiplies a_n by 1e317 when it is rescaled for the next
+    // step; h_next = 1e-320 ends the next adaptive step below its minimum).
+    const double t = buf[4];
+    for (const int k : {5, 6}) {
+        const double h = buf[k];
+        if (h < 0.0 || (h > 0.0 && t + h == t && t - h == t))
+            return diag.fail(GA_ERR_ARG, "checkpoint entry %d (%s = %g) is not a step from "
+                             "t = %.17g", k, k == 5 ? "h_last" : "h_next", h, t);
+    }
+    if (buf[7] < 0.0 || (buf[8] != 0.0 && buf[8] != 1.0))
+        return diag.fail(GA_ERR_ARG, "checkpoint entries 7-8 (err_prev = %g, grew = %g) are "
+                         "not those of galpha's step-size control", buf[7], buf[8]);
     if (!model.ready())
         return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
     if (auto st = setup())

@@ -488,6 +488,22 @@ static void bad_checkpoints_are_refused(void **state)
     buf[8] = NAN;
     assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
     expect_message(x->s, "not finite");
+    /* the step-size control's entries (t = 0.1 here): h_last and h_next 0 or steps that move
+     * t, err_prev >= 0, grew 0 or 1 */
+    const double bad_controls[][2] = {{5, -1e-3}, {5, 1e-320}, {5, 1e-18}, {6, -1.0},
+                                      {6, 1e-320}, {7, -0.5}, {8, 0.5}, {8, 2.0}};
+    for (size_t k = 0; k < sizeof bad_controls / sizeof bad_controls[0]; ++k) {
+        memcpy(buf, before, len * sizeof(double));
+        buf[(int)bad_controls[k][0]] = bad_controls[k][1];
+        assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
+        expect_message(x->s, bad_controls[k][0] <= 6 ? "is not a step from"
+                                                      : "step-size control");
+    }
+    memcpy(buf, before, len * sizeof(double));
+    buf[5] = 0.0; /* a checkpoint from before the first step */
+    buf[6] = 0.0;
+    assert_int_equal(ga_set_state(x->s, buf, len), GA_OK);
+    assert_int_equal(ga_set_state(x->s, before, len), GA_OK);
     snapshot(x->s, after);
     assert_memory_equal(before, after, len * sizeof(double));
 }
