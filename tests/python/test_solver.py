@@ -87,6 +87,25 @@ def test_callback_exception_is_reraised_and_solver_stays_usable():
         assert s.stats["failed_steps"] == 2
 
 
+@pytest.mark.parametrize("rc,expected", [(2**32, galpha.CallbackRetry),
+                                         (np.int64(-3), galpha.CallbackError),
+                                         (-0.5, galpha.CallbackError), (0.5, galpha.CallbackRetry),
+                                         (float("nan"), TypeError), ("ok", TypeError)])
+def test_callback_return_value_counts_by_its_sign(rc, expected):
+    """0/None succeed, > 0 is recoverable, < 0 fatal, whatever the type: 2**32 must not wrap to
+    0 in the C int, -0.5 must not truncate to 0; a value without a sign is an error."""
+    def force_returning(t, q, v, f):
+        f[:] = (0.0, -G)
+        return rc if t > 0 else None
+
+    with galpha.Solver(2, 1, mass, force_returning, constraint, jacobian) as s:
+        s.init(0.0, Q0, V0)
+        state = s.get_state()
+        with pytest.raises(expected):
+            s.step(1e-3)
+        assert np.array_equal(s.get_state(), state)
+
+
 def test_status_maps_to_exception_classes():
     def retry_force(t, q, v, f):
         f[:] = (0.0, -G)

@@ -128,12 +128,22 @@ class Solver:
                       "constraint_accel": constraint_accel, "constraint_dt": constraint_dt}
 
         # Trampolines: views of the library's buffers, every exception caught and stored.
+        # The return value counts by its sign, as in C: int() would pass 2**32 through the
+        # C int as 0 (success) and truncate -0.5 to 0; a value without a sign (NaN, a string)
+        # is an error of the callback.
         def call(fn, *args):
             if self._pending is not None:
                 return -1
             try:
                 rc = fn(*args)
-                return 0 if rc is None else int(rc)
+                if rc is None or rc == 0:
+                    return 0
+                if rc > 0:
+                    return 1
+                if rc < 0:
+                    return -1
+                raise TypeError("callback %s returned %r: expected None or an int"
+                                % (getattr(fn, "__name__", "?"), rc))
             except BaseException as e:  # re-raised by the call that stepped
                 self._pending = e
                 return -1
