@@ -106,6 +106,29 @@ def test_callback_return_value_counts_by_its_sign(rc, expected):
         assert np.array_equal(s.get_state(), state)
 
 
+def test_close_from_a_callback_is_refused_and_the_solver_stays_open():
+    box = {}
+
+    def closing_force(t, q, v, f):
+        f[:] = (0.0, -G)
+        if t > 0 and not box.get("tried"):
+            box["tried"] = True
+            box["s"].close()
+
+    s = galpha.Solver(2, 1, mass, closing_force, constraint, jacobian)
+    box["s"] = s
+    s.init(0.0, Q0, V0)
+    state = s.get_state()
+    with pytest.raises(galpha.StateError, match="close"):
+        s.step(1e-3)
+    assert np.array_equal(s.get_state(), state)  # still open, at its last accepted state
+    s.step(1e-3)
+    assert s.t == pytest.approx(1e-3)
+    s.close()
+    with pytest.raises(galpha.StateError, match="closed"):
+        s.step(1e-3)
+
+
 def test_status_maps_to_exception_classes():
     def retry_force(t, q, v, f):
         f[:] = (0.0, -G)

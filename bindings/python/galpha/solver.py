@@ -79,6 +79,7 @@ class Solver:
                  step_limits=None, initial_step=None, patterns=None):
         self._ptr = None
         self._pending = None          # exception raised inside a callback
+        self._in_callback = 0         # callbacks of this solver running now
         self._views = {}              # (address, shape, writeable) -> ndarray
         self.n, self.m = int(n), int(m)
         handle = ctypes.c_void_p()
@@ -134,6 +135,7 @@ class Solver:
         def call(fn, *args):
             if self._pending is not None:
                 return -1
+            self._in_callback += 1
             try:
                 rc = fn(*args)
                 if rc is None or rc == 0:
@@ -147,6 +149,8 @@ class Solver:
             except BaseException as e:  # re-raised by the call that stepped
                 self._pending = e
                 return -1
+            finally:
+                self._in_callback -= 1
 
         self._cbs = [
             _MASS(lambda t, q, M, u: call(mass, t, v(q, (n,)), v(M, shape("mass", (n, n)),
@@ -250,7 +254,10 @@ class Solver:
 
     # ---- life cycle -------------------------------------------------------------------------
     def close(self):
-        """Free the C solver (idempotent)."""
+        """Free the C solver (idempotent). Not from one of its own callbacks: ga_free ignores
+        that call (the solver is in use), so it raises StateError instead of leaking it."""
+        if getattr(self, "_in_callback", 0):
+            raise error_for(_ffi.GA_ERR_STATE, "close() from a callback of the same solver")
         if self._ptr is not None:
             self._free(self._ptr)
             self._ptr = None
