@@ -993,19 +993,6 @@ static void fast_rotation_needs_damping_or_index2(void **state)
  * double pendulum took 11 million steps to t = 0.36 before GA_ERR_STEP_SIZE). The call is
  * refused before any work; index 2, and a system without constraints, run at rho_inf = 1 in
  * about as many steps as at 0.9. */
-static int osc_mass(double t, const double *q, double *M, void *u)
-{
-    (void)t, (void)q, (void)u;
-    M[0] = 1.0;
-    return 0;
-}
-static int osc_force(double t, const double *q, const double *v, double *f, void *u)
-{
-    (void)t, (void)v, (void)u;
-    f[0] = -100.0 * sin(q[0]);
-    return 0;
-}
-
 static long long adaptive_steps_to(ga_solver *s, double t_end)
 {
     long long steps = -1;
@@ -1015,12 +1002,13 @@ static long long adaptive_steps_to(ga_solver *s, double t_end)
     return steps;
 }
 
+/* the pendulum ODE of the rescaling test above, without constraints */
 static long long oscillator_steps(double rho)
 {
     ga_solver *s = NULL;
     double q = 1.0, v = 0.0;
     assert_int_equal(ga_create(1, 0, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, osc_mass, osc_force, NULL, NULL, NULL), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pend_ode_mass, pend_ode_force, NULL, NULL, NULL), GA_OK);
     assert_int_equal(ga_set_rho_inf(s, rho), GA_OK);
     assert_int_equal(ga_init(s, 0.0, &q, &v), GA_OK);
     const long long steps = adaptive_steps_to(s, 5.0);

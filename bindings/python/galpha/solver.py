@@ -256,7 +256,7 @@ class Solver:
     def close(self):
         """Free the C solver (idempotent). Not from one of its own callbacks: ga_free ignores
         that call (the solver is in use), so it raises StateError instead of leaking it."""
-        if getattr(self, "_in_callback", 0):
+        if self._in_callback:
             raise error_for(_ffi.GA_ERR_STATE, "close() from a callback of the same solver")
         if self._ptr is not None:
             self._free(self._ptr)
