@@ -2,6 +2,9 @@
 // reporting a failure inside ga_step never allocates.
 #pragma once
 
+#include <cstddef>
+#include <cstring>
+
 #include "galpha.h"
 
 namespace ga {
@@ -23,8 +26,13 @@ public:
     void clear() { text_[0] = '\0'; }
     const char *text() const { return text_; }
 
+    // Keep a message aside and put it back (a failure reported after later attempts).
+    static constexpr std::size_t kSize = 512;
+    void copy_to(char (&out)[kSize]) const { std::memcpy(out, text_, kSize); }
+    void restore(const char (&in)[kSize]) { std::memcpy(text_, in, kSize); }
+
 private:
-    char text_[512] = {0};
+    char text_[kSize] = {0};
 };
 
 }  // namespace ga

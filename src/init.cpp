@@ -14,9 +14,19 @@ namespace {
 constexpr int kMaxProjectionIterations = 50;
 const double kEps = std::numeric_limits<double>::epsilon();
 
-double max_abs(const ModelMatrix &A)
+// Largest |entry| in the rows whose flag is set (all rows when active is null): a constraint
+// dropped as redundant takes no part in the scaling.
+double max_abs(const ModelMatrix &A, const unsigned char *active = nullptr)
 {
-    return A.size() ? Eigen::Map<const Vec>(A.data(), A.size()).cwiseAbs().maxCoeff() : 0.0;
+    if (!active)
+        return A.size() ? Eigen::Map<const Vec>(A.data(), A.size()).cwiseAbs().maxCoeff() : 0.0;
+    double m = 0.0;
+    for (Eigen::Index k = 0; k < A.size(); ++k) {
+        const int row = A.dense() ? static_cast<int>(k % A.rows()) : A.row_index()[k];
+        if (active[row])
+            m = std::max(m, std::fabs(A.data()[k]));
+    }
+    return m;
 }
 
 Eigen::Index argmax_abs(const Vec &x)
@@ -88,7 +98,7 @@ ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v,
         return st;
     jacobian_valid_ = false;  // S_ holds another matrix now
     double sigma = 1.0;
-    const double mmax = max_abs(M_), jmax = max_abs(J_);
+    const double mmax = max_abs(M_), jmax = max_abs(J_, active_ptr());
     if (mmax > 0.0 && jmax > 0.0)
         sigma = jmax / mmax;
     count(counters, GA_COUNT_FACTORIZATIONS);

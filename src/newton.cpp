@@ -23,62 +23,88 @@ double relative(double increment, double tol, double value)
 constexpr double kMinTrustedRate = 0.05;
 // Iterations one matrix is given to converge before it counts as too slow.
 constexpr int kIterationBudget = 4;
+// An increment within its floor that shrank by less than this factor is noise.
+constexpr double kStagnation = 0.5;
+// The round-off floor of the positions, in ulps of |q|.
+constexpr double kFloorUlps = 64.0;
 }  // namespace
 
 ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &size,
-                                                double beta_prime)
+                                                double beta_prime, double gamma_prime)
 {
     ++iteration_;
     ++with_matrix_;
-    const double dq_norm = size.dq, q_norm = size.q;
-    double eta = std::max(relative(dq_norm, tol, q_norm),
-                          relative(beta_prime * size.dw, tol, size.qdd));
-    eta = std::max(eta, relative(size.dlambda, tol, size.lambda));  // 0 without constraints
-    ratio_ = eta;
+    enum { Q, A, L, K };
+    const std::array<double, K> e = {relative(size.dq, tol, size.q),
+                                     relative(beta_prime * size.dw, tol, size.qdd),
+                                     relative(size.dlambda, tol, size.lambda)};
+    ratio_ = std::max({e[Q], e[A], e[L]});
 
-    double theta = -1.0;
-    // A rate needs two finite ratios: an increment of a quantity that was exactly zero has an
-    // infinite ratio, and eta / inf = 0 would claim convergence after any second increment.
-    const bool measured = previous_ratio_ > 0.0 && std::isfinite(previous_ratio_);
-    if (measured) {
-        theta = eta / previous_ratio_;
-        rate_ = theta;
-    } else if (theta_prev_ >= 0.0) {
-        theta = std::max(theta_prev_, kMinTrustedRate);
-    }
-    previous_ratio_ = eta;
+    // Round-off floors (newton.hpp).
+    const double ulps = kFloorUlps * std::numeric_limits<double>::epsilon();
+    const double q_floor = ulps * size.q;
+    const double dw_floor = size.dw_is_dq         ? q_floor
+                            : gamma_prime > 0.0 ? ulps * size.v / gamma_prime
+                                                : 0.0;
+    const double relative_qdd_floor = size.qdd > 0.0 ? beta_prime * dw_floor / size.qdd : 0.0;
+    const std::array<bool, K> at_floor = {size.dq <= q_floor, size.dw <= dw_floor,
+                                          size.dlambda <= relative_qdd_floor * size.lambda};
 
-    if (eta <= 1.0)
-        return Verdict::Converged;
-    if (theta >= 0.0 && theta < 1.0 && eta * theta / (1.0 - theta) <= 1.0)
-        return Verdict::Converged;
-
-    // Round-off exit: positions no longer move. With q fixed the equations are linear in
-    // lambda (qdd follows q, eq. 7), so the update that found q in place has corrected lambda
-    // as far as the matrix's Phi_q^T is that of the current q: at once if the matrix is of
-    // this step and q has moved within the tolerance since (the accelerations' increment dw
-    // at round-off too, for the index-2 form, where it differs from dq); otherwise after a
-    // second such increment.
-    const double ulps = 64.0 * std::numeric_limits<double>::epsilon();
-    const double roundoff = ulps * q_norm;
-    const bool dq_at_roundoff = dq_norm <= roundoff;
-    moved_since_matrix_ += relative(dq_norm, tol, q_norm);
-    // "within the tolerance" is within round-off where the tolerance is below it
+    // One update at the floor with a matrix factorized in this step at an iterate within the
+    // tolerance (within round-off where the tolerance is below it) of the current one: it
+    // solved the equations, linear in lambda and qdd once q stays.
+    moved_since_matrix_ += e[Q];
     const double moved_limit = std::max(1.0, ulps / tol);
-    const bool matrix_current =
-        fresh_matrix_ && moved_since_matrix_ <= moved_limit && size.dw <= roundoff;
-    const bool stop = dq_at_roundoff && (previous_dq_at_roundoff_ || matrix_current);
-    previous_dq_at_roundoff_ = dq_at_roundoff;
-    if (stop)
+    const bool matrix_current = fresh_matrix_ && moved_since_matrix_ <= moved_limit &&
+                                at_floor[Q] && at_floor[A];
+
+    previous_dq_at_roundoff_ = at_floor[Q];
+    if (matrix_current) {
+        previous_ = e;
         return Verdict::Converged;
-    if (!dq_at_roundoff) {
-        if (with_matrix_ >= kIterationBudget)
-            return Verdict::Slow;
-        if (theta >= 1.0)
+    }
+
+    std::array<double, K> theta;
+    std::array<bool, K> measured, done;
+    double rate = -1.0;
+    bool converged = true;
+    for (int k = 0; k < K; ++k) {
+        // A rate needs two finite ratios: an increment of a quantity that was exactly zero
+        // has an infinite ratio, and e / inf = 0 would claim convergence.
+        measured[k] = previous_[k] > 0.0 && std::isfinite(previous_[k]);
+        theta[k] = measured[k]        ? e[k] / previous_[k]
+                   : theta_prev_ >= 0 ? std::max(theta_prev_, kMinTrustedRate)
+                                      : -1.0;
+        if (measured[k] && !at_floor[k])
+            rate = std::max(rate, theta[k]);
+        const bool within = e[k] <= 1.0;
+        const bool predicted = theta[k] >= 0.0 && theta[k] < 1.0 &&
+                               e[k] * theta[k] / (1.0 - theta[k]) <= 1.0;
+        const bool noise = at_floor[k] && measured[k] && theta[k] >= kStagnation;
+        done[k] = within || predicted || noise;
+        converged = converged && done[k];
+    }
+    previous_ = e;
+    if (rate >= 0.0)
+        rate_ = rate;
+    if (converged)
+        return Verdict::Converged;
+
+    // Positions at their floor with a matrix of an earlier step, and something else not yet
+    // converged: iterating on would feed the round-off of q through the old Phi_q into v and
+    // qdd at every update (gamma' and beta' times it). A matrix of the current q ends the step
+    // in one update instead.
+    if (at_floor[Q] && !fresh_matrix_)
+        return Verdict::Slow;
+    // Not converged: is this matrix too slow for what is left above the floors?
+    for (int k = 0; k < K; ++k) {
+        if (done[k] || at_floor[k])
+            continue;
+        if (with_matrix_ >= kIterationBudget || theta[k] >= 1.0)
             return Verdict::Slow;
         // error predicted after the iterations left in the budget (from a measured rate)
-        if (measured && theta > 0.0 &&
-            eta * std::pow(theta, kIterationBudget - with_matrix_) / (1.0 - theta) > 1.0)
+        if (measured[k] && theta[k] > 0.0 &&
+            e[k] * std::pow(theta[k], kIterationBudget - with_matrix_) / (1.0 - theta[k]) > 1.0)
             return Verdict::Slow;
     }
     return Verdict::Continue;

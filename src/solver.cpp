@@ -85,6 +85,8 @@ void apply_update(const Vec &dq, const Vec &dw, const Vec &dlambda, double gamma
         size.dlambda = std::max(size.dlambda, d.cwiseAbs().maxCoeff());
         size.lambda = std::max(size.lambda, lambda.cwiseAbs().maxCoeff());
     }
+    size.v = v_max;
+    size.dw_is_dq = !separate_dw;
     size.iterate_finite = std::isfinite(size.q) && std::isfinite(v_max) &&
                           std::isfinite(size.qdd) && std::isfinite(size.lambda);
 }
@@ -249,16 +251,16 @@ ga_status Solver::evaluate_mass(double t, const Vec &q)
 }
 
 // The Newton tolerance the user gave, or: 1e-10 for fixed steps (far below any discretization
-// error worth computing), and in adaptive mode 1e-2 rtol, not below that. With a tolerance on
-// the error, iterating the Newton error much further below it buys nothing (IDA and Radau5 tie
-// their Newton tests to the error tolerance too); on Andrews at rtol 1e-4 it saves a quarter of
-// the residual evaluations.
+// error worth computing), and in adaptive mode 1e-2 of the local error tolerance (rtol times
+// its calibration, control.cpp). With a tolerance on the error, iterating the Newton error much
+// further below it buys nothing (IDA and Radau5 tie their Newton tests to the error tolerance
+// too).
 double Solver::newton_tolerance(bool adaptive) const
 {
-    constexpr double kFixedStep = 1e-10, kFractionOfRtol = 1e-2;
+    constexpr double kFixedStep = 1e-10, kFractionOfLocal = 0.1;
     if (newton_tol > 0.0)
         return newton_tol;
-    return adaptive ? std::max(kFixedStep, kFractionOfRtol * control.rtol) : kFixedStep;
+    return adaptive ? kFractionOfLocal * control.rtol * control.calibration() : kFixedStep;
 }
 
 ga_status Solver::step(double h)
@@ -336,34 +338,71 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     reuse_attempted_ = !refresh;
     bool converged = false, used_stale = false;
     last_newton_iters_ = 0;
-    if (auto st = newton(h, tol, refresh, converged, used_stale))
+    // Each attempt starts from the predictor. A matrix found singular at an iterate the
+    // iteration moved to (beyond its first update) means that attempt diverged there; the
+    // next one, more careful, may not.
+    // Should every attempt fail so, the first one's message is the one reported.
+    ga_status st = GA_OK;
+    bool diverged = false;
+    char first_failure[Diagnostics::kSize] = "";
+    const auto attempt = [&](bool fresh) {
+        st = newton(h, tol, fresh, converged, used_stale);
+        if (st == GA_ERR_SINGULAR && (diverged || last_newton_iters_ > 1)) {
+            if (!diverged)
+                diag.copy_to(first_failure);
+            diverged = true;
+            converged = false;
+            return true;
+        }
+        return st == GA_OK;
+    };
+    if (!attempt(refresh))
         return st;
     if (!converged && used_stale) {
         // Modified Newton failed with an old matrix: the same step again, from the predictor,
         // with a matrix evaluated now (as IDA and Chrono do) before giving up.
-        if (auto st = newton(h, tol, true, converged, used_stale))
+        if (!attempt(true))
             return st;
     }
     if (!converged && tangents_deferred_) {
         // The simplified iteration failed or was too slow: again with the missing tangents.
         fd_tangents_ = true;
-        if (auto st = newton(h, tol, true, converged, used_stale))
+        if (!attempt(true))
+            return st;
+    }
+    // Then full Newton (a matrix at every iterate): modified Newton must not give up on a
+    // step that Algorithm 1 as printed solves (Andrews at h = 1e-3, index 2: the kept matrix
+    // let the iteration wander into a singular configuration). The fallbacks of a run in
+    // full Newton are all among these.
+    const ga_reuse_mode planned_reuse = reuse;
+    if (!converged && reuse == GA_REUSE_AUTO) {
+        reuse = GA_REUSE_NEVER;
+        const bool go_on = attempt(true);
+        reuse = planned_reuse;
+        if (!go_on)
             return st;
     }
     if (!converged && predictor == GA_PREDICTOR_EXTRAPOLATE) {
         // An extrapolation through a rough a_n (after abrupt changes of h, or without
         // rescaling) can start Newton outside its basin: once more from a_{n+1} = a_n.
         predictor = GA_PREDICTOR_CONSTANT_A;
-        const ga_status st = newton(h, tol, true, converged, used_stale);
+        reuse = GA_REUSE_NEVER;
+        const bool go_on = attempt(true);
         predictor = GA_PREDICTOR_EXTRAPOLATE;
-        if (st)
+        reuse = planned_reuse;
+        if (!go_on)
             return st;
+    }
+    if (!converged && diverged) {
+        diag.restore(first_failure);
+        return GA_ERR_SINGULAR;
     }
     if (!converged)
         return diag.fail(GA_ERR_NEWTON,
                          "Newton iteration did not converge in %d iterations in the step from "
                          "t = %.17g with h = %g (last increment / tolerance = %.3g)",
                          max_iter, s.t, h, convergence_.ratio());
+    diag.clear();  // an attempt before the one that converged may have left a message
     State &x = trial_;  // finite: every Newton update checked it
     const Params &p = params;
     // Algorithm 1, last line: a_{n+1} from eq. (3) with the converged qdd_{n+1}; a_n kept for
@@ -615,7 +654,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
                              "Newton %s is not finite in iteration %d of the step from "
                              "t = %.17g with h = %g",
                              size.increments_finite ? "iterate" : "increment", iter, s.t, h);
-        const auto verdict = convergence_.check(tol, size, c.beta_prime);
+        const auto verdict = convergence_.check(tol, size, c.beta_prime, c.gamma_prime);
         converged = verdict == ConvergenceTest::Verdict::Converged;
         if (!converged && tangents_deferred_ && refresh_done && !convergence_.at_roundoff() &&
             convergence_.iterations_with_matrix() >= 2 &&

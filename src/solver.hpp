@@ -32,6 +32,9 @@ struct Control {
     double h_next = 0.0, err_prev = 0.0;  // err_prev 0: none (see control.cpp)
     bool grew = false;
     double err_last = 0.0;  // error norm of the last accepted step
+    // The factor on the error test's weights (tolerance calibration, control.cpp): the local
+    // error tolerance is calibration() (atol + rtol |y|).
+    double calibration() const;
 };
 
 class Solver {
