@@ -517,11 +517,19 @@ GA_API ga_status ga_step_adaptive(ga_solver *s, double t_stop);
 GA_API ga_status ga_advance(ga_solver *s, double t_out);
 
 /** Dense output inside the last step [t_prev, t]: q and v by cubic Hermite interpolation
- *  (from q, v, qdd at both ends; third-order local accuracy), lambda linear. Any of q (n), v
- *  (n), lambda (m) may be NULL. Errors: GA_ERR_ARG (t outside the last step), GA_ERR_STATE
- *  (no step since ga_init or ga_set_state). */
+ *  (from q, v, qdd at both ends; third-order local accuracy); lambda as ga_get_lambda gives
+ *  it, at the interpolated (q, v) (GA_OUTPUT_CONSISTENT, default: one saddle-point solve per
+ *  call) or linear between the step's own values (GA_OUTPUT_STEP). Any of q (n), v (n),
+ *  lambda (m) may be NULL. Errors: GA_ERR_ARG (t outside the last step), GA_ERR_STATE (no step
+ *  since ga_init or ga_set_state, or from a callback), and with lambda in
+ *  GA_OUTPUT_CONSISTENT those of ga_get_lambda. */
 GA_API ga_status ga_interpolate(const ga_solver *s, double t, double *q, double *v,
                                 double *lambda);
+
+/** Accelerations at t inside the last step (n doubles): consistent with the interpolated
+ *  (q, v) (GA_OUTPUT_CONSISTENT) or linear between the step's own (GA_OUTPUT_STEP).
+ *  Errors: as ga_interpolate. */
+GA_API ga_status ga_interpolate_qdd(const ga_solver *s, double t, double *qdd);
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */
@@ -552,6 +560,32 @@ GA_API ga_status ga_set_init_mode(ga_solver *s, int mode, double init_tol);
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */
+/** @name Output of accelerations and multipliers */
+/**@{*/
+typedef enum ga_output {
+    GA_OUTPUT_CONSISTENT = 0, /**< (default) ga_get_qdd, ga_get_lambda, ga_interpolate and
+                                   ga_interpolate_qdd solve the acceleration-level system
+                                   [M Phi_q^T; Phi_q 0] [qdd; lambda] =
+                                   [f; -(Phi_qq(v,v) + 2 Phi_qt v + Phi_tt)] at the step's (or
+                                   the interpolated) t, q, v: as accurate as q and v, free of
+                                   the eps |q| / (beta h^2) round-off of index-3 multipliers
+                                   (paper, sec. 3.3) and of their transient after each change
+                                   of h in adaptive runs (ALGORITHMS.md sec. 1.4). Costs the
+                                   callbacks M, f, Phi_q, the constraint acceleration term and
+                                   one factorization of that matrix per accepted step read (the
+                                   result is kept until the next step), dense or sparse like
+                                   the iteration matrix, with a workspace of its own allocated
+                                   with the solver's: reading never changes the run. */
+    GA_OUTPUT_STEP = 1        /**< the values the step computed (Algorithm 1's qdd_{n+1} and
+                                   lambda_{n+1}), interpolated linearly: no work at output */
+} ga_output;
+
+/** mode is a ::ga_output. Errors: GA_ERR_ARG, GA_ERR_STATE, GA_ERR_NOMEM (consistent output
+ *  chosen after ga_init, and its workspace does not fit). */
+GA_API ga_status ga_set_output(ga_solver *s, int mode);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
 /** @name State
  *  Copies of the current (last accepted) state. Errors: GA_ERR_ARG (NULL), GA_ERR_STATE
  *  (before ga_init, or from a callback). */
@@ -562,11 +596,16 @@ GA_API ga_status ga_get_t(const ga_solver *s, double *t);
 GA_API ga_status ga_get_q(const ga_solver *s, double *q);
 /** Copy the velocities q' (n doubles). */
 GA_API ga_status ga_get_v(const ga_solver *s, double *v);
-/** Copy the accelerations q'' (n doubles): second order accurate (the residual is not
- *  weighted), unlike the auxiliary vector a. */
+/** The accelerations q'' (n doubles) of the last accepted step: by default (see
+ *  ga_set_output) consistent with its q and v, otherwise the step's own (second order
+ *  accurate: the residual is not weighted, unlike the auxiliary vector a).
+ *  Errors: GA_ERR_ARG, GA_ERR_STATE, and in GA_OUTPUT_CONSISTENT those of the callbacks
+ *  (GA_ERR_CALLBACK, GA_ERR_CALLBACK_RETRY, GA_ERR_NONFINITE) and GA_ERR_SINGULAR, with a
+ *  message; the solver's state is never changed. */
 GA_API ga_status ga_get_qdd(const ga_solver *s, double *qdd);
-/** Copy the Lagrange multipliers lambda (m doubles; with the sign convention
- *  M q'' = f - Phi_q^T lambda). With m = 0, lambda may be NULL. */
+/** The Lagrange multipliers lambda (m doubles; with the sign convention
+ *  M q'' = f - Phi_q^T lambda) of the last accepted step, as ga_get_qdd gives accelerations.
+ *  With m = 0, lambda may be NULL. Errors: as ga_get_qdd. */
 GA_API ga_status ga_get_lambda(const ga_solver *s, double *lambda);
 /** Copy the auxiliary acceleration-like vector a of eq. (3) (n doubles). */
 GA_API ga_status ga_get_a(const ga_solver *s, double *a);

@@ -50,6 +50,32 @@ ga_status reading(const ga_solver *s, Body &&body)
     return body(s->core);
 }
 
+// Calls that read the solver but may evaluate callbacks (consistent output): the same guard
+// and exception handling as guarded(), but a success keeps the last message, as reads do.
+template <class Body>
+ga_status computing(const ga_solver *cs, Body &&body)
+{
+    if (!cs)
+        return GA_ERR_ARG;
+    if (cs->busy)
+        return GA_ERR_STATE;
+    // The handle is the caller's; what changes is output scratch and counters, not the state.
+    ga_solver *s = const_cast<ga_solver *>(cs);
+    s->busy = true;
+    ga_status st;
+    try {
+        st = body(s->core);
+    } catch (const std::bad_alloc &) {
+        st = s->core.diag.fail(GA_ERR_NOMEM, "out of memory");
+    } catch (const std::exception &e) {
+        st = s->core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception: %s", e.what());
+    } catch (...) {
+        st = s->core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception of unknown type");
+    }
+    s->busy = false;
+    return st;
+}
+
 ga_status copy_out(const ga::Solver &c, const ga::Vec &x, double *out)
 {
     if (!out)
@@ -468,12 +494,23 @@ GA_API ga_status ga_advance(ga_solver *s, double t_out)
 GA_API ga_status ga_interpolate(const ga_solver *s, double t, double *q, double *v,
                                 double *lambda)
 {
-    return reading(s, [&](const ga::Solver &c) {
+    return computing(s, [&](ga::Solver &c) {
         if (!c.initialized())
             return GA_ERR_STATE;
         if (!std::isfinite(t))
             return GA_ERR_ARG;
-        return c.interpolate(t, q, v, lambda);
+        return c.interpolate(t, q, v, nullptr, lambda);
+    });
+}
+
+GA_API ga_status ga_interpolate_qdd(const ga_solver *s, double t, double *qdd)
+{
+    return computing(s, [&](ga::Solver &c) {
+        if (!c.initialized())
+            return GA_ERR_STATE;
+        if (!std::isfinite(t) || !qdd)
+            return GA_ERR_ARG;
+        return c.interpolate(t, nullptr, nullptr, qdd, nullptr);
     });
 }
 
@@ -565,15 +602,37 @@ GA_API ga_status ga_get_v(const ga_solver *s, double *v)
 
 GA_API ga_status ga_get_qdd(const ga_solver *s, double *qdd)
 {
-    return reading(s, [&](const ga::Solver &c) { return copy_out(c, c.state().qdd, qdd); });
+    return computing(s, [&](ga::Solver &c) {
+        if (!qdd)
+            return GA_ERR_ARG;
+        if (!c.initialized())
+            return GA_ERR_STATE;
+        return c.output_state(qdd, nullptr);
+    });
 }
 
 GA_API ga_status ga_get_lambda(const ga_solver *s, double *lambda)
 {
-    return reading(s, [&](const ga::Solver &c) {
+    return computing(s, [&](ga::Solver &c) {
         if (c.m() == 0 && c.initialized())
             return GA_OK;  // nothing to copy; lambda may be NULL
-        return copy_out(c, c.state().lambda, lambda);
+        if (!lambda)
+            return GA_ERR_ARG;
+        if (!c.initialized())
+            return GA_ERR_STATE;
+        return c.output_state(nullptr, lambda);
+    });
+}
+
+GA_API ga_status ga_set_output(ga_solver *s, int mode)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (mode != GA_OUTPUT_CONSISTENT && mode != GA_OUTPUT_STEP)
+            return c.diag.fail(GA_ERR_ARG, "unknown output mode %d", mode);
+        if (mode == GA_OUTPUT_CONSISTENT)
+            c.setup_output();  // may throw std::bad_alloc: the mode stays as it was
+        c.output = static_cast<ga_output>(mode);
+        return GA_OK;
     });
 }
 

@@ -1,5 +1,5 @@
-// Adaptive mode: local error estimate, step-size controller, landing on output times, and
-// dense output (ALGORITHMS.md sec. 1).
+// Adaptive mode: local error estimate, step-size controller, landing on output times
+// (ALGORITHMS.md sec. 1). Dense output is in output.cpp.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -208,29 +208,6 @@ ga_status Solver::advance(double t_out)
     while (accepted_.t < t_out)
         if (auto st = step_adaptive(t_out))
             return st;
-    return GA_OK;
-}
-
-// Cubic Hermite interpolation of q (from q, v at both ends) and of v (from v, qdd) over the
-// last step; lambda linear.
-ga_status Solver::interpolate(double t, double *q, double *v, double *lambda) const
-{
-    if (!previous_valid_)
-        return GA_ERR_STATE;
-    const State &a = previous_, &b = accepted_;
-    const double h = b.t - a.t;
-    const double slack = 1e-12 * std::max(std::fabs(b.t), 1.0);
-    if (!(t >= a.t - slack && t <= b.t + slack))
-        return GA_ERR_ARG;
-    const double th = std::clamp((t - a.t) / h, 0.0, 1.0);
-    const double h00 = (2 * th - 3) * th * th + 1, h10 = ((th - 2) * th + 1) * th;
-    const double h01 = (3 - 2 * th) * th * th, h11 = (th - 1) * th * th;
-    if (q)
-        Eigen::Map<Vec>(q, n_) = h00 * a.q + (h10 * h) * a.v + h01 * b.q + (h11 * h) * b.v;
-    if (v)
-        Eigen::Map<Vec>(v, n_) = h00 * a.v + (h10 * h) * a.qdd + h01 * b.v + (h11 * h) * b.qdd;
-    if (lambda && m_ > 0)
-        Eigen::Map<Vec>(lambda, m_) = (1.0 - th) * a.lambda + th * b.lambda;
     return GA_OK;
 }
 

@@ -70,6 +70,7 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
     x.a_prev = x.a;
 
     accepted_.swap(trial_);
+    ++state_id_;
     initialized_ = true;
     previous_valid_ = false;
     start_pending_ = true;  // corrected starting values need the h of the first step
@@ -81,37 +82,54 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
     return GA_OK;
 }
 
-// [M Phi_q^T; Phi_q 0] [qdd; lambda] = [f; -(Phi_qq(v,v) + 2 Phi_qt v + Phi_tt)] at (t, q, v).
-// The first block row is multiplied by sigma = max|Phi_q| / max|M| so that both blocks have the
-// same size; the unknown in the second block is then sigma lambda. Leaves M_, f_, J_ at q.
+// [M Phi_q^T; Phi_q 0] [qdd; lambda] = [f; -(Phi_qq(v,v) + 2 Phi_qt v + Phi_tt)] at (t, q, v),
+// with the step's matrix S_ and scratch. Leaves M_, f_, J_ at q.
 ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v, Vec &qdd,
                                            Vec &lambda)
 {
-    ga_status st = evaluate_mass(t, q);  // once for a constant mass (ga_set_constant_mass)
+    SaddleWorkspace w{S_, M_, J_, f_, c_, rq_};
+    w.mass_given = model.constant_mass && mass_valid_;  // evaluated once (evaluate_mass)
+    const ga_status st = acceleration_level(t, q, v, w, qdd, lambda);
+    jacobian_valid_ = false;  // S_ holds another matrix now
+    if (w.mass_evaluated)
+        mass_valid_ = model.constant_mass;
+    if (st == GA_ERR_SINGULAR)
+        explain_singular_saddle_point();
+    return st;
+}
+
+// The saddle-point solve of the consistent start and of consistent output (ALGORITHMS.md
+// sec. 3.3, 10) in the workspace w. The first block row is multiplied by
+// sigma = max|Phi_q| / max|M| (active constraints) so that both blocks have the same size;
+// the unknown in the second block is then sigma lambda.
+ga_status Solver::acceleration_level(double t, const Vec &q, const Vec &v, SaddleWorkspace &w,
+                                     Vec &qdd, Vec &lambda)
+{
+    ga_status st = GA_OK;
+    if (!w.mass_given) {
+        st = model.mass(t, q, w.M);
+        w.mass_evaluated = !st;
+    }
     if (!st)
-        st = model.force(t, q, v, f_);
+        st = model.force(t, q, v, w.f);
     if (!st)
-        st = model.jacobian(t, q, J_);
+        st = model.jacobian(t, q, w.J);
     if (!st)
-        st = model.constraint_accel(t, q, v, c_);
+        st = model.constraint_accel(t, q, v, w.c);
     if (st)
         return st;
-    jacobian_valid_ = false;  // S_ holds another matrix now
     double sigma = 1.0;
-    const double mmax = max_abs(M_), jmax = max_abs(J_, active_ptr());
+    const double mmax = max_abs(w.M), jmax = max_abs(w.J, active_ptr());
     if (mmax > 0.0 && jmax > 0.0)
         sigma = jmax / mmax;
     count(counters, GA_COUNT_FACTORIZATIONS);
-    if (!S_.factorize_kkt(M_, sigma, J_)) {
-        diag.fail(GA_ERR_SINGULAR,
-                  "saddle-point matrix [M Phi_q^T; Phi_q 0] is singular at t = %.17g "
-                  "(rcond = %.3g)",
-                  t, S_.rcond());
-        explain_singular_saddle_point();
-        return GA_ERR_SINGULAR;
-    }
-    rq_ = -sigma * f_;
-    S_.solve(rq_, c_, qdd, lambda);
+    if (!w.K.factorize_kkt(w.M, sigma, w.J))
+        return diag.fail(GA_ERR_SINGULAR,
+                         "saddle-point matrix [M Phi_q^T; Phi_q 0] is singular at t = %.17g "
+                         "(rcond = %.3g)",
+                         t, w.K.rcond());
+    w.r = -sigma * w.f;
+    w.K.solve(w.r, w.c, qdd, lambda);
     if (m_ > 0)
         lambda /= sigma;
     if (!all_finite(qdd) || !all_finite(lambda))

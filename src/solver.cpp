@@ -200,6 +200,8 @@ ga_status Solver::setup()
     workspace_ready_ = true;
     if (formulation == GA_INDEX2_STABILIZED)
         setup_index2();
+    if (output == GA_OUTPUT_CONSISTENT)
+        setup_output();
     // The factors' storage after every setup, so that it does not add to their peak.
     S_.reserve_factors();
     return GA_OK;
@@ -294,6 +296,7 @@ void Solver::commit(bool land_on, double t_land)
         accepted_.t = t_land;  // exactly, not t_n + h rounded
     previous_valid_ = true;
     start_pending_ = false;
+    ++state_id_;
     count(counters, GA_COUNT_STEPS);
 }
 
@@ -801,6 +804,7 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
     invalidate_jacobian();
     pivots_forgotten_ = true;
     previous_valid_ = false;
+    ++state_id_;
     // A checkpoint from before the first step (h_last = 0) still owes that step its corrected
     // starting values, as the solver it was taken from does.
     start_pending_ = s.h_last == 0.0;

@@ -37,6 +37,17 @@ struct Control {
     double calibration() const;
 };
 
+// The matrix and scratch of an acceleration-level solve (init.cpp): the step's own at the
+// consistent start, separate ones for consistent output, so that reading the output never
+// touches what the next step reuses.
+struct SaddleWorkspace {
+    IterationMatrix &K;
+    ModelMatrix &M, &J;
+    Vec &f, &c, &r;
+    bool mass_given = false;      // M holds the constant mass matrix already
+    bool mass_evaluated = false;  // set by the solve
+};
+
 class Solver {
 public:
     Solver(int n, int m);
@@ -57,6 +68,7 @@ public:
     ga_linear_solver linear_solver = GA_LINEAR_AUTO;
     ga_formulation formulation = GA_INDEX3;
     ga_redundancy redundancy = GA_REDUNDANT_REFUSE;
+    ga_output output = GA_OUTPUT_CONSISTENT;
     bool rescale_a = true;
     bool corrected_start = true;
     Control control;
@@ -84,11 +96,20 @@ public:
     // exactly if it is reached); or steps until t_out exactly.
     ga_status step_adaptive(double t_stop);
     ga_status advance(double t_out);
-    ga_status interpolate(double t, double *q, double *v, double *lambda) const;
+    // Output (output.cpp): qdd and lambda at the accepted state, consistent with (q, v) or the
+    // step's own (ga_output); dense output inside the last step (any pointer may be null).
+    // They evaluate callbacks in GA_OUTPUT_CONSISTENT, and do not touch what steps reuse.
+    ga_status output_state(double *qdd, double *lambda);
+    ga_status interpolate(double t, double *q, double *v, double *qdd, double *lambda);
+    // Allocates the workspace of consistent output if the solver's workspace exists and it
+    // does not yet; throws std::bad_alloc.
+    void setup_output();
 
     // Anything that changes the iteration matrix (options, callbacks) calls this.
     void invalidate_jacobian() const
     {
+        output_for_ = -1;
+        out_mass_valid_ = false;
         jacobian_valid_ = false;
         theta_prev_ = -1.0;
         mass_valid_ = false;
@@ -144,6 +165,8 @@ private:
     ga_status correct_velocities(Vec &v, const char *what);
     ga_status consistent_accelerations(double t, const Vec &q, const Vec &v, Vec &qdd,
                                        Vec &lambda);
+    ga_status acceleration_level(double t, const Vec &q, const Vec &v, SaddleWorkspace &w,
+                                 Vec &qdd, Vec &lambda);
     ga_status starting_values(double h);
     void explain_singular_saddle_point();
     ga_status select_active_constraints(double t, const Vec &q);
@@ -186,6 +209,17 @@ private:
     // A checkpoint was taken or restored: the next step forgets the pivots (get_state).
     mutable bool pivots_forgotten_ = false;
     bool tangents_deferred_ = false;  // the last Newton iteration ran without them
+
+    // Consistent output (output.cpp): its own saddle-point matrix and scratch, and the
+    // accepted state its values belong to (state_id_ counts accepted states).
+    ga_status consistent_output(double t, const Vec &q, const Vec &v);
+    IterationMatrix O_;
+    ModelMatrix out_M_, out_J_;
+    Vec out_f_, out_c_, out_r_, out_q_, out_v_, out_qdd_, out_lambda_;
+    long long state_id_ = 0;
+    mutable long long output_for_ = -1;
+    double output_t_ = 0.0;
+    mutable bool out_mass_valid_ = false;
 
     // Step workspace, sized once.
     ModelMatrix M_, J_, K_, C_, B_;  // B_: index-2, Phi_q(q_n)

@@ -35,6 +35,7 @@ module galpha
   integer(c_int), parameter, public :: GA_INDEX3 = 0, GA_INDEX2_STABILIZED = 1
   integer(c_int), parameter, public :: GA_REDUNDANT_REFUSE = 0, GA_REDUNDANT_DROP = 1
   integer(c_int), parameter, public :: GA_INIT_PROJECT = 0, GA_INIT_REFUSE = 1
+  integer(c_int), parameter, public :: GA_OUTPUT_CONSISTENT = 0, GA_OUTPUT_STEP = 1
   integer(c_int), parameter, public :: GA_COUNT_STEPS = 0, GA_COUNT_FAILED_STEPS = 1, &
        GA_COUNT_NEWTON_ITERS = 2, GA_COUNT_FACTORIZATIONS = 3, GA_COUNT_RESIDUALS = 4, &
        GA_COUNT_MASS_EVALS = 5, GA_COUNT_FORCE_EVALS = 6, GA_COUNT_CONSTRAINT_EVALS = 7, &
@@ -348,6 +349,17 @@ module galpha
        real(c_double), value :: t
        real(c_double), intent(out) :: q(*), v(*), lambda(*)
      end function ga_interpolate
+     integer(c_int) function ga_interpolate_qdd(s, t, qdd) bind(C, name="ga_interpolate_qdd")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: t
+       real(c_double), intent(out) :: qdd(*)
+     end function ga_interpolate_qdd
+     integer(c_int) function ga_set_output(s, mode) bind(C, name="ga_set_output")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: mode
+     end function ga_set_output
      function c_strlen(p) bind(C, name="strlen")
        import :: c_ptr, c_size_t
        type(c_ptr), value :: p
@@ -366,7 +378,7 @@ module galpha
        ga_linear_solver_name, ga_set_formulation, ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
-       ga_interpolate
+       ga_interpolate, ga_interpolate_qdd, ga_set_output
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
@@ -406,6 +418,11 @@ module galpha
      procedure :: set_redundant_constraints => solver_set_redundant_constraints
      procedure :: get_active_constraints => solver_get_active_constraints
      procedure :: advance => solver_advance
+     !> set_output(GA_OUTPUT_CONSISTENT or GA_OUTPUT_STEP): what get_qdd, get_lambda give
+     procedure :: set_output => solver_set_output
+     !> interpolate(t, q, v, lambda) and interpolate_qdd(t, qdd) inside the last step
+     procedure :: interpolate => solver_interpolate
+     procedure :: interpolate_qdd => solver_interpolate_qdd
      procedure :: t => solver_t
      procedure :: get_q => solver_get_q
      procedure :: get_v => solver_get_v
@@ -630,6 +647,39 @@ contains
     real(c_double), intent(in) :: t_out
     status = ga_advance(this%handle, t_out)
   end function solver_advance
+
+  integer(c_int) function solver_set_output(this, mode) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: mode
+    status = ga_set_output(this%handle, mode)
+  end function solver_set_output
+
+  integer(c_int) function solver_interpolate(this, t, q, v, lambda) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t
+    real(c_double), intent(out) :: q(:), v(:), lambda(:)
+    real(c_double) :: none(1)
+    if (size(q) < this%n .or. size(v) < this%n .or. size(lambda) < this%m) then
+       status = GA_ERR_ARG
+       return
+    end if
+    if (this%m > 0) then
+       status = ga_interpolate(this%handle, t, q, v, lambda)
+    else
+       status = ga_interpolate(this%handle, t, q, v, none)
+    end if
+  end function solver_interpolate
+
+  integer(c_int) function solver_interpolate_qdd(this, t, qdd) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t
+    real(c_double), intent(out) :: qdd(:)
+    if (size(qdd) < this%n) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_interpolate_qdd(this%handle, t, qdd)
+  end function solver_interpolate_qdd
 
   real(c_double) function solver_t(this) result(t)
     class(galpha_solver), intent(in) :: this

@@ -270,6 +270,8 @@ static void run_sequence(int seq, long long *calls, long long *steps_ok, long lo
     ga_solver *s = NULL;
     assert_int_equal(ga_create(N, md.m, &s), GA_OK);
     md.s = s;
+    /* snapshots read the state: the step's qdd and lambda, no callbacks */
+    assert_int_equal(ga_set_output(s, GA_OUTPUT_STEP), GA_OK);
     assert_int_equal(ga_set_callbacks(s, mass, force, constraint, jacobian, &md), GA_OK);
     if (pick(&md, 3) == 0) {  /* a third of the runs on the sparse path */
         md.sparse_M = 1;

@@ -141,7 +141,8 @@ static ga_solver *configured(const config *cf, faulty_chain *f)
     ga_solver *s = NULL;
     if (ga_create(N, M, &s) != GA_OK)
         return NULL;
-    if (chain_declare_patterns(&f->c, s) ||
+    /* the state as the steps leave it: qdd and lambda of the step, not consistent output */
+    if (ga_set_output(s, GA_OUTPUT_STEP) || chain_declare_patterns(&f->c, s) ||
         ga_set_callbacks(s, f_mass, f_force, f_constraint, f_jacobian, f) ||
         ga_set_constraint_accel(s, f_accel) || ga_set_constraint_dt(s, f_dt) ||
         ga_set_linear_solver(s, cf->linear_solver) || ga_set_formulation(s, cf->formulation) ||

@@ -66,6 +66,7 @@ static ga_solver *start(int pred, step_data *n, double h)
                                       pendulum_jacobian, &P),
                      GA_OK);
     assert_int_equal(ga_set_predictor(s, pred), GA_OK);
+    assert_int_equal(ga_set_output(s, GA_OUTPUT_STEP), GA_OK); /* the step's own solution */
     /* the reference below solves the scheme with a_n as stored (no rescaling to the new h) */
     assert_int_equal(ga_set_rescale(s, 0), GA_OK);
     assert_int_equal(ga_set_constraint_accel(s, pendulum_constraint_accel), GA_OK);

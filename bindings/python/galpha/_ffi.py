@@ -108,6 +108,7 @@ GA_MATRIX_MASS, GA_MATRIX_JACOBIAN, GA_MATRIX_STIFFNESS, GA_MATRIX_DAMPING = 0, 
 GA_INDEX3, GA_INDEX2_STABILIZED = 0, 1
 GA_REDUNDANT_REFUSE, GA_REDUNDANT_DROP = 0, 1
 GA_INIT_PROJECT, GA_INIT_REFUSE = 0, 1
+GA_OUTPUT_CONSISTENT, GA_OUTPUT_STEP = 0, 1
 (GA_INFO_RCOND, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_ERROR_ESTIMATE,
  GA_INFO_H_NEXT) = 0, 1, 2, 3, 4
 COUNTERS = ("steps", "failed_steps", "newton_iters", "factorizations", "residuals",
@@ -172,6 +173,8 @@ _SIGNATURES = {
     "ga_step_adaptive": (_I, [_S, _D]),
     "ga_advance": (_I, [_S, _D]),
     "ga_interpolate": (_I, [_S, _D, c_double_p, c_double_p, c_double_p]),
+    "ga_interpolate_qdd": (_I, [_S, _D, c_double_p]),
+    "ga_set_output": (_I, [_S, _I]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():

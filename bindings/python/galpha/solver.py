@@ -60,7 +60,7 @@ class Solver:
         whose values then come column by column, as the `data` of such a matrix.
     rho_inf, params, newton, tangent_mode, scaling, predictor, init_mode, formulation, redundant,
     tolerances, reuse, constant_mass, linear_solver, rescale, corrected_start, step_limits,
-    initial_step
+    initial_step, output
         Options, as the C setters (ga_set_rho_inf, ga_set_params((alpha_m, alpha_f, beta,
         gamma)), ga_set_newton((tol, max_iter)), ga_set_tolerances((rtol, atol)),
         ga_set_step_limits((h_min, h_max)), ga_set_formulation(galpha.GA_INDEX2_STABILIZED),
@@ -76,7 +76,7 @@ class Solver:
                  params=None, newton=None, tangent_mode=None, scaling=None, predictor=None,
                  init_mode=None, formulation=None, redundant=None, tolerances=None, reuse=None,
                  constant_mass=None, linear_solver=None, rescale=None, corrected_start=None,
-                 step_limits=None, initial_step=None, patterns=None):
+                 step_limits=None, initial_step=None, output=None, patterns=None):
         self._ptr = None
         self._pending = None          # exception raised inside a callback
         self._in_callback = 0         # callbacks of this solver running now
@@ -202,6 +202,7 @@ class Solver:
             self._check(_ffi.ga_set_init_mode(self._ptr, int(init_mode[0]), float(init_mode[1])))
         for value, setter in ((formulation, _ffi.ga_set_formulation), (reuse, _ffi.ga_set_jacobian_reuse),
                               (linear_solver, _ffi.ga_set_linear_solver),
+                              (output, _ffi.ga_set_output),
                               (redundant, _ffi.ga_set_redundant_constraints)):
             if value is not None:
                 self._check(setter(self._ptr, int(value)))
@@ -320,6 +321,12 @@ class Solver:
         self._check(_ffi.ga_interpolate(self._handle(), float(t), self._dp(q), self._dp(v),
                                         self._dp(lam)))
         return q, v, lam[:self.m]
+
+    def interpolate_qdd(self, t):
+        """qdd at t inside the last step (see ga_interpolate_qdd)."""
+        qdd = np.empty(self.n)
+        self._check(_ffi.ga_interpolate_qdd(self._handle(), float(t), self._dp(qdd)))
+        return qdd
 
     @property
     def linear_solver_name(self):

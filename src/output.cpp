@@ -1,0 +1,118 @@
+// What the solver reports besides its state: accelerations and multipliers consistent with
+// (q, v) (ALGORITHMS.md sec. 10), at the last accepted step or at any t inside it, and dense
+// output of q and v over the last step.
+//
+// Index-3 multipliers and accelerations carry eps |q| / (beta h^2) of round-off (paper, sec.
+// 3.3) and, in adaptive runs, a transient after every change of h (ALGORITHMS.md sec. 1.4).
+// Solved from the acceleration-level saddle-point system at the step's (q, v) they are as
+// accurate as q and v. The solve has its own matrix and scratch: reading the output must not
+// change what the next step reuses, so that a run does not depend on what was read.
+#include <algorithm>
+#include <cmath>
+
+#include "solver.hpp"
+
+namespace ga {
+
+void Solver::setup_output()
+{
+    if (O_.ready() || !workspace_ready_)
+        return;
+    O_.setup(sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Auto), n_,
+             m_, M_, J_, K_, C_, active_ptr());
+    out_M_.copy_layout(M_);
+    out_J_.copy_layout(J_);
+    out_f_.setZero(n_);
+    out_c_.setZero(m_);
+    out_r_.setZero(n_);
+    out_q_.setZero(n_);
+    out_v_.setZero(n_);
+    out_qdd_.setZero(n_);
+    out_lambda_.setZero(m_);
+    O_.reserve_factors();
+}
+
+// qdd, lambda from the acceleration-level equations at (t, q, v) into out_qdd_, out_lambda_.
+ga_status Solver::consistent_output(double t, const Vec &q, const Vec &v)
+{
+    if (!O_.ready())
+        return diag.fail(GA_ERR_INTERNAL, "the workspace of consistent output was not set up");
+    SaddleWorkspace w{O_, out_M_, out_J_, out_f_, out_c_, out_r_};
+    if (model.constant_mass && mass_valid_ && !out_mass_valid_) {  // evaluated once for all
+        Eigen::Map<Vec>(out_M_.data(), out_M_.size()) = Eigen::Map<const Vec>(M_.data(), M_.size());
+        out_mass_valid_ = true;
+    }
+    w.mass_given = model.constant_mass && out_mass_valid_;
+    const ga_status st = acceleration_level(t, q, v, w, out_qdd_, out_lambda_);
+    if (w.mass_evaluated)
+        out_mass_valid_ = model.constant_mass;
+    if (st)
+        diag.append(" (consistent accelerations and multipliers for output at t = %.17g)", t);
+    return st;
+}
+
+ga_status Solver::output_state(double *qdd, double *lambda)
+{
+    const State &x = accepted_;
+    if (output != GA_OUTPUT_CONSISTENT) {
+        if (qdd)
+            Eigen::Map<Vec>(qdd, n_) = x.qdd;
+        if (lambda && m_ > 0)
+            Eigen::Map<Vec>(lambda, m_) = x.lambda;
+        return GA_OK;
+    }
+    if (output_for_ != state_id_ || output_t_ != x.t) {
+        if (auto st = consistent_output(x.t, x.q, x.v))
+            return st;
+        output_for_ = state_id_;
+        output_t_ = x.t;
+    }
+    if (qdd)
+        Eigen::Map<Vec>(qdd, n_) = out_qdd_;
+    if (lambda && m_ > 0)
+        Eigen::Map<Vec>(lambda, m_) = out_lambda_;
+    return GA_OK;
+}
+
+// Cubic Hermite interpolation of q (from q, v at both ends) and of v (from v, qdd) over the
+// last step: third-order local accuracy.
+ga_status Solver::interpolate(double t, double *q, double *v, double *qdd, double *lambda)
+{
+    if (!previous_valid_)
+        return GA_ERR_STATE;
+    const State &a = previous_, &b = accepted_;
+    const double h = b.t - a.t;
+    const double slack = 1e-12 * std::max(std::fabs(b.t), 1.0);
+    if (!(t >= a.t - slack && t <= b.t + slack))
+        return GA_ERR_ARG;
+    const double th = std::clamp((t - a.t) / h, 0.0, 1.0);
+    const double h00 = (2 * th - 3) * th * th + 1, h10 = ((th - 2) * th + 1) * th;
+    const double h01 = (3 - 2 * th) * th * th, h11 = (th - 1) * th * th;
+    const bool consistent = output == GA_OUTPUT_CONSISTENT && (qdd || (lambda && m_ > 0));
+    if (consistent || q)
+        out_q_ = h00 * a.q + (h10 * h) * a.v + h01 * b.q + (h11 * h) * b.v;
+    if (consistent || v)
+        out_v_ = h00 * a.v + (h10 * h) * a.qdd + h01 * b.v + (h11 * h) * b.qdd;
+    if (q)
+        Eigen::Map<Vec>(q, n_) = out_q_;
+    if (v)
+        Eigen::Map<Vec>(v, n_) = out_v_;
+    if (consistent) {
+        if (auto st = consistent_output(t, out_q_, out_v_))
+            return st;
+        output_for_ = -1;  // out_qdd_, out_lambda_ now hold values at t
+        if (qdd)
+            Eigen::Map<Vec>(qdd, n_) = out_qdd_;
+        if (lambda && m_ > 0)
+            Eigen::Map<Vec>(lambda, m_) = out_lambda_;
+        return GA_OK;
+    }
+    // the step's own values, linear over the step
+    if (qdd)
+        Eigen::Map<Vec>(qdd, n_) = (1.0 - th) * a.qdd + th * b.qdd;
+    if (lambda && m_ > 0)
+        Eigen::Map<Vec>(lambda, m_) = (1.0 - th) * a.lambda + th * b.lambda;
+    return GA_OK;
+}
+
+}  // namespace ga
