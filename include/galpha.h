@@ -542,7 +542,10 @@ GA_API ga_status ga_set_constraint_accel(ga_solver *s, ga_constraint_accel_fn fn
 /** Optional callback for Phi_t(q, t), the partial time derivative of the constraints (length m,
  *  same signature as the constraint callback), used by the consistent start (velocities) and by
  *  the stabilized index-2 formulation (the velocity constraint Phi_q v + Phi_t, every Newton
- *  iteration). NULL (default): central differences in t, two constraint calls per evaluation.
+ *  iteration). NULL (default): central differences in t over 2^-13 max(|t|, 1) and half
+ *  that, extrapolated (error O(d^4)), four constraint calls per evaluation; in index 2 the
+ *  velocity constraint then holds to the error of those differences (4e-12 on a pendulum of
+ *  varying length, 2e-16 with the callback; tests/c/test_init.c).
  *  Constraints that do not depend on t have Phi_t = 0: a callback that writes zeros saves
  *  those calls. Errors: GA_ERR_ARG, GA_ERR_STATE. */
 GA_API ga_status ga_set_constraint_dt(ga_solver *s, ga_constraint_fn fn);

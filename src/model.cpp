@@ -9,6 +9,9 @@ namespace ga {
 
 namespace {
 const double kEps = std::numeric_limits<double>::epsilon();
+// The step in t of the differences of Phi_t (relative to max(|t|, 1)): 2^-13, where the
+// extrapolated difference's round-off and truncation meet for time scales ~1 (design-notes).
+const double kPhiTStep = 1.0 / 8192.0;
 
 // Forward-difference increment: sqrt(eps) relative to the component, with 1 as the typical
 // magnitude below which it is absolute (as SUNDIALS does with atol = 1). Returned as the exact
@@ -362,14 +365,22 @@ ga_status Model::constraint_dt(double t, const Vec &q, Vec &out)
             return st;
         return check_finite(out.data(), m_, 0, "constraint time derivative Phi_t", t);
     }
-    // Central difference in t. For constraints that do not depend on t both evaluations are
-    // identical and Phi_t = 0 exactly.
-    const double d = std::cbrt(kEps) * std::max(std::fabs(t), 1.0);
-    if (auto st = constraint(t + d, q, phi_plus_))
-        return st;
-    if (auto st = constraint(t - d, q, phi_minus_))
-        return st;
-    out = (phi_plus_ - phi_minus_) / (2.0 * d);
+    // Central differences in t over d and d/2, extrapolated (Richardson): error O(d^4) instead
+    // of O(d^2), so that a longer d keeps the round-off eps |Phi| / d smaller; index 2 carries
+    // the error of Phi_t into Phi_q v (docs/design-notes.md). For constraints that do not
+    // depend on t every difference is 0 exactly.
+    const double d = kPhiTStep * std::max(std::fabs(t), 1.0);
+    for (int half = 0; half < 2; ++half) {
+        const double e = half ? 0.5 * d : d;
+        if (auto st = constraint(t + e, q, phi_plus_))
+            return st;
+        if (auto st = constraint(t - e, q, phi_minus_))
+            return st;
+        if (half)
+            out = (4.0 * (phi_plus_ - phi_minus_) / (2.0 * e) - out) / 3.0;
+        else
+            out = (phi_plus_ - phi_minus_) / (2.0 * e);
+    }
     return GA_OK;
 }
 

@@ -85,8 +85,8 @@ public:
     ga_status damping(double t, const Vec &q, const Vec &v, const Vec &f, ModelMatrix &C);
     // Phi_qq(v, v) + 2 Phi_qt v + Phi_tt.
     ga_status constraint_accel(double t, const Vec &q, const Vec &v, Vec &out);
-    // Phi_t: the callback, or central differences in t (exactly zero for time-independent
-    // constraints).
+    // Phi_t: the callback, or extrapolated central differences in t (exactly zero for
+    // time-independent constraints).
     ga_status constraint_dt(double t, const Vec &q, Vec &out);
 
     // r^q = M qdd - f + Phi_q^T lambda: the residual of eq. (1), not weighted.

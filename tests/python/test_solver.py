@@ -378,7 +378,7 @@ def test_redundant_constraint_dropped():
 
 def test_constraint_dt_callback_spares_the_differences():
     """Phi_t = 0 for the pendulum: with the callback the index-2 steps give the same motion
-    without the two constraint calls per Newton iteration that central differences cost."""
+    without the four constraint calls per Newton iteration that differences in t cost."""
     def zero_dt(t, q, out):
         out[:] = 0.0
 
@@ -393,7 +393,7 @@ def test_constraint_dt_callback_spares_the_differences():
     (q_fd, fd), (q_cb, cb) = runs
     assert np.max(np.abs(q_fd - q_cb)) < 1e-12
     assert cb["constraint_dt_evals"] >= cb["residuals"]
-    assert fd["constraint_evals"] - 2 * fd["constraint_dt_evals"] - fd["residuals"] == \
+    assert fd["constraint_evals"] - 4 * fd["constraint_dt_evals"] - fd["residuals"] == \
         cb["constraint_evals"] - cb["residuals"]
 
 
@@ -550,3 +550,21 @@ def test_missing_library_is_reported_with_where_it_looked():
     assert "libgalpha not found" in out
     assert "environment variable GALPHA_LIBRARY: /nonexistent/libgalpha.so.0" in out
     assert "Set GALPHA_LIBRARY" in out
+
+
+def test_output_consistent_by_default_and_the_step_s_on_request():
+    """lam and qdd are consistent with q and v by default; output=GA_OUTPUT_STEP gives the
+    step's own (at h = 1e-3 both within the run's error of each other); interpolate_qdd."""
+    values = []
+    for output in (None, galpha.GA_OUTPUT_STEP):
+        with pendulum(output=output) as s:
+            s.init(0.0, Q0, V0)
+            for _ in range(100):
+                s.step(1e-3)
+            values.append((s.lam.copy(), s.qdd.copy(), s.interpolate_qdd(s.t - 5e-4)))
+    (l_c, a_c, i_c), (l_s, a_s, i_s) = values
+    assert abs(l_c[0] - l_s[0]) < 1e-4 * abs(l_s[0]) and l_c[0] != l_s[0]
+    assert np.max(np.abs(a_c - a_s)) < 1e-3
+    assert i_c.shape == (2,) and np.max(np.abs(i_c - i_s)) < 1e-2
+    with pytest.raises(galpha.ArgumentError):
+        pendulum(output=5)
