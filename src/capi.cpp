@@ -4,6 +4,7 @@
 #include <cmath>
 #include <exception>
 #include <new>
+#include <utility>
 #include <vector>
 
 #include "galpha.h"
@@ -15,16 +16,17 @@
 namespace {
 
 // Runs `body` as one API call on `s`: refuses calls from inside the solver's own callbacks,
-// clears the last error, and converts every C++ exception into a status.
+// clears the last error if asked, and converts every C++ exception into a status.
 template <class Body>
-ga_status guarded(ga_solver *s, Body &&body)
+ga_status call(ga_solver *s, bool clear_message, Body &&body)
 {
     if (!s)
         return GA_ERR_ARG;
     if (s->busy)
         return GA_ERR_STATE;  // message left alone: the outer call owns it
     s->busy = true;
-    s->core.diag.clear();
+    if (clear_message)
+        s->core.diag.clear();
     ga_status st;
     try {
         st = body(s->core);
@@ -37,6 +39,13 @@ ga_status guarded(ga_solver *s, Body &&body)
     }
     s->busy = false;
     return st;
+}
+
+// Calls that may change the solver: they start with a clear message.
+template <class Body>
+ga_status guarded(ga_solver *s, Body &&body)
+{
+    return call(s, true, std::forward<Body>(body));
 }
 
 // Read-only calls: the same refusal from callbacks; they cannot throw and keep the message.
@@ -50,30 +59,13 @@ ga_status reading(const ga_solver *s, Body &&body)
     return body(s->core);
 }
 
-// Calls that read the solver but may evaluate callbacks (consistent output): the same guard
-// and exception handling as guarded(), but a success keeps the last message, as reads do.
+// Calls that read the solver but may evaluate callbacks (consistent output): a success keeps
+// the last message, as reads do. What they change is output scratch and counters, not the
+// state, so they take the caller's const handle.
 template <class Body>
-ga_status computing(const ga_solver *cs, Body &&body)
+ga_status computing(const ga_solver *s, Body &&body)
 {
-    if (!cs)
-        return GA_ERR_ARG;
-    if (cs->busy)
-        return GA_ERR_STATE;
-    // The handle is the caller's; what changes is output scratch and counters, not the state.
-    ga_solver *s = const_cast<ga_solver *>(cs);
-    s->busy = true;
-    ga_status st;
-    try {
-        st = body(s->core);
-    } catch (const std::bad_alloc &) {
-        st = s->core.diag.fail(GA_ERR_NOMEM, "out of memory");
-    } catch (const std::exception &e) {
-        st = s->core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception: %s", e.what());
-    } catch (...) {
-        st = s->core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception of unknown type");
-    }
-    s->busy = false;
-    return st;
+    return call(const_cast<ga_solver *>(s), false, std::forward<Body>(body));
 }
 
 ga_status copy_out(const ga::Solver &c, const ga::Vec &x, double *out)

@@ -61,11 +61,10 @@ ga_status Solver::output_state(double *qdd, double *lambda)
             Eigen::Map<Vec>(lambda, m_) = x.lambda;
         return GA_OK;
     }
-    if (output_for_ != state_id_ || output_t_ != x.t) {
+    if (output_for_ != state_id_) {
         if (auto st = consistent_output(x.t, x.q, x.v))
             return st;
         output_for_ = state_id_;
-        output_t_ = x.t;
     }
     if (qdd)
         Eigen::Map<Vec>(qdd, n_) = out_qdd_;

@@ -253,8 +253,8 @@ ga_status Solver::evaluate_mass(double t, const Vec &q)
 }
 
 // The Newton tolerance the user gave, or: 1e-10 for fixed steps (far below any discretization
-// error worth computing), and in adaptive mode 1e-2 of the local error tolerance (rtol times
-// its calibration, control.cpp). With a tolerance on the error, iterating the Newton error much
+// error worth computing), and in adaptive mode a tenth of the local error tolerance (rtol times
+// its calibration, control.cpp): at 1e-2 rtol it spoiled the calibrated control in index 3. With a tolerance on the error, iterating the Newton error much
 // further below it buys nothing (IDA and Radau5 tie their Newton tests to the error tolerance
 // too).
 double Solver::newton_tolerance(bool adaptive) const
@@ -309,6 +309,7 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
         S_.forget_pivots();
         S2_.forget_pivots();
         P_.forget_pivots();
+        O_.forget_pivots();
         pivots_forgotten_ = false;
     }
     if (sliver_allowed && accepted_.h_last > 0.0 && h < accepted_.h_last / kShortStepRatio)

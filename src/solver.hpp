@@ -218,7 +218,6 @@ private:
     Vec out_f_, out_c_, out_r_, out_q_, out_v_, out_qdd_, out_lambda_;
     long long state_id_ = 0;
     mutable long long output_for_ = -1;
-    double output_t_ = 0.0;
     mutable bool out_mass_valid_ = false;
 
     // Step workspace, sized once.
