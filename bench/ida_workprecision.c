@@ -10,9 +10,11 @@
  * form was tried first: IDA's corrector fails at t = 0 for rtol <= 1e-5, its iteration matrix
  * being singular to working precision at the tiny first steps.) The index-1 form lets the
  * position and velocity constraints drift by the integration error; galpha keeps them.
- * galpha runs fixed steps swept over h. For both: the error at the final time against the
- * reference, CPU time (best of REPEATS runs), residual evaluations (IDA: including those of its
- * Jacobian) and factorizations.
+ * galpha runs fixed steps swept over h, and adaptive steps (index 2) over rtol = atol from 1e-3
+ * to 1e-8. For both: the error of the positions at the final time against the reference, that
+ * of the multipliers (IDA's own; galpha's consistent output, the default, and the step's own
+ * lambda), CPU time (best of REPEATS runs, reading the multipliers included), residual
+ * evaluations (IDA: including those of its Jacobian) and factorizations.
  *
  * Usage: ida_workprecision [andrews|slider_crank]; CSV on stdout. */
 #include <galpha.h>
@@ -51,6 +53,7 @@ typedef struct model {
     const double *ref;  /* reference q at t_end (the compared components) */
     int first, compared; /* compared: q[first .. first + compared) */
     double *M, *f, *J, *phi; /* scratch for the IDA residual */
+    const double *lambda_ref; /* reference multipliers at t_end (all m) */
 } model;
 
 static double now(void)
@@ -67,6 +70,17 @@ static double error_of(const model *md, const double *q)
     for (int i = 0; i < md->compared; ++i)
         e = fmax(e, fabs(q[md->first + i] - md->ref[i]) / fabs(md->ref[i]));
     return e;
+}
+
+/* max_i |lambda_i - ref_i| / max_i |ref_i| */
+static double lambda_error_of(const model *md, const double *lambda)
+{
+    double e = 0.0, scale = 0.0;
+    for (int i = 0; i < md->m; ++i) {
+        e = fmax(e, fabs(lambda[i] - md->lambda_ref[i]));
+        scale = fmax(scale, fabs(md->lambda_ref[i]));
+    }
+    return e / scale;
 }
 
 /* ---- IDA, GGL formulation ---------------------------------------------------------------- */
@@ -100,7 +114,7 @@ static int ida_residual(double t, N_Vector yy, N_Vector yp, N_Vector rr, void *d
 }
 
 typedef struct run_result {
-    double err, cpu;
+    double err, lambda_err, lambda_step_err, cpu;
     long long residuals, factorizations, steps;
     int ok;
 } run_result;
@@ -108,7 +122,7 @@ typedef struct run_result {
 static run_result run_ida(model *md, double tol, const double *qdd0, const double *lam0)
 {
     const int n = md->n, m = md->m, N = 2 * n + m;
-    run_result r = {0, 0, 0, 0, 0, 0};
+    run_result r = {0, 0, 0, 0, 0, 0, 0, 0};
     SUNContext ctx;
     SUNContext_Create(NULL, &ctx);
     N_Vector yy = N_VNew_Serial(N, ctx), yp = N_VNew_Serial(N, ctx), id = N_VNew_Serial(N, ctx);
@@ -147,6 +161,8 @@ static run_result run_ida(model *md, double tol, const double *qdd0, const doubl
         r.factorizations = nsetups;
         r.steps = nsteps;
         r.err = error_of(md, y);
+        r.lambda_err = lambda_error_of(md, y + 2 * n); /* IDA's own multipliers */
+        r.lambda_step_err = r.lambda_err;
         r.ok = 1;
     }
     IDAFree(&mem);
@@ -164,9 +180,9 @@ static run_result run_ida(model *md, double tol, const double *qdd0, const doubl
 static run_result run_galpha_mode(const model *md, double h, double newton_tol, int tangent_mode,
                                   double rtol)
 {
-    run_result r = {0, 0, 0, 0, 0, 0};
+    run_result r = {0, 0, 0, 0, 0, 0, 0, 0};
     ga_solver *s = NULL;
-    double q[AN31_N];
+    double q[AN31_N], lambda[AN31_M];
     ga_create(md->n, md->m, &s);
     ga_set_callbacks(s, md->mass, md->force, md->constraint, md->jacobian, md->user);
     ga_set_tangents(s, md->stiffness, NULL);
@@ -188,10 +204,16 @@ static run_result run_galpha_mode(const model *md, double h, double newton_tol, 
         st = ga_step(s, h);
     if (!st && h == 0.0)
         st = ga_advance(s, md->t_end);
+    if (!st)
+        st = ga_get_lambda(s, lambda); /* consistent output: its cost is counted */
     r.cpu = now() - t0;
     if (!st) {
         ga_get_q(s, q);
         r.err = error_of(md, q);
+        r.lambda_err = lambda_error_of(md, lambda);
+        ga_set_output(s, GA_OUTPUT_STEP);
+        ga_get_lambda(s, lambda);
+        r.lambda_step_err = lambda_error_of(md, lambda);
         ga_get_counter(s, GA_COUNT_RESIDUALS, &r.residuals);
         ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &r.factorizations);
         ga_get_counter(s, GA_COUNT_STEPS, &r.steps);
@@ -204,15 +226,15 @@ static run_result run_galpha_mode(const model *md, double h, double newton_tol, 
 static void print_row(const char *scene, const char *method, double setting, run_result r)
 {
     if (r.ok)
-        printf("%s,%s,%.6g,%.6e,%.6e,%lld,%lld,%lld\n", scene, method, setting, r.err, r.cpu,
-               r.residuals, r.factorizations, r.steps);
+        printf("%s,%s,%.6g,%.6e,%.6e,%.6e,%.6e,%lld,%lld,%lld\n", scene, method, setting, r.err,
+               r.lambda_err, r.lambda_step_err, r.cpu, r.residuals, r.factorizations, r.steps);
     else
-        printf("%s,%s,%.6g,nan,nan,0,0,0\n", scene, method, setting);
+        printf("%s,%s,%.6g,nan,nan,nan,nan,0,0,0\n", scene, method, setting);
     fflush(stdout);
 }
 
 static slider_crank SC;
-static double SC_REF[SC_N];
+static double SC_REF[SC_N], SC_LAMBDA_REF[SC_M];
 
 int main(int argc, char **argv)
 {
@@ -224,14 +246,15 @@ int main(int argc, char **argv)
         md = (model){"slider_crank", SC_N, SC_M, sc_mass, sc_force, sc_constraint, sc_jacobian,
                      sc_stiffness, sc_constraint_accel, sc_constraint_dt, &SC, {0}, {0}, 1.0,
                      5e-3, 1, NULL, 0,
-                     0, NULL, NULL, NULL, NULL};
+                     0, NULL, NULL, NULL, NULL, NULL};
         sc_initial(&SC, M_PI / 2, md.q0, md.v0);
         /* reference: independent RK4 on the index-1 form, 400 000 steps */
         double v[SC_N];
         memcpy(SC_REF, md.q0, sizeof SC_REF);
         memcpy(v, md.v0, sizeof v);
         rk4_model rk = {SC_N, SC_M, sc_mass, sc_force, sc_jacobian, sc_constraint_accel, &SC};
-        index1_rk4(&rk, 0.0, 1.0, 400000, SC_REF, v, NULL, NULL);
+        index1_rk4(&rk, 0.0, 1.0, 400000, SC_REF, v, NULL, SC_LAMBDA_REF);
+        md.lambda_ref = SC_LAMBDA_REF;
         md.ref = SC_REF + SC_TH1; /* compared: the crank angle */
         md.first = SC_TH1;
         md.compared = 1;
@@ -239,7 +262,8 @@ int main(int argc, char **argv)
         md = (model){"andrews7", AN7_N, AN7_M, an7_mass, an7_force, an7_constraint,
                      an7_jacobian, NULL, an7_constraint_accel, an7_constraint_dt, NULL, {0},
                      {0}, andrews_t_end,
-                     3e-4, 0, andrews_q_ref, 0, 7, NULL, NULL, NULL, NULL};
+                     3e-4, 0, andrews_q_ref, 0, 7, NULL, NULL, NULL, NULL,
+                     andrews_lambda_ref};
         memcpy(md.q0, andrews_q0, sizeof andrews_q0);
     }
     md.M = malloc(sizeof(double) * md.n * md.n);
@@ -287,7 +311,7 @@ int main(int argc, char **argv)
         set[ns++] = (setting){"galpha_simplified", h, h, tol, 0, GA_TANGENT_NEGLECT};
     }
     for (int k = 0; k < N_ADAPTIVE; ++k) {
-        const double rtol = pow(10.0, -2.0 - 0.5 * k);
+        const double rtol = pow(10.0, -3.0 - 0.5 * k);
         set[ns++] = (setting){"galpha_adaptive", rtol, 0.0, 0.0, rtol, GA_TANGENT_AUTO};
     }
     for (int rep = 0; rep < REPEATS; ++rep)
@@ -300,7 +324,8 @@ int main(int argc, char **argv)
             if (rep == 0 || (r.ok && r.cpu < best[i].cpu))
                 best[i] = r;
         }
-    printf("scene,method,setting,error,cpu_seconds,residuals,factorizations,steps\n");
+    printf("scene,method,setting,error,lambda_error,lambda_step_error,cpu_seconds,residuals,"
+           "factorizations,steps\n");
     for (int i = 0; i < N_SETTINGS; ++i)
         print_row(md.name, set[i].method, set[i].value, best[i]);
     free(md.M);

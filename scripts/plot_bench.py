@@ -149,7 +149,7 @@ for name, target in (("wp_andrews.csv", 1e-3), ("wp_slider_crank.csv", 1e-3)):
     if not data:
         continue
     scene = data[0]["scene"]
-    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
+    fig, ax = plt.subplots(1, 3, figsize=(17, 4.5))
     methods = [("ida", "SUNDIALS IDA (index 1, BDF, rtol = atol swept)", "k"),
                ("galpha", "galpha fixed h (full Newton)", "C0"),
                ("galpha_simplified", "galpha fixed h (tangents neglected)", "C1"),
@@ -163,12 +163,23 @@ for name, target in (("wp_andrews.csv", 1e-3), ("wp_slider_crank.csv", 1e-3)):
         ax[0].loglog(cpu, e, "o-", color=color, label=label, ms=4)
         ax[1].loglog(res, e, "o-", color=color, label=label, ms=4)
         best[method] = cheapest_within(pts, target)
+        lam = sorted(((num(r["lambda_error"]), num(r["lambda_step_error"]),
+                       num(r["cpu_seconds"])) for r in data
+                      if r["method"] == method and num(r["lambda_error"]) > 0),
+                     key=lambda x: x[2])
+        if lam and method != "galpha_simplified":
+            le, ls, lc = zip(*lam)
+            ax[2].loglog(lc, le, "o-", color=color, ms=4,
+                         label=label if method == "ida" else label + ", consistent lambda")
+            if method != "ida":
+                ax[2].loglog(lc, ls, "x:", color=color, ms=4, label=label + ", the step's lambda")
     for a in ax:
         a.axhline(target, color="gray", lw=0.5)
         a.grid(True, which="both", lw=0.3)
         a.legend(fontsize=7)
     ax[0].set(xlabel="CPU time [s]", ylabel="max relative error at the final time")
     ax[1].set(xlabel="residual evaluations (IDA: with its difference-quotient Jacobian)")
+    ax[2].set(xlabel="CPU time [s]", ylabel="relative error of the multipliers (max-norm)")
     ida = best.get("ida")
     lines = []
     for method, _, _ in methods[1:]:
