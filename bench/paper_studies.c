@@ -61,6 +61,8 @@ static run_out run(const scene *sc, run_opts o)
     ga_solver *s = NULL;
     memset(&r, 0, sizeof r);
     r.status = ga_create(sc->n, sc->m, &s);
+    if (!r.status) /* the paper's figures show the method's own multipliers and accelerations */
+        r.status = ga_set_output(s, GA_OUTPUT_STEP);
     if (!r.status)
         r.status = ga_set_callbacks(s, sc->mass, sc->force, sc->constraint, sc->jacobian,
                                     sc->user);
