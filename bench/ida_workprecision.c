@@ -176,9 +176,9 @@ static run_result run_ida(model *md, double tol, const double *qdd0, const doubl
 }
 
 /* ---- galpha, fixed steps ------------------------------------------------------------------ */
-/* galpha fixed steps (h > 0) or adaptive (h = 0, index-2, tolerance rtol) */
+/* galpha fixed steps (h > 0, index 3) or adaptive (h = 0, tolerance rtol, in `formulation`) */
 static run_result run_galpha_mode(const model *md, double h, double newton_tol, int tangent_mode,
-                                  double rtol)
+                                  double rtol, int formulation)
 {
     run_result r = {0, 0, 0, 0, 0, 0, 0, 0};
     ga_solver *s = NULL;
@@ -190,11 +190,11 @@ static run_result run_galpha_mode(const model *md, double h, double newton_tol, 
     ga_set_constraint_dt(s, md->dt);
     ga_set_constant_mass(s, md->constant_mass);
     ga_set_rho_inf(s, 0.7);
-    if (newton_tol > 0.0) /* else the default: 1e-2 rtol in adaptive mode */
+    if (newton_tol > 0.0) /* else the default: a tenth of the local tolerance in adaptive mode */
         ga_set_newton(s, newton_tol, 20);
     ga_set_tangent_mode(s, tangent_mode);
     if (h == 0.0) {
-        ga_set_formulation(s, GA_INDEX2_STABILIZED);
+        ga_set_formulation(s, formulation);
         ga_set_tolerances(s, rtol, rtol);
     }
     const long steps = h > 0.0 ? lround(md->t_end / h) : 0;
@@ -291,28 +291,31 @@ int main(int argc, char **argv)
      * repetitions are the outer loop, so that every setting samples the same phases of the
      * machine's speed. */
     enum { N_IDA = 17, N_FIXED = 19, N_ADAPTIVE = 11 };
-    enum { N_SETTINGS = N_IDA + 2 * N_FIXED + N_ADAPTIVE };
+    enum { N_SETTINGS = N_IDA + 2 * N_FIXED + 2 * N_ADAPTIVE };
     typedef struct setting {
         const char *method;
         double value, h, newton_tol, rtol;
-        int tangent_mode;
+        int tangent_mode, formulation;
     } setting;
     setting set[N_SETTINGS];
     run_result best[N_SETTINGS];
     int ns = 0;
     for (int k = 0; k < N_IDA; ++k)
-        set[ns++] = (setting){"ida", pow(10.0, -2.0 - 0.5 * k), 0, 0, 0, 0};
+        set[ns++] = (setting){"ida", pow(10.0, -2.0 - 0.5 * k), 0, 0, 0, 0, 0};
     for (int k = 0; k < N_FIXED; ++k) {
         /* a whole number of steps to t_end */
         const double h = md.t_end / (double)lround(md.t_end / (md.h0 * 4.0 / pow(2.0, 0.5 * k)));
         /* Newton tolerance well below the discretization error, which falls like h^2 */
         const double tol = fmin(1e-6, 1e-4 * (h / md.h0) * (h / md.h0));
-        set[ns++] = (setting){"galpha", h, h, tol, 0, GA_TANGENT_AUTO};
-        set[ns++] = (setting){"galpha_simplified", h, h, tol, 0, GA_TANGENT_NEGLECT};
+        set[ns++] = (setting){"galpha", h, h, tol, 0, GA_TANGENT_AUTO, GA_INDEX3};
+        set[ns++] = (setting){"galpha_simplified", h, h, tol, 0, GA_TANGENT_NEGLECT, GA_INDEX3};
     }
     for (int k = 0; k < N_ADAPTIVE; ++k) {
         const double rtol = pow(10.0, -3.0 - 0.5 * k);
-        set[ns++] = (setting){"galpha_adaptive", rtol, 0.0, 0.0, rtol, GA_TANGENT_AUTO};
+        set[ns++] = (setting){"galpha_adaptive", rtol, 0.0, 0.0, rtol, GA_TANGENT_AUTO,
+                              GA_INDEX2_STABILIZED};
+        set[ns++] = (setting){"galpha_adaptive_index3", rtol, 0.0, 0.0, rtol, GA_TANGENT_AUTO,
+                              GA_INDEX3};
     }
     for (int rep = 0; rep < REPEATS; ++rep)
         for (int i = 0; i < N_SETTINGS; ++i) {
@@ -320,7 +323,8 @@ int main(int argc, char **argv)
             const run_result r = c->method[0] == 'i'
                                      ? run_ida(&md, c->value, qdd0, lam0)
                                      : run_galpha_mode(&md, c->h, c->newton_tol,
-                                                       c->tangent_mode, c->rtol);
+                                                       c->tangent_mode, c->rtol,
+                                                       c->formulation);
             if (rep == 0 || (r.ok && r.cpu < best[i].cpu))
                 best[i] = r;
         }

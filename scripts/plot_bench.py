@@ -153,7 +153,8 @@ for name, target in (("wp_andrews.csv", 1e-3), ("wp_slider_crank.csv", 1e-3)):
     methods = [("ida", "SUNDIALS IDA (index 1, BDF, rtol = atol swept)", "k"),
                ("galpha", "galpha fixed h (full Newton)", "C0"),
                ("galpha_simplified", "galpha fixed h (tangents neglected)", "C1"),
-               ("galpha_adaptive", "galpha adaptive (index 2)", "C2")]
+               ("galpha_adaptive", "galpha adaptive (index 2)", "C2"),
+               ("galpha_adaptive_index3", "galpha adaptive (index 3)", "C3")]
     best = {}
     for method, label, color in methods:
         pts = curve(data, method)

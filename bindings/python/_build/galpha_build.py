@@ -10,7 +10,7 @@ import os
 import zipfile
 
 NAME = "galpha"
-VERSION = "0.1.0"
+VERSION = "0.2.0"
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DIST_INFO = "%s-%s.dist-info" % (NAME, VERSION)
 METADATA = """Metadata-Version: 2.1
