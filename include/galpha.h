@@ -188,7 +188,9 @@ GA_API ga_status ga_set_callbacks(ga_solver *s, ga_mass_fn mass, ga_force_fn for
  *  Allocates the solver's linear-algebra workspace (the last allocation before stepping).
  *  Errors: GA_ERR_ARG, GA_ERR_STATE (callbacks not set, or from a callback), GA_ERR_NOMEM,
  *  GA_ERR_CALLBACK, GA_ERR_CALLBACK_RETRY, GA_ERR_NONFINITE, GA_ERR_SINGULAR,
- *  GA_ERR_INCONSISTENT. On failure the solver is not initialized. */
+ *  GA_ERR_INCONSISTENT. On failure the solver is as it was: not initialized, or, called again
+ *  on an initialized solver, with its state and its constraints in use unchanged
+ *  (tests/c/test_redundant.c). */
 GA_API ga_status ga_init(ga_solver *s, double t0, const double *q0, const double *v0);
 
 /** Advance by exactly one step of size h > 0 (Algorithm 1). The step is transactional: unless

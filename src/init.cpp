@@ -38,10 +38,31 @@ Eigen::Index argmax_abs(const Vec &x)
 }
 }  // namespace
 
+// A failed ga_init leaves the solver as it was, its state and the constraints in use included:
+// GA_REDUNDANT_DROP selects them at the new q0 before the rest can fail, and the old state
+// stepped on without a constraint it needed (issue 17).
 ga_status Solver::init(double t0, const double *q0, const double *v0)
 {
     if (auto st = setup())
         return st;
+    const std::vector<unsigned char> active_before = active_;
+    const ga_status st = start(t0, q0, v0);
+    if (st)
+        restore_active(active_before);
+    return st;
+}
+
+// Puts back the constraints in use (in place: the linear algebra holds their address).
+void Solver::restore_active(const std::vector<unsigned char> &before)
+{
+    if (before != active_) {
+        std::copy(before.begin(), before.end(), active_.begin());
+        invalidate_jacobian();  // the matrices' active rows change back
+    }
+}
+
+ga_status Solver::start(double t0, const double *q0, const double *v0)
+{
     invalidate_jacobian();
     jacobian_valid_ = false;
     State &x = trial_;

@@ -787,8 +787,11 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
         return st;
     if (redundancy == GA_REDUNDANT_DROP && m_ > 0) {
         const Vec q = Eigen::Map<const Vec>(buf + kStateHeader, n_);
-        if (auto st = select_active_constraints(buf[4], q))
+        const std::vector<unsigned char> active_before = active_;
+        if (auto st = select_active_constraints(buf[4], q)) {
+            restore_active(active_before);
             return st;
+        }
     }
     State &s = accepted_;
     s.t = buf[4];

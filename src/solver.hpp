@@ -160,6 +160,8 @@ private:
     void commit(bool land_on, double t_land);
     double error_norm(double h);  // control.cpp
     // init.cpp
+    ga_status start(double t0, const double *q0, const double *v0);
+    void restore_active(const std::vector<unsigned char> &before);
     ga_status project_positions(double t, Vec &q);
     ga_status project_velocities(double t, const Vec &q, Vec &v);
     ga_status correct_velocities(Vec &v, const char *what);

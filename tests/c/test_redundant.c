@@ -382,6 +382,49 @@ static void errors(void **state)
     ga_free(s);
 }
 
+/* A failed ga_init leaves the solver as it was, the constraints in use included (issue 17): at
+ * q0 = 0 both gradients vanish and the selection keeps neither; the call then fails (the
+ * projection refused), and the old state must go on with its constraint, exactly as a twin
+ * that never saw the call (whose kept matrix is dropped the same way). */
+static void failed_init_keeps_the_constraints_in_use(void **state)
+{
+    (void)state;
+    kind = 0;
+    ga_solver *s[2];
+    double q[2], v[2], zero[2] = {0.0, 0.0}, phi[2], end[2][2];
+    for (int k = 0; k < 2; ++k) {
+        pendulum_state(&P, 1.0, 0.5, q, v);
+        assert_int_equal(ga_create(2, 2, &s[k]), GA_OK);
+        assert_int_equal(ga_set_callbacks(s[k], pendulum_mass, pendulum_force, twice_constraint,
+                                          twice_jacobian, &P),
+                         GA_OK);
+        assert_int_equal(ga_set_redundant_constraints(s[k], GA_REDUNDANT_DROP), GA_OK);
+        assert_int_equal(ga_init(s[k], 0.0, q, v), GA_OK);
+        for (int i = 0; i < 100; ++i)
+            assert_int_equal(ga_step(s[k], 1e-3), GA_OK);
+    }
+    int active[2];
+    assert_int_equal(ga_set_init_mode(s[0], GA_INIT_REFUSE, 1e-10), GA_OK);
+    assert_int_not_equal(ga_init(s[0], 0.1, zero, zero), GA_OK);
+    assert_int_equal(ga_get_active_constraints(s[0], active), GA_OK);
+    assert_int_equal(active[0], 1);
+    assert_int_equal(active[1], 0);
+    double t;
+    assert_int_equal(ga_get_t(s[0], &t), GA_OK); /* still initialized, at its own t */
+    assert_true(t > 0.09);
+    assert_int_equal(ga_set_jacobian_reuse(s[1], GA_REUSE_AUTO), GA_OK); /* drops its matrix */
+    for (int k = 0; k < 2; ++k) {
+        for (int i = 0; i < 900; ++i)
+            assert_int_equal(ga_step(s[k], 1e-3), GA_OK);
+        ga_get_q(s[k], end[k]);
+        ga_free(s[k]);
+    }
+    twice_constraint(1.0, end[0], phi, &P);
+    printf("  after the failed ga_init: |Phi| = %.1e at t = 1\n", fabs(phi[0]));
+    assert_true(fabs(phi[0]) < 1e-12);
+    assert_memory_equal(end[0], end[1], sizeof end[0]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -392,6 +435,7 @@ int main(void)
         cmocka_unit_test(large_sparse_chain),
         cmocka_unit_test(checkpoint_restarts_bit_identically),
         cmocka_unit_test(errors),
+        cmocka_unit_test(failed_init_keeps_the_constraints_in_use),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
