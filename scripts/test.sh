@@ -20,11 +20,12 @@ run_suite() {
 run_suite build -DCMAKE_BUILD_TYPE=Release
 run_suite build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGALPHA_SANITIZE=ON
 # Valgrind's memcheck on the release build's C suites: reads of uninitialized memory, which the
-# sanitizers do not see. (test_alloc replaces malloc itself, so memcheck cannot watch it; the
-# accuracy sweeps, test_newton_sweep and test_tolerance, run the same code as the other suites
-# for minutes of steps, which memcheck would stretch to most of an hour.)
+# sanitizers do not see. (test_alloc and test_alloc_failures replace malloc themselves, so
+# memcheck cannot watch them; the accuracy sweeps, test_newton_sweep and test_tolerance, run the
+# same code as the other suites for minutes of steps, which memcheck would stretch to most of an
+# hour.)
 echo "=== memcheck: C suites of the release build under valgrind"
-find build/tests/c -maxdepth 1 -type f -name 'test_*' -perm -u+x ! -name test_alloc \
+find build/tests/c -maxdepth 1 -type f -name 'test_*' -perm -u+x ! -name 'test_alloc*' \
     ! -name test_newton_sweep ! -name test_tolerance -print0 |
     xargs -0 -P "$JOBS" -I{} sh -c \
         'valgrind --error-exitcode=9 --quiet "$1" >"$1.memcheck.log" 2>&1 ||

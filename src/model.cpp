@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <limits>
 #include <tuple>
 
@@ -24,8 +25,11 @@ double fd_increment(double x)
 }
 }  // namespace
 
+// Built aside and moved in at the end: out of memory half way must not leave a grouping that
+// counts groups but lacks their columns (the retried setup would skip it, the step crash).
 void ColumnGroups::build(const ModelMatrix &A)
 {
+    ColumnGroups built;
     const int nrows = A.rows(), ncols = A.cols(), nnz = A.nnz();
     const auto &ri = A.row_index();
     const auto &ci = A.col_index();
@@ -65,26 +69,27 @@ void ColumnGroups::build(const ModelMatrix &A)
         }
         color[j] = c;
     }
-    start.assign(groups + 1, 0);
-    entry_start.assign(groups + 1, 0);
+    built.start.assign(groups + 1, 0);
+    built.entry_start.assign(groups + 1, 0);
     for (int j = 0; j < ncols; ++j)
         if (color[j] >= 0)
-            ++start[color[j] + 1];
+            ++built.start[color[j] + 1];
     for (int k : unique)
-        ++entry_start[color[ci[k]] + 1];
+        ++built.entry_start[color[ci[k]] + 1];
     for (int g = 0; g < groups; ++g) {
-        start[g + 1] += start[g];
-        entry_start[g + 1] += entry_start[g];
+        built.start[g + 1] += built.start[g];
+        built.entry_start[g + 1] += built.entry_start[g];
     }
-    cols.assign(start[groups], 0);
-    entries.assign(entry_start[groups], 0);
-    std::vector<int> fill_c(start.begin(), start.end() - 1);
-    std::vector<int> fill_e(entry_start.begin(), entry_start.end() - 1);
+    built.cols.assign(built.start[groups], 0);
+    built.entries.assign(built.entry_start[groups], 0);
+    std::vector<int> fill_c(built.start.begin(), built.start.end() - 1);
+    std::vector<int> fill_e(built.entry_start.begin(), built.entry_start.end() - 1);
     for (int j = 0; j < ncols; ++j)
         if (color[j] >= 0)
-            cols[fill_c[color[j]]++] = j;
+            built.cols[fill_c[color[j]]++] = j;
     for (int k : unique)
-        entries[fill_e[color[ci[k]]]++] = k;
+        built.entries[fill_e[color[ci[k]]]++] = k;
+    *this = std::move(built);
 }
 
 Model::Model(int n, int m, Counters &counters, Diagnostics &diag)

@@ -140,8 +140,27 @@ ModelMatrix &Solver::matrix(ga_matrix which)
 
 ga_status Solver::setup()
 {
-    if (workspace_ready_)
+    // The parts that options call for are set up each once; after running out of memory half
+    // way, a retry builds what is missing (the workspace was marked ready before the index-2
+    // system existed, and every step then failed).
+    const bool index2_missing = formulation == GA_INDEX2_STABILIZED && !S2_.ready();
+    const bool output_missing = output == GA_OUTPUT_CONSISTENT && !O_.ready();
+    if (workspace_ready_ && !index2_missing && !output_missing)
         return GA_OK;
+    if (!workspace_ready_)
+        if (auto st = setup_workspace())
+            return st;
+    if (index2_missing)
+        setup_index2();
+    if (output_missing)
+        setup_output();
+    // The factors' storage after every setup, so that it does not add to their peak.
+    S_.reserve_factors();
+    return GA_OK;
+}
+
+ga_status Solver::setup_workspace()
+{
     // Which linear algebra: sparse needs declared patterns of M and Phi_q, and K_t, C_t either
     // declared (possibly empty), not needed, or neglected.
     const bool sparse_possible = !M_.dense() && (m_ == 0 || !J_.dense()) &&
@@ -198,12 +217,6 @@ ga_status Solver::setup()
         active_.assign(m_, 1);
     S_.setup(std::move(backend), n_, m_, M_, J_, K_, C_, active_ptr());
     workspace_ready_ = true;
-    if (formulation == GA_INDEX2_STABILIZED)
-        setup_index2();
-    if (output == GA_OUTPUT_CONSISTENT)
-        setup_output();
-    // The factors' storage after every setup, so that it does not add to their peak.
-    S_.reserve_factors();
     return GA_OK;
 }
 

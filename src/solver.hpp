@@ -143,6 +143,7 @@ public:
 
 private:
     ga_status setup();  // chooses the backend and allocates everything; throws std::bad_alloc
+    ga_status setup_workspace();  // the part every formulation and option needs
     void setup_projection();
     void prefactor_index2();
     double newton_tolerance(bool adaptive) const;

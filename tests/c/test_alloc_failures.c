@@ -1,0 +1,191 @@
+/* Every allocation of a call that allocates, failed in turn (issue 17): the call returns
+ * GA_ERR_NOMEM with a message, and retried without the failure it works, and the run that
+ * follows is bit for bit that of a solver that never met the failure. Calls swept: ga_init,
+ * ga_set_state, and the options that allocate after ga_init (ga_set_formulation to index 2,
+ * ga_set_tangent_mode to finite differences, ga_set_output) -- on the sparse path with
+ * finite-difference tangents grouped by pattern. malloc and friends are
+ * interposed here (not under the sanitizers, whose allocator cannot be made to fail so; nor
+ * under valgrind, which replaces them). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <galpha.h>
+
+#include "scenes/chain.h"
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_UNDEFINED__)
+#define INTERPOSED 0
+#else
+#define INTERPOSED 1
+static long fail_at = 0; /* the allocation to fail, counted from arming; 0: none */
+static long count = 0;
+extern void *__libc_malloc(size_t);
+extern void *__libc_calloc(size_t, size_t);
+extern void *__libc_realloc(void *, size_t);
+extern void *__libc_memalign(size_t, size_t);
+extern void __libc_free(void *);
+static int fails(void) { return fail_at > 0 && ++count == fail_at; }
+void *malloc(size_t n) { return fails() ? NULL : __libc_malloc(n); }
+void *calloc(size_t k, size_t n) { return fails() ? NULL : __libc_calloc(k, n); }
+void *realloc(void *p, size_t n) { return fails() ? NULL : __libc_realloc(p, n); }
+void *memalign(size_t a, size_t n) { return fails() ? NULL : __libc_memalign(a, n); }
+void *aligned_alloc(size_t a, size_t n) { return memalign(a, n); }
+int posix_memalign(void **out, size_t a, size_t n)
+{
+    *out = memalign(a, n);
+    return *out ? 0 : 12;
+}
+void free(void *p) { __libc_free(p); }
+#endif
+
+enum { kLinks = 6, N = 3 * kLinks, M = 2 * kLinks };
+static chain g_chain;
+
+/* A chain on the sparse path without a K_t callback, so that its finite differences (grouped
+ * by the pattern) are part of what is set up. */
+static ga_solver *make(void)
+{
+    ga_solver *s = NULL;
+    g_chain = chain_make(kLinks);
+    if (ga_create(N, M, &s) != GA_OK)
+        return NULL;
+    assert_int_equal(chain_declare_patterns(&g_chain, s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
+                                      chain_jacobian, &g_chain),
+                     GA_OK);
+    assert_int_equal(ga_set_constraint_accel(s, chain_constraint_accel), GA_OK);
+    assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
+    return s;
+}
+
+static void steps(ga_solver *s, double *q)
+{
+    for (int i = 0; i < 5; ++i)
+        assert_int_equal(ga_step(s, 1e-3), GA_OK);
+    assert_int_equal(ga_get_q(s, q), GA_OK);
+}
+
+typedef enum call { INIT, INIT_INDEX2, SET_STATE, FORMULATION, TANGENT_MODE, OUTPUT } call;
+static const char *const kNames[] = {"ga_init", "ga_init (index 2)", "ga_set_state",
+                                     "ga_set_formulation", "ga_set_tangent_mode",
+                                     "ga_set_output"};
+
+/* The call under test on a solver prepared for it. */
+static ga_status do_call(ga_solver *s, call c, const double *checkpoint, size_t len)
+{
+    double q[N], v[N];
+    chain_initial(&g_chain, q, v);
+    switch (c) {
+    case INIT:
+    case INIT_INDEX2: return ga_init(s, 0.0, q, v);
+    case SET_STATE: return ga_set_state(s, checkpoint, len);
+    case FORMULATION: return ga_set_formulation(s, GA_INDEX2_STABILIZED);
+    case TANGENT_MODE: return ga_set_tangent_mode(s, GA_TANGENT_FD);
+    default: return ga_set_output(s, GA_OUTPUT_CONSISTENT);
+    }
+}
+
+/* A solver ready for the call: options that make the call allocate set the other way first. */
+static ga_solver *prepare(call c)
+{
+    ga_solver *s = make();
+    assert_non_null(s);
+    double q[N], v[N];
+    chain_initial(&g_chain, q, v);
+    if (c == TANGENT_MODE)
+        assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_NEGLECT), GA_OK);
+    if (c == OUTPUT)
+        assert_int_equal(ga_set_output(s, GA_OUTPUT_STEP), GA_OK);
+    if (c == INIT_INDEX2)
+        assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
+    if (c != INIT && c != INIT_INDEX2 && c != SET_STATE)
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    return s;
+}
+
+static void sweep(call c)
+{
+#if INTERPOSED
+    static double checkpoint[1024];
+    size_t len = 0;
+    {   /* a checkpoint of the initial state, for ga_set_state */
+        ga_solver *s = make();
+        double q[N], v[N];
+        chain_initial(&g_chain, q, v);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        assert_int_equal(ga_state_size(s, &len), GA_OK);
+        assert_true(len <= 1024);
+        assert_int_equal(ga_get_state(s, checkpoint, len), GA_OK);
+        ga_free(s);
+    }
+    /* the run of a solver that never met a failure */
+    double q_ref[N], q[N];
+    {
+        ga_solver *s = prepare(c);
+        assert_int_equal(do_call(s, c, checkpoint, len), GA_OK);
+        steps(s, q_ref);
+        ga_free(s);
+    }
+    long k = 1, failed = 0;
+    for (;; ++k) {
+        ga_solver *s = prepare(c);
+        count = 0;
+        fail_at = k;
+        const ga_status st = do_call(s, c, checkpoint, len);
+        const int hit = count >= k;
+        fail_at = 0;
+        if (!hit) { /* the call made fewer than k allocations: swept them all */
+            assert_int_equal(st, GA_OK);
+            ga_free(s);
+            break;
+        }
+        if (st == GA_OK) { /* an allocation whose failure the call survives (a fallback) */
+            steps(s, q);
+        } else {
+            ++failed;
+            if (st != GA_ERR_NOMEM)
+                fail_msg("%s, allocation %ld failed: status %d (%s)", kNames[c], k, st,
+                         ga_last_error(s));
+            assert_true(ga_last_error(s)[0] != '\0');
+            const ga_status retry = do_call(s, c, checkpoint, len);
+            if (retry != GA_OK)
+                fail_msg("%s, retry after allocation %ld failed: %s", kNames[c], k,
+                         ga_last_error(s));
+            steps(s, q);
+        }
+        if (memcmp(q, q_ref, sizeof q) != 0)
+            fail_msg("%s, allocation %ld failed: the run differs from one without the failure",
+                     kNames[c], k);
+        ga_free(s);
+    }
+    printf("  %s: %ld allocations, each failed in turn (%ld reported GA_ERR_NOMEM)\n", kNames[c],
+           k - 1, failed);
+#else
+    (void)c;
+    printf("  allocation failures cannot be injected under the sanitizers: skipped\n");
+#endif
+}
+
+static void init_sweep(void **state) { (void)state; sweep(INIT); }
+static void init_index2_sweep(void **state) { (void)state; sweep(INIT_INDEX2); }
+static void set_state_sweep(void **state) { (void)state; sweep(SET_STATE); }
+static void formulation_sweep(void **state) { (void)state; sweep(FORMULATION); }
+static void tangent_mode_sweep(void **state) { (void)state; sweep(TANGENT_MODE); }
+static void output_sweep(void **state) { (void)state; sweep(OUTPUT); }
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(init_sweep),         cmocka_unit_test(init_index2_sweep),
+        cmocka_unit_test(set_state_sweep),
+        cmocka_unit_test(formulation_sweep),  cmocka_unit_test(tangent_mode_sweep),
+        cmocka_unit_test(output_sweep),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
