@@ -488,9 +488,9 @@ GA_API ga_status ga_interpolate(const ga_solver *s, double t, double *q, double 
 {
     return computing(s, [&](ga::Solver &c) {
         if (!c.initialized())
-            return GA_ERR_STATE;
+            return c.diag.fail(GA_ERR_STATE, "ga_interpolate before ga_init");
         if (!std::isfinite(t))
-            return GA_ERR_ARG;
+            return c.diag.fail(GA_ERR_ARG, "ga_interpolate: t = %g is not finite", t);
         return c.interpolate(t, q, v, nullptr, lambda);
     });
 }
@@ -499,9 +499,10 @@ GA_API ga_status ga_interpolate_qdd(const ga_solver *s, double t, double *qdd)
 {
     return computing(s, [&](ga::Solver &c) {
         if (!c.initialized())
-            return GA_ERR_STATE;
+            return c.diag.fail(GA_ERR_STATE, "ga_interpolate_qdd before ga_init");
         if (!std::isfinite(t) || !qdd)
-            return GA_ERR_ARG;
+            return c.diag.fail(GA_ERR_ARG, "ga_interpolate_qdd: t = %g not finite or qdd NULL",
+                               t);
         return c.interpolate(t, nullptr, nullptr, qdd, nullptr);
     });
 }
@@ -676,16 +677,17 @@ GA_API ga_status ga_get_counter(const ga_solver *s, int key, long long *value)
 
 GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value)
 {
-    return reading(s, [&](const ga::Solver &c) {
+    // a failure says so in ga_last_error, instead of leaving an earlier failure's message there
+    return computing(s, [&](ga::Solver &c) {
         if (!value)
-            return GA_ERR_ARG;
+            return c.diag.fail(GA_ERR_ARG, "ga_get_info: value is NULL");
         switch (key) {
         case GA_INFO_RCOND: *value = c.last_rcond(); return GA_OK;
         case GA_INFO_NEWTON_ITERS: *value = c.last_newton_iters(); return GA_OK;
         case GA_INFO_NEWTON_RATIO: *value = c.last_newton_ratio(); return GA_OK;
         case GA_INFO_ERROR_ESTIMATE: *value = c.control.err_last; return GA_OK;
         case GA_INFO_H_NEXT: *value = c.control.h_next; return GA_OK;
-        default: return GA_ERR_ARG;
+        default: return c.diag.fail(GA_ERR_ARG, "ga_get_info: unknown key %d", key);
         }
     });
 }

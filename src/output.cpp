@@ -78,12 +78,13 @@ ga_status Solver::output_state(double *qdd, double *lambda)
 ga_status Solver::interpolate(double t, double *q, double *v, double *qdd, double *lambda)
 {
     if (!previous_valid_)
-        return GA_ERR_STATE;
+        return diag.fail(GA_ERR_STATE, "dense output: no step since ga_init or ga_set_state");
     const State &a = previous_, &b = accepted_;
     const double h = b.t - a.t;
     const double slack = 1e-12 * std::max(std::fabs(b.t), 1.0);
     if (!(t >= a.t - slack && t <= b.t + slack))
-        return GA_ERR_ARG;
+        return diag.fail(GA_ERR_ARG, "dense output: t = %.17g is outside the last step [%.17g, "
+                         "%.17g]", t, a.t, b.t);
     const double th = std::clamp((t - a.t) / h, 0.0, 1.0);
     const double h00 = (2 * th - 3) * th * th + 1, h10 = ((th - 2) * th + 1) * th;
     const double h01 = (3 - 2 * th) * th * th, h11 = (th - 1) * th * th;

@@ -358,8 +358,10 @@ static void bad_options_are_refused(void **state)
     expect_message(x->s, "declared before ga_init");
     /* queries with a bad key or no output */
     assert_int_equal(ga_get_info(x->s, GA_INFO_COUNT, &d), GA_ERR_ARG);
+    expect_message(x->s, "unknown key");
     assert_int_equal(ga_get_info(x->s, -1, &d), GA_ERR_ARG);
     assert_int_equal(ga_get_info(x->s, GA_INFO_H_NEXT, NULL), GA_ERR_ARG);
+    expect_message(x->s, "value is NULL");
     assert_int_equal(ga_set_jacobian_reuse(NULL, GA_REUSE_AUTO), GA_ERR_ARG);
     assert_int_equal(ga_reset_counters(NULL), GA_ERR_ARG);
     assert_string_equal(ga_linear_solver_name(NULL), "none");
@@ -462,10 +464,14 @@ static void bad_adaptive_calls_are_refused(void **state)
     /* dense output needs a step: not after ga_set_state; not at NaN or outside the step */
     double q[2];
     assert_int_equal(ga_interpolate(x->s, t, q, NULL, NULL), GA_OK);
+    /* each failure with its own message, not the one an earlier failure left (issue 17) */
     assert_int_equal(ga_interpolate(x->s, NAN, q, NULL, NULL), GA_ERR_ARG);
+    expect_message(x->s, "t = nan is not finite");
     assert_int_equal(ga_interpolate(x->s, t + 1.0, q, NULL, NULL), GA_ERR_ARG);
+    expect_message(x->s, "is outside the last step");
     assert_int_equal(ga_set_state(x->s, before, len), GA_OK);
     assert_int_equal(ga_interpolate(x->s, t, q, NULL, NULL), GA_ERR_STATE);
+    expect_message(x->s, "no step since ga_init or ga_set_state");
     assert_int_equal(ga_interpolate(NULL, t, q, NULL, NULL), GA_ERR_ARG);
 }
 
