@@ -215,8 +215,9 @@ GA_API ga_status ga_step(ga_solver *s, double h);
  *  step, which norm. Every call that can change the solver (ga_init, ga_step, ga_set_*,
  *  ga_reset_counters) clears it when it starts; read-only calls (ga_get_*, ga_interpolate*)
  *  leave it when they succeed, so it can be read after inspecting the state, and replace it
- *  with their own when they fail (ga_get_info, ga_interpolate*, consistent output). "" when there is nothing to report. The string belongs
- *  to the solver. ga_last_error(NULL) returns a fixed message. */
+ *  with their own when they fail (ga_get_info, ga_interpolate*, consistent output). "" when
+ *  there is nothing to report. The string belongs to the solver. ga_last_error(NULL) returns a
+ *  fixed message. */
 GA_API const char *ga_last_error(const ga_solver *s);
 
 /** Sizes given to ga_create. Errors: GA_ERR_ARG. */
