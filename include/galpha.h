@@ -658,7 +658,8 @@ typedef enum ga_counter {
     GA_COUNT_NEWTON_ITERS = 2,   /**< Newton iterations (linear solves in ga_step) */
     GA_COUNT_FACTORIZATIONS = 3, /**< LU factorizations (including ga_init's and, in adaptive
                                       mode, that of the error estimate's projection) */
-    GA_COUNT_RESIDUALS = 4,      /**< evaluations of the residual (r^q, r^lambda) */
+    GA_COUNT_RESIDUALS = 4,      /**< evaluations of the residual (r^q, r^lambda), those of
+                                      finite-difference tangents included */
     GA_COUNT_MASS_EVALS = 5,     /**< mass matrix callback calls (finite differences included) */
     GA_COUNT_FORCE_EVALS = 6,    /**< force callback calls (finite differences included) */
     GA_COUNT_CONSTRAINT_EVALS = 7, /**< constraint callback calls */

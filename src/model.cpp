@@ -258,6 +258,7 @@ ga_status Model::perturbed_residual(double t, const Vec &qp, const Vec &v, const
     if (auto st = jacobian(t, qp, J_pert_))
         return st;
     dynamics_residual(constant_mass ? M : M_pert_, qdd, f_pert_, J_pert_, lambda, r);
+    count(counters_, GA_COUNT_RESIDUALS);  // all work counts: the differences' residuals too
     return GA_OK;
 }
 

@@ -18,6 +18,7 @@
 
 #include "scenes/andrews.h"
 #include "scenes/chain.h"
+#include "scenes/pendulum.h"
 
 enum { kLinks = 10 };
 static chain g_chain;
@@ -146,11 +147,40 @@ static void auto_spares_the_tangents_where_they_do_not(void **state)
     assert_true(aut.iterations <= 1.25 * fd.iterations);
 }
 
+/* The residual counter counts all residuals, those of finite-difference tangents too (one per
+ * column for a dense K_t): work-precision comparisons count honestly (issue 17). */
+static void differences_count_their_residuals(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    double q[2], v[2];
+    ga_solver *s = NULL;
+    pendulum_state(&p, 1.0, 0.5, q, v);
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &p),
+                     GA_OK);
+    assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    for (int i = 0; i < 10; ++i)
+        assert_int_equal(ga_step(s, 1e-2), GA_OK);
+    long long residuals, iterations, tangents;
+    ga_get_counter(s, GA_COUNT_RESIDUALS, &residuals);
+    ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &iterations);
+    ga_get_counter(s, GA_COUNT_STIFFNESS_EVALS, &tangents);
+    printf("  %lld residuals: %lld Newton iterations, %lld tangents of 2 columns\n", residuals,
+           iterations, tangents);
+    assert_true(tangents > 0);
+    assert_true(residuals == iterations + 2 * tangents);
+    ga_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(auto_takes_the_tangents_where_they_matter),
         cmocka_unit_test(auto_spares_the_tangents_where_they_do_not),
+        cmocka_unit_test(differences_count_their_residuals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
