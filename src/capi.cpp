@@ -22,9 +22,9 @@ ga_status call(ga_solver *s, bool clear_message, Body &&body)
 {
     if (!s)
         return GA_ERR_ARG;
-    if (s->busy)
+    bool idle = false;
+    if (!s->busy.compare_exchange_strong(idle, true))
         return GA_ERR_STATE;  // message left alone: the outer call owns it
-    s->busy = true;
     if (clear_message)
         s->core.diag.clear();
     ga_status st;
