@@ -1,5 +1,6 @@
 // The C ABI: argument checks, the re-entrancy guard, exceptions turned into statuses.
 // No mathematics here; it lives in the ga:: core.
+#include <cfenv>
 #include <climits>
 #include <cmath>
 #include <exception>
@@ -15,6 +16,35 @@
 
 namespace {
 
+// Floating-point traps the caller enabled (feenableexcept) are held while galpha's own code
+// runs, which meets NaN and Inf on purpose (arguments, callback outputs) to report them as
+// statuses, and restored for the callbacks and on return. Nothing happens without traps.
+class TrapsHeld {
+public:
+    explicit TrapsHeld(ga::Model &model) : model_(model)
+    {
+#ifdef __GLIBC__
+        if (fegetexcept() != 0) {
+            std::feholdexcept(&caller_);
+            model_.caller_fenv = &caller_;
+        }
+#endif
+    }
+    ~TrapsHeld()
+    {
+        if (model_.caller_fenv) {
+            model_.caller_fenv = nullptr;
+            std::fesetenv(&caller_);
+        }
+    }
+    TrapsHeld(const TrapsHeld &) = delete;
+    TrapsHeld &operator=(const TrapsHeld &) = delete;
+
+private:
+    ga::Model &model_;
+    std::fenv_t caller_;
+};
+
 // Runs `body` as one API call on `s`: refuses calls from inside the solver's own callbacks,
 // clears the last error if asked, and converts every C++ exception into a status.
 template <class Body>
@@ -25,6 +55,7 @@ ga_status call(ga_solver *s, bool clear_message, Body &&body)
     bool idle = false;
     if (!s->busy.compare_exchange_strong(idle, true))
         return GA_ERR_STATE;  // message left alone: the outer call owns it
+    const TrapsHeld traps(s->core.model);
     if (clear_message)
         s->core.diag.clear();
     ga_status st;

@@ -164,7 +164,7 @@ ga_status Model::mass(double t, const Vec &q, ModelMatrix &M)
     if (M.zero())
         return GA_OK;
     count(counters_, GA_COUNT_MASS_EVALS);
-    if (auto st = callback_status(cb.mass(t, q.data(), M.data(), cb.user), "mass", t))
+    if (auto st = callback_status(user([&] { return cb.mass(t, q.data(), M.data(), cb.user); }), "mass", t))
         return st;
     return check_finite(M.data(), M.size(), message_rows(M), "mass matrix M", t);
 }
@@ -176,7 +176,7 @@ ga_status Model::force(double t, const Vec &q, const Vec &v, Vec &f, Check check
         return GA_OK;
     }
     count(counters_, GA_COUNT_FORCE_EVALS);
-    if (auto st = callback_status(cb.force(t, q.data(), v.data(), f.data(), cb.user), "force",
+    if (auto st = callback_status(user([&] { return cb.force(t, q.data(), v.data(), f.data(), cb.user); }), "force",
                                   t))
         return st;
     return check == Check::Now ? check_finite(f.data(), n_, 0, "force f", t) : GA_OK;
@@ -187,7 +187,7 @@ ga_status Model::constraint(double t, const Vec &q, Vec &phi)
     if (m_ == 0)
         return GA_OK;
     count(counters_, GA_COUNT_CONSTRAINT_EVALS);
-    if (auto st = callback_status(cb.constraint(t, q.data(), phi.data(), cb.user), "constraint",
+    if (auto st = callback_status(user([&] { return cb.constraint(t, q.data(), phi.data(), cb.user); }), "constraint",
                                   t))
         return st;
     return check_finite(phi.data(), m_, 0, "constraint Phi", t);
@@ -198,7 +198,7 @@ ga_status Model::jacobian(double t, const Vec &q, ModelMatrix &J, Check check)
     if (m_ == 0 || J.zero())
         return GA_OK;
     count(counters_, GA_COUNT_JACOBIAN_EVALS);
-    if (auto st = callback_status(cb.jacobian(t, q.data(), J.data(), cb.user), "jacobian", t))
+    if (auto st = callback_status(user([&] { return cb.jacobian(t, q.data(), J.data(), cb.user); }), "jacobian", t))
         return st;
     if (check == Check::Deferred)
         return GA_OK;
@@ -267,8 +267,8 @@ ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
 {
     count(counters_, GA_COUNT_STIFFNESS_EVALS);
     if (cb.stiffness && tangent_mode == GA_TANGENT_AUTO) {
-        if (auto st = callback_status(cb.stiffness(t, q.data(), v.data(), qdd.data(),
-                                                   lambda.data(), K.data(), cb.user),
+        if (auto st = callback_status(user([&] { return cb.stiffness(t, q.data(), v.data(), qdd.data(),
+                                                   lambda.data(), K.data(), cb.user); }),
                                       "stiffness", t))
             return st;
         return check_finite(K.data(), K.size(), message_rows(K), "tangent stiffness K_t", t);
@@ -315,7 +315,7 @@ ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, Mod
 {
     count(counters_, GA_COUNT_DAMPING_EVALS);
     if (cb.damping && tangent_mode == GA_TANGENT_AUTO) {
-        if (auto st = callback_status(cb.damping(t, q.data(), v.data(), C.data(), cb.user),
+        if (auto st = callback_status(user([&] { return cb.damping(t, q.data(), v.data(), C.data(), cb.user); }),
                                       "damping", t))
             return st;
         return check_finite(C.data(), C.size(), message_rows(C), "tangent damping C_t", t);
@@ -366,7 +366,7 @@ ga_status Model::constraint_dt(double t, const Vec &q, Vec &out)
         return GA_OK;
     count(counters_, GA_COUNT_CONSTRAINT_DT_EVALS);
     if (cb.constraint_dt) {
-        if (auto st = callback_status(cb.constraint_dt(t, q.data(), out.data(), cb.user),
+        if (auto st = callback_status(user([&] { return cb.constraint_dt(t, q.data(), out.data(), cb.user); }),
                                       "constraint_dt", t))
             return st;
         return check_finite(out.data(), m_, 0, "constraint time derivative Phi_t", t);
@@ -396,8 +396,8 @@ ga_status Model::constraint_accel(double t, const Vec &q, const Vec &v, Vec &out
         return GA_OK;
     count(counters_, GA_COUNT_ACCEL_EVALS);
     if (cb.constraint_accel) {
-        if (auto st = callback_status(cb.constraint_accel(t, q.data(), v.data(), out.data(),
-                                                          cb.user),
+        if (auto st = callback_status(user([&] { return cb.constraint_accel(t, q.data(), v.data(), out.data(),
+                                                          cb.user); }),
                                       "constraint_accel", t))
             return st;
         return check_finite(out.data(), m_, 0, "constraint acceleration term", t);

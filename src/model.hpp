@@ -6,6 +6,7 @@
 // not n.
 #pragma once
 
+#include <cfenv>
 #include <vector>
 
 #include "diagnostics.hpp"
@@ -40,6 +41,10 @@ public:
     Model(int n, int m, Counters &counters, Diagnostics &diag);
 
     Callbacks cb;
+    // The caller's floating-point environment while a call runs with its traps held (the C
+    // shim sets it when the caller has traps enabled): callbacks run in it, galpha's own
+    // arithmetic, which meets NaN and Inf on purpose to report them, does not.
+    const std::fenv_t *caller_fenv = nullptr;
     ga_tangent_mode tangent_mode = GA_TANGENT_AUTO;
     bool constant_mass = false;
 
@@ -94,6 +99,18 @@ public:
                                   const ModelMatrix &J, const Vec &lambda, Vec &rq);
 
 private:
+    // Runs a user callback in the caller's floating-point environment (see caller_fenv).
+    template <class Call>
+    int user(Call &&call)
+    {
+        if (!caller_fenv)
+            return call();
+        std::fenv_t held;
+        std::fesetenv(caller_fenv);
+        const int rc = call();
+        std::feholdexcept(&held);
+        return rc;
+    }
     ga_status callback_status(int rc, const char *name, double t);
     ga_status check_finite(const double *x, Eigen::Index size, Eigen::Index rows,
                            const char *what, double t);
