@@ -48,6 +48,7 @@ int sparse_in_order(const ModelMatrix &J, int n, int m, unsigned char *active)
 {
     cholmod_common cc;
     cholmod_l_start(&cc);
+    cc.print = 0;  // CHOLMOD prints its errors to stdout unless told not to; galpha never prints
     std::vector<double> norm2(m, 0.0);
     for (int k = 0; k < J.nnz(); ++k)
         norm2[J.row_index()[k]] += J.data()[k] * J.data()[k];  // (duplicates: close enough)
