@@ -111,6 +111,34 @@ ga_status copy_out(const ga::Solver &c, const ga::Vec &x, double *out)
 
 }  // namespace
 
+namespace {
+// Changes an option that shapes the tangents; a failure (no place on the sparse path, out of
+// memory) puts every such option back: a failed call leaves the solver as it was.
+template <class Change>
+ga_status change_tangents(ga::Solver &c, Change &&change)
+{
+    const ga::Callbacks cb = c.model.cb;
+    const ga_tangent_mode mode = c.model.tangent_mode;
+    const bool constant_mass = c.model.constant_mass;
+    const auto restore = [&] {
+        c.model.cb = cb;
+        c.model.tangent_mode = mode;
+        c.model.constant_mass = constant_mass;
+    };
+    change();
+    try {
+        if (const ga_status st = c.tangent_options_changed()) {
+            restore();
+            return st;
+        }
+    } catch (...) {
+        restore();
+        throw;
+    }
+    return GA_OK;
+}
+}  // namespace
+
 extern "C" {
 
 GA_API const char *ga_version(void)
@@ -208,10 +236,10 @@ GA_API ga_status ga_set_callbacks(ga_solver *s, ga_mass_fn mass, ga_force_fn for
 GA_API ga_status ga_set_tangents(ga_solver *s, ga_stiffness_fn stiffness, ga_damping_fn damping)
 {
     return guarded(s, [&](ga::Solver &c) {
-        c.model.cb.stiffness = stiffness;
-        c.model.cb.damping = damping;
-        c.tangent_options_changed();
-        return GA_OK;
+        return change_tangents(c, [&] {
+            c.model.cb.stiffness = stiffness;
+            c.model.cb.damping = damping;
+        });
     });
 }
 
@@ -220,9 +248,7 @@ GA_API ga_status ga_set_tangent_mode(ga_solver *s, int mode)
     return guarded(s, [&](ga::Solver &c) {
         if (mode != GA_TANGENT_AUTO && mode != GA_TANGENT_FD && mode != GA_TANGENT_NEGLECT)
             return c.diag.fail(GA_ERR_ARG, "unknown tangent mode %d", mode);
-        c.model.tangent_mode = static_cast<ga_tangent_mode>(mode);
-        c.tangent_options_changed();
-        return GA_OK;
+        return change_tangents(c, [&] { c.model.tangent_mode = static_cast<ga_tangent_mode>(mode); });
     });
 }
 
@@ -322,9 +348,7 @@ GA_API ga_status ga_set_constant_mass(ga_solver *s, int on)
     return guarded(s, [&](ga::Solver &c) {
         if (on != 0 && on != 1)
             return c.diag.fail(GA_ERR_ARG, "constant mass must be 0 or 1, got %d", on);
-        c.model.constant_mass = on == 1;
-        c.tangent_options_changed();
-        return GA_OK;
+        return change_tangents(c, [&] { c.model.constant_mass = on == 1; });
     });
 }
 

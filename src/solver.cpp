@@ -196,8 +196,12 @@ ga_status Solver::setup_workspace()
     }
     M_.allocate();
     J_.allocate();
-    K_.allocate();
-    C_.allocate();
+    // On the sparse path a tangent without a pattern is one that is not needed (neglected, or
+    // C_t without forces): no dense n x n for it (1.5 GB at n = 10^4).
+    if (!sparse || !K_.dense())
+        K_.allocate();
+    if (!sparse || !C_.dense())
+        C_.allocate();
     B_.copy_layout(J_);
     Z_.copy_layout(J_);
     f_.setZero(n_);
@@ -698,11 +702,21 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
     return GA_OK;
 }
 
-void Solver::tangent_options_changed()
+ga_status Solver::tangent_options_changed()
 {
+    // The sparse path was chosen with tangents that need no pattern (not needed then); a
+    // tangent needed now has no place in its matrix.
+    if (sparse_backend_ && ((model.stiffness_needed(K_) && K_.dense()) ||
+                            (model.damping_needed(C_) && C_.dense())))
+        return diag.fail(GA_ERR_ARG,
+                         "the sparse path was set up without a pattern of %s, which these "
+                         "options need: declare it before ga_init (an empty pattern declares a "
+                         "zero matrix)",
+                         model.stiffness_needed(K_) && K_.dense() ? "K_t" : "C_t");
     invalidate_jacobian();
     if (workspace_ready_)
         model.prepare_differences(M_, K_, C_);  // may throw std::bad_alloc (GA_ERR_NOMEM)
+    return GA_OK;
 }
 
 double Solver::last_rcond() const

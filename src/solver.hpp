@@ -121,7 +121,9 @@ public:
     // An option or callback that shapes the tangents changed (ga_set_tangents,
     // ga_set_tangent_mode, ga_set_constant_mass): a fresh matrix, and after setup the
     // finite-difference scratch the new choice needs, allocated here rather than in a step.
-    void tangent_options_changed();
+    // GA_ERR_ARG if the sparse path has no place for a tangent now needed; may throw
+    // std::bad_alloc. The caller puts its option back when this fails.
+    ga_status tangent_options_changed();
 
     // For bench/: the unavoidable work of a step, done once at the current state -- one
     // residual evaluation (callbacks and r^q, r^lambda) and one solve with the factorization

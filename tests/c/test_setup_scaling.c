@@ -13,6 +13,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include <galpha.h>
@@ -131,10 +132,50 @@ static void setup_is_not_quadratic_in_components(void **state)
     }
 }
 
+/* A tangent that is not needed has no pattern on the sparse path and gets no dense n x n
+ * matrix (issue 17: 1.5 GB at n = 10^4, GA_ERR_NOMEM at 3 x 10^4; here n = 2e5, 320 GB). Asking
+ * for it after ga_init is refused with a message and changes nothing. */
+static ga_solver *make_neglected(void)
+{
+    static int rows[N], cols[N], jr[N], jc[N];
+    ga_solver *s = NULL;
+    for (int k = 0; k < N; ++k) {
+        rows[k] = cols[k] = k;
+        jr[k] = k / 2;
+        jc[k] = k;
+    }
+    assert_int_equal(ga_create(N, M, &s), GA_OK);
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_MASS, N, rows, cols), GA_OK);
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_JACOBIAN, N, jr, jc), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, mass, force, constraint, jacobian, NULL), GA_OK);
+    assert_int_equal(ga_set_constraint_accel(s, accel), GA_OK);
+    assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_NEGLECT), GA_OK);
+    return s;
+}
+
+static void unneeded_tangents_are_not_allocated(void **state)
+{
+    (void)state;
+    static double q[N], v[N];
+    for (int i = 0; i < K; ++i) {
+        q[2 * i] = sin(0.7), q[2 * i + 1] = -cos(0.7);
+        v[2 * i] = v[2 * i + 1] = 0.0;
+    }
+    ga_solver *s = make_neglected();
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    assert_string_equal(ga_linear_solver_name(s), "sparse KLU");
+    assert_int_equal(ga_step(s, 1e-3), GA_OK);
+    assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_AUTO), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "without a pattern of K_t"));
+    assert_int_equal(ga_step(s, 1e-3), GA_OK); /* still neglected */
+    ga_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(setup_is_not_quadratic_in_components),
+        cmocka_unit_test(unneeded_tangents_are_not_allocated),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
