@@ -568,3 +568,41 @@ def test_output_consistent_by_default_and_the_step_s_on_request():
     assert i_c.shape == (2,) and np.max(np.abs(i_c - i_s)) < 1e-2
     with pytest.raises(galpha.ArgumentError):
         pendulum(output=5)
+
+
+def test_a_solver_is_neither_copied_nor_pickled():
+    """copy.copy(solver) made two objects own one C solver, freed twice (issue 17)."""
+    import copy
+    import pickle
+    with pendulum() as s:
+        for make in (copy.copy, copy.deepcopy, pickle.dumps):
+            with pytest.raises(TypeError):
+                make(s)
+        s.init(0.0, Q0, V0)
+        s.step(1e-3)  # the original is intact
+
+
+def test_integrate_refuses_constraints_without_m_and_a_bad_h():
+    """integrate() without m dropped the constraint callbacks and reported success; h = nan
+    integrated the span in one step (issue 17)."""
+    with pytest.raises(ValueError, match="without m"):
+        galpha.integrate(mass, force, constraint, jacobian, (0.0, 0.5), Q0, V0, 0.01)
+    with pytest.raises(ValueError, match="m = 0"):
+        galpha.integrate(mass, force, constraint, jacobian, (0.0, 0.5), Q0, V0, 0.01, m=0)
+    for h in (float("nan"), 0.0, -1e-3, float("inf")):
+        with pytest.raises(ValueError, match="positive and finite"):
+            galpha.integrate(mass, force, constraint, jacobian, (0.0, 0.5), Q0, V0, h, m=1)
+
+
+def test_integrate_result_attributes_repr_and_qdd_at_t_eval():
+    """A missing attribute is an AttributeError (hasattr, deepcopy), the repr counts steps as
+    steps, and qdd at t_eval comes from dense output, not NaN (issue 17)."""
+    import copy
+    sol = galpha.integrate(mass, force, constraint, jacobian, (0.0, 0.5), Q0, V0, 0.01, m=1,
+                           t_eval=[0.105, 0.25, 0.5])
+    assert not hasattr(sol, "no_such_field")
+    copy.deepcopy(sol)
+    assert "outputs=3" in repr(sol) and "steps=50" in repr(sol)
+    assert np.all(np.isfinite(sol.qdd))
+    # the pendulum's acceleration at t_eval against the step's at the same time nearby
+    assert sol.qdd.shape == (3, 2)

@@ -9,14 +9,18 @@ class IntegrateResult(dict):
     """Attributes: t (N,), q, v, qdd (N, n), lam (N, m), stats (dict), success (bool),
     status (0 or the failing ga_status), message (str)."""
 
-    __getattr__ = dict.__getitem__
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(name) from None
 
     def __repr__(self):
-        return "IntegrateResult(success=%r, message=%r, steps=%d, t_end=%g)" % (
-            self.success, self.message, len(self.t) - 1, self.t[-1])
+        return "IntegrateResult(success=%r, message=%r, outputs=%d, steps=%d, t_end=%g)" % (
+            self.success, self.message, len(self.t), self.stats.get("steps", 0), self.t[-1])
 
 
-def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=0, t_eval=None,
+def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=None, t_eval=None,
               **options):
     """Integrate from t_span[0] to t_span[1] and record every accepted step, or the states at
     the times t_eval (by dense output, without shortening steps).
@@ -24,6 +28,9 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=0,
     With h: fixed steps h (the last one shortened to land on t_span[1]). Without h: adaptive
     steps controlled by `tolerances=(rtol, atol)` (default 1e-6, 1e-6); the stabilized index-2
     formulation is recommended then (`formulation=galpha.GA_INDEX2_STABILIZED`).
+
+    m, the number of constraints, must be given with constraint callbacks (it was taken as 0,
+    which dropped them); without them it is 0.
 
     `options` go to Solver (rho_inf, newton, stiffness, constraint_accel, ...). A failure of
     the method (no convergence, singular matrix, ...) ends the integration with success=False
@@ -33,10 +40,21 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=0,
     t0, t1 = float(t_span[0]), float(t_span[1])
     if not t1 > t0:
         raise ValueError("t_span = (%g, %g): the end must come after the start" % (t0, t1))
+    if h is not None and not (float(h) > 0.0 and np.isfinite(float(h))):
+        raise ValueError("h = %r: a fixed step must be positive and finite" % (h,))
+    if (constraint is None) != (jacobian is None):
+        raise ValueError("constraint and jacobian come together (or neither: m = 0)")
     if t_eval is not None and any(not t0 <= float(t) <= t1 for t in t_eval):
         raise ValueError("t_eval: every time must lie in t_span = [%g, %g]" % (t0, t1))
     q0 = np.asarray(q0, dtype=float)
     n = q0.size
+    if m is None:
+        if constraint is not None:
+            raise ValueError("constraint callbacks given without m: say how many constraints "
+                             "they compute (m=...)")
+        m = 0
+    elif m == 0 and constraint is not None:
+        raise ValueError("m = 0 with constraint callbacks: they would be ignored; give m")
     ts, qs, vs, as_, ls = [], [], [], [], []
     status, message = 0, "reached t_span[1]"
     with Solver(n, m, mass, force, constraint, jacobian, **options) as s:
@@ -60,7 +78,7 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=0,
                     ts.append(te)
                     qs.append(qi)
                     vs.append(vi)
-                    as_.append(np.full(n, np.nan))  # accelerations are not interpolated
+                    as_.append(s.interpolate_qdd(te))
                     ls.append(li)
 
         pending = sorted(float(t) for t in t_eval) if t_eval is not None else None

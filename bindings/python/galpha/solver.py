@@ -267,6 +267,18 @@ class Solver:
     def __enter__(self):
         return self
 
+    # One object owns one C solver: a copy would free it twice.
+    def __copy__(self):
+        raise TypeError("a galpha.Solver cannot be copied (it owns its C solver); create "
+                        "another, or take a checkpoint (get_state) and restore it")
+
+    def __deepcopy__(self, memo):
+        self.__copy__()
+
+    def __reduce__(self):
+        raise TypeError("a galpha.Solver cannot be pickled (it owns its C solver and Python "
+                        "callbacks); pickle how to build it instead")
+
     def __exit__(self, *exc):
         self.close()
         return False
