@@ -606,3 +606,33 @@ def test_integrate_result_attributes_repr_and_qdd_at_t_eval():
     assert np.all(np.isfinite(sol.qdd))
     # the pendulum's acceleration at t_eval against the step's at the same time nearby
     assert sol.qdd.shape == (3, 2)
+
+
+def test_calls_from_two_threads_are_serialized():
+    """close() from another thread while a run is inside C waits for it, instead of freeing the
+    C solver under it (3 of 3 such processes crashed; issue 17). The run ends, then the
+    solver is closed."""
+    import threading
+    started = threading.Event()
+
+    def force_signalling(t, q, v, f):
+        started.set()
+        force(t, q, v, f)
+
+    s = galpha.Solver(2, 1, mass, force_signalling, constraint, jacobian, tolerances=(1e-6, 1e-6))
+    s.init(0.0, Q0, V0)
+    started.clear()
+    done = []
+
+    def run():
+        s.advance(1.0)  # ends undisturbed (then the solver may be closed at once)
+        done.append(1.0)
+
+    th = threading.Thread(target=run)
+    th.start()
+    started.wait()      # the run is inside C now
+    s.close()           # waits for it
+    th.join()
+    assert done == [1.0]
+    with pytest.raises(galpha.StateError):
+        s.step(1e-3)

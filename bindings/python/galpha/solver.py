@@ -12,6 +12,8 @@ A Python exception raised inside a callback makes the step fail cleanly (the sol
 its last accepted state) and is re-raised, with its traceback, from the call that stepped.
 """
 import ctypes
+import functools
+import threading
 
 import numpy as np
 
@@ -34,6 +36,17 @@ def _cast(fn, ctype):
 
 _PATTERN_MATRICES = {"mass": _ffi.GA_MATRIX_MASS, "jacobian": _ffi.GA_MATRIX_JACOBIAN,
                      "stiffness": _ffi.GA_MATRIX_STIFFNESS, "damping": _ffi.GA_MATRIX_DAMPING}
+
+
+
+def _serialized(method):
+    """Runs a method with the solver's lock held: calls from several threads are serialized
+    (close() no longer frees the C solver under a step running in another thread)."""
+    @functools.wraps(method)
+    def locked(self, *args, **kwargs):
+        with self._lock:
+            return method(self, *args, **kwargs)
+    return locked
 
 
 class Solver:
@@ -78,6 +91,7 @@ class Solver:
                  constant_mass=None, linear_solver=None, rescale=None, corrected_start=None,
                  step_limits=None, initial_step=None, output=None, patterns=None):
         self._ptr = None
+        self._lock = threading.RLock()  # see _serialized
         self._pending = None          # exception raised inside a callback
         self._in_callback = 0         # callbacks of this solver running now
         self._views = {}              # (address, shape, writeable) -> ndarray
@@ -248,12 +262,14 @@ class Solver:
     def _dp(a):
         return a.ctypes.data_as(_ffi.c_double_p)
 
+    @_serialized
     def _get(self, fn, size):
         out = np.empty(max(size, 1))
         self._check(fn(self._handle(), self._dp(out)))
         return out[:size]
 
     # ---- life cycle -------------------------------------------------------------------------
+    @_serialized
     def close(self):
         """Free the C solver (idempotent). Not from one of its own callbacks: ga_free ignores
         that call (the solver is in use), so it raises StateError instead of leaking it."""
@@ -290,16 +306,20 @@ class Solver:
             pass
 
     # ---- options ----------------------------------------------------------------------------
+    @_serialized
     def set_rho_inf(self, rho_inf):
         self._check(_ffi.ga_set_rho_inf(self._handle(), float(rho_inf)))
 
+    @_serialized
     def set_params(self, alpha_m, alpha_f, beta, gamma):
         self._check(_ffi.ga_set_params(self._handle(), alpha_m, alpha_f, beta, gamma))
 
+    @_serialized
     def set_newton(self, tol, max_iter=20):
         self._check(_ffi.ga_set_newton(self._handle(), float(tol), int(max_iter)))
 
     @property
+    @_serialized
     def params(self):
         """(alpha_m, alpha_f, beta, gamma)"""
         vals = [ctypes.c_double() for _ in range(4)]
@@ -307,6 +327,7 @@ class Solver:
         return tuple(x.value for x in vals)
 
     # ---- stepping ---------------------------------------------------------------------------
+    @_serialized
     def init(self, t0, q0, v0):
         """Consistent initial values at t0 (see ga_init)."""
         q0 = np.ascontiguousarray(q0, dtype=float)
@@ -315,18 +336,22 @@ class Solver:
             raise error_for(_ffi.GA_ERR_ARG, "q0 and v0 must have shape (%d,)" % self.n)
         self._check(_ffi.ga_init(self._handle(), float(t0), self._dp(q0), self._dp(v0)))
 
+    @_serialized
     def step(self, h):
         """One step of size h. On failure raises; the state stays at the last accepted step."""
         self._check(_ffi.ga_step(self._handle(), float(h)))
 
+    @_serialized
     def step_adaptive(self, t_stop):
         """One error-controlled step, not beyond t_stop (see ga_step_adaptive)."""
         self._check(_ffi.ga_step_adaptive(self._handle(), float(t_stop)))
 
+    @_serialized
     def advance(self, t_out):
         """Error-controlled steps until t_out exactly (see ga_advance)."""
         self._check(_ffi.ga_advance(self._handle(), float(t_out)))
 
+    @_serialized
     def interpolate(self, t):
         """(q, v, lam) at t inside the last step (dense output, see ga_interpolate)."""
         q, v, lam = np.empty(self.n), np.empty(self.n), np.empty(max(self.m, 1))
@@ -334,6 +359,7 @@ class Solver:
                                         self._dp(lam)))
         return q, v, lam[:self.m]
 
+    @_serialized
     def interpolate_qdd(self, t):
         """qdd at t inside the last step (see ga_interpolate_qdd)."""
         qdd = np.empty(self.n)
@@ -341,10 +367,12 @@ class Solver:
         return qdd
 
     @property
+    @_serialized
     def linear_solver_name(self):
         return _ffi.ga_linear_solver_name(self._handle()).decode()
 
     @property
+    @_serialized
     def active_constraints(self):
         """Flags of the constraints in use (True) or dropped as redundant (False)."""
         flags = (ctypes.c_int * max(self.m, 1))()
@@ -353,12 +381,14 @@ class Solver:
 
     # ---- state ------------------------------------------------------------------------------
     @property
+    @_serialized
     def t(self):
         x = ctypes.c_double()
         self._check(_ffi.ga_get_t(self._handle(), ctypes.byref(x)))
         return x.value
 
     @property
+    @_serialized
     def h_last(self):
         x = ctypes.c_double()
         self._check(_ffi.ga_get_h_last(self._handle(), ctypes.byref(x)))
@@ -371,6 +401,7 @@ class Solver:
     a = property(lambda self: self._get(_ffi.ga_get_a, self.n), doc="auxiliary vector a (copy)")
 
     @property
+    @_serialized
     def stats(self):
         """Work counters as a dict (steps, failed_steps, newton_iters, factorizations, ...)."""
         out = {}
@@ -380,15 +411,18 @@ class Solver:
             out[name] = x.value
         return out
 
+    @_serialized
     def reset_counters(self):
         """Set every work counter of `stats` to zero."""
         self._check(_ffi.ga_reset_counters(self._handle()))
 
+    @_serialized
     def info(self, key):
         x = ctypes.c_double()
         self._check(_ffi.ga_get_info(self._handle(), int(key), ctypes.byref(x)))
         return x.value
 
+    @_serialized
     def get_state(self):
         """Checkpoint: the full state as a flat float array (see ga_get_state)."""
         size = ctypes.c_size_t()
@@ -397,6 +431,7 @@ class Solver:
         self._check(_ffi.ga_get_state(self._handle(), self._dp(out), size.value))
         return out
 
+    @_serialized
     def set_state(self, state):
         state = np.ascontiguousarray(state, dtype=float)
         self._check(_ffi.ga_set_state(self._handle(), self._dp(state), state.size))
