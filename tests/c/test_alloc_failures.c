@@ -226,7 +226,7 @@ static void sweep(call c)
            "printed\n", kNames[c], k - 1, failed, (long)printed);
     assert_int_equal(printed, 0);
 #else
-    (void)c;
+    (void)c, (void)prepare, (void)do_call, (void)kNames, (void)steps;
     printf("  allocation failures cannot be injected under the sanitizers: skipped\n");
 #endif
 }
