@@ -646,19 +646,32 @@ def test_ctrl_c_stops_a_run_every_time():
     import random
     import signal
     import threading
+    import time
     rng = random.Random(7)
     stopped = 0
     for trial in range(30):
-        with pendulum(tolerances=(1e-6, 1e-6)) as s:
+        running = threading.Event()
+
+        def force_running(t, q, v, f):
+            running.set()
+            force(t, q, v, f)
+
+        def interrupt(delay=rng.uniform(0.0, 0.02)):
+            running.wait()  # the run is inside C: the interrupt lands in it
+            time.sleep(delay)
+            os.kill(os.getpid(), signal.SIGINT)
+
+        with galpha.Solver(2, 1, mass, force_running, constraint, jacobian,
+                           tolerances=(1e-8, 1e-8)) as s:
             s.init(0.0, Q0, V0)
-            timer = threading.Timer(rng.uniform(0.002, 0.03),
-                                    lambda: os.kill(os.getpid(), signal.SIGINT))
-            timer.start()
+            running.clear()
+            killer = threading.Thread(target=interrupt)
+            killer.start()
             try:
-                s.advance(50.0)  # about a second: far longer than the timer
+                s.advance(200.0)  # seconds of work: far longer than the delay
             except KeyboardInterrupt:
                 stopped += 1
-            timer.join()
+            killer.join()
             t = s.t
             s.step(1e-4)          # consistent: it steps on from the last accepted state
             assert s.t == pytest.approx(t + 1e-4)
