@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The README's test command: installs what is missing (as root), then builds galpha twice --
 # release with warnings as errors, and AddressSanitizer + UndefinedBehaviorSanitizer -- and
-# runs the whole ctest suite (C, Python, Fortran, install/consumers, ABI) in both; then the C
-# suites once more under valgrind's memcheck, and the threads suite under helgrind.
+# runs the whole ctest suite (C, Python, Fortran, install/consumers, exports) in both, checks
+# the ABI against its baseline (scripts/abi.sh), then runs the C suites once more under
+# valgrind's memcheck, and the threads suite under helgrind.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/deps.sh
@@ -19,6 +20,10 @@ run_suite() {
 }
 run_suite build -DCMAKE_BUILD_TYPE=Release
 run_suite build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGALPHA_SANITIZE=ON
+# The ABI against its baseline (abi/libgalpha.abi): an incompatible change fails; the
+# sanitizer build carries the debug information libabigail reads.
+echo "=== ABI"
+bash scripts/abi.sh check build-sanitize/libgalpha.so
 # Valgrind's memcheck on the release build's C suites: reads of uninitialized memory, which the
 # sanitizers do not see. (test_alloc and test_alloc_failures replace malloc themselves, so
 # memcheck cannot watch them; the accuracy sweeps, test_newton_sweep and test_tolerance, and

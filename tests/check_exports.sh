@@ -4,7 +4,13 @@
 set -eu
 lib=$1
 header=$2
-exported=$(nm -D --defined-only "$lib" | awk '{print $3}' | sort)
+# every function in the version node GALPHA_0 (the node itself is an absolute symbol)
+unversioned=$(nm -D --defined-only "$lib" | awk '$2 != "A" && $3 !~ /@@GALPHA_0$/ {print $3}')
+if [ -n "$unversioned" ]; then
+    echo "symbols exported outside the version node GALPHA_0:"; echo "$unversioned"; exit 1
+fi
+exported=$(nm -D --defined-only "$lib" | awk '$2 != "A" {sub(/@@GALPHA_0$/, "", $3); print $3}' |
+           sort)
 declared=$(sed -n 's/^GA_API[^(]*[ *]\(ga_[a-z_0-9]*\)(.*/\1/p' "$header" | sort -u)
 status=0
 foreign=$(printf '%s\n' "$exported" | grep -v '^ga_' || true)
