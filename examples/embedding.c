@@ -10,6 +10,9 @@
  * (x_load - x_trolley)^2 + y_load^2 - L^2 = 0. */
 #include <galpha.h>
 #include <math.h>
+#ifndef M_PI /* not in strict C99 */
+#define M_PI 3.14159265358979323846
+#endif
 #include <stdio.h>
 
 /* ======================= the host's own code (no galpha inside) ========================= */

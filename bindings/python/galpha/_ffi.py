@@ -19,34 +19,42 @@ ABI_MAJOR = 0
 
 
 def _candidates():
+    """(where, path) to try; path None: that place has nothing (said in the error)."""
     env = os.environ.get("GALPHA_LIBRARY")
     if env:
         yield "environment variable GALPHA_LIBRARY", env
         return
+    yield "environment variable GALPHA_LIBRARY", None
     here = os.path.dirname(os.path.abspath(__file__))
     try:  # written by `cmake --install` next to this file: where the library went
         from ._install import LIBDIR_FROM_PACKAGE
         yield "install tree", os.path.normpath(os.path.join(
             here, LIBDIR_FROM_PACKAGE, "libgalpha.so.%d" % ABI_MAJOR))
     except ImportError:
-        pass
+        yield "install tree (a package installed by cmake --install)", None
     try:
         libdir = subprocess.run(["pkg-config", "--variable=libdir", "galpha"], check=True,
                                 capture_output=True, text=True).stdout.strip()
         if libdir:
             yield "pkg-config libdir", os.path.join(libdir, "libgalpha.so.%d" % ABI_MAJOR)
     except (OSError, subprocess.CalledProcessError):
-        pass
+        yield "pkg-config galpha (is PKG_CONFIG_PATH set for the install prefix?)", None
     found = ctypes.util.find_library("galpha")
     if found:
         yield "ctypes.util.find_library", found
+    else:
+        yield "ctypes.util.find_library('galpha') (the linker's paths; run ldconfig after " \
+              "installing to /usr/local)", None
     root = os.path.normpath(os.path.join(here, "..", "..", ".."))
     builds = sorted(glob.glob(os.path.join(root, "build*", "libgalpha.so.%d" % ABI_MAJOR)),
                     key=lambda p: (os.path.basename(os.path.dirname(p)) != "build", p))
     asan_loaded = "libasan" in os.environ.get("LD_PRELOAD", "")
+    if not builds:
+        yield "build trees next to this source tree (%s/build*)" % root, None
     for path in builds:
         # a sanitizer build aborts a process that did not preload its runtime: skip it
         if not asan_loaded and _needs_asan(path):
+            yield "build tree %s (a sanitizer build: skipped)" % path, None
             continue
         yield "build tree", path
 
@@ -62,11 +70,14 @@ def _needs_asan(path):
 def load():
     tried = []
     for where, path in _candidates():
+        if path is None:
+            tried.append("%s: nothing" % where)
+            continue
         try:
             return ctypes.CDLL(path), path
         except OSError as e:
             tried.append("%s: %s (%s)" % (where, path, e))
-    raise OSError("libgalpha not found; looked at:\n  " + "\n  ".join(tried or ["nothing"]) +
+    raise OSError("libgalpha not found; looked at:\n  " + "\n  ".join(tried) +
                   "\nSet GALPHA_LIBRARY to the full path of libgalpha.so.%d." % ABI_MAJOR)
 
 
