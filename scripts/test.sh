@@ -26,12 +26,13 @@ echo "=== ABI"
 bash scripts/abi.sh check build-sanitize/libgalpha.so
 # Valgrind's memcheck on the release build's C suites: reads of uninitialized memory, which the
 # sanitizers do not see. (test_alloc and test_alloc_failures replace malloc themselves, so
-# memcheck cannot watch them; the accuracy sweeps, test_newton_sweep and test_tolerance, and
-# test_setup_scaling's 100 000 pendulums run the same code as the other suites for minutes,
-# which memcheck would stretch to most of an hour.)
+# memcheck cannot watch them; the accuracy sweeps, test_newton_sweep, test_tolerance and
+# test_output_sweep, and test_setup_scaling's 100 000 pendulums run the same code as the other
+# suites for minutes, which memcheck would stretch to most of an hour.)
 echo "=== memcheck: C suites of the release build under valgrind"
 find build/tests/c -maxdepth 1 -type f -name 'test_*' -perm -u+x ! -name 'test_alloc*' \
-    ! -name test_newton_sweep ! -name test_tolerance ! -name test_setup_scaling -print0 |
+    ! -name test_newton_sweep ! -name test_tolerance ! -name test_setup_scaling \
+    ! -name test_output_sweep -print0 |
     xargs -0 -P "$JOBS" -I{} sh -c \
         'valgrind --error-exitcode=9 --quiet "$1" >"$1.memcheck.log" 2>&1 ||
          { echo "memcheck FAILED: $1"; tail -n 40 "$1.memcheck.log"; exit 255; }' _ {}
