@@ -5,7 +5,7 @@
  *   damping       like Fig. 8: rho_inf = 1 against 0.7 on Andrews, multiplier oscillation
  *   scaling       with and without the scaling (10), h from 1e-3 to 1e-7
  *   work          error against CPU time and residual evaluations (work-precision)
- * References: the published Andrews solution and its recomputation (shared/reference), and the
+ * References: the published Andrews solution and its recomputation (docs/references.md), and the
  * independent index-1 RK4 integrator of examples/scenes for everything else. */
 #include <galpha.h>
 #include <math.h>

@@ -467,7 +467,7 @@ GA_API ga_status ga_get_active_constraints(const ga_solver *s, int *active);
 
 /** Rescale the stored a_n to the size of the coming step, a_n <- qdd_n + (h/h_last)(a_n -
  *  qdd_n), when h changes (1, default), or not (0). Without it the method drops to first order
- *  when h changes often (ALGORITHMS.md sec. 1.1); the switch exists to show that.
+ *  when h changes often (docs/algorithms.md sec. 1.1); the switch exists to show that.
  *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
 GA_API ga_status ga_set_rescale(ga_solver *s, int on);
 
@@ -500,7 +500,7 @@ GA_API ga_status ga_set_initial_step(ga_solver *s, double h0);
  *  that reaches t_stop lands on it exactly. Steps rejected by the error test (counter
  *  GA_COUNT_REJECTED_STEPS) or by a recoverable failure (Newton, callback > 0, NaN, singular
  *  matrix; GA_COUNT_FAILED_STEPS) are retried smaller until one is accepted.
- *  Error estimate (position, ALGORITHMS.md sec. 1.5a): h^2 (beta + delta_alpha/2 - 1/6)
+ *  Error estimate (position, docs/algorithms.md sec. 1.5a): h^2 (beta + delta_alpha/2 - 1/6)
  *  (a_n+1 - a_n); velocity (sec. 1.5b) from the divided differences of a over two steps.
  *  Controller: predictive (Gustafsson, as in Radau5), safety 0.9, growth at most 2 and not on
  *  consecutive steps nor right after a rejection, shrink at least 0.2. First step (unless
@@ -577,7 +577,7 @@ typedef enum ga_output {
                                    the interpolated) t, q, v: as accurate as q and v, free of
                                    the eps |q| / (beta h^2) round-off of index-3 multipliers
                                    (paper, sec. 3.3) and of their transient after each change
-                                   of h in adaptive runs (ALGORITHMS.md sec. 1.4). Costs the
+                                   of h in adaptive runs (docs/algorithms.md sec. 1.4). Costs the
                                    callbacks M, f, Phi_q, the constraint acceleration term and
                                    one factorization of that matrix per accepted step read (the
                                    result is kept until the next step), dense or sparse like

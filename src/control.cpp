@@ -1,5 +1,5 @@
 // Adaptive mode: local error estimate, step-size controller, landing on output times
-// (ALGORITHMS.md sec. 1). Dense output is in output.cpp.
+// (docs/algorithms.md sec. 1). Dense output is in output.cpp.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,7 +10,7 @@ namespace ga {
 
 namespace {
 const double kEps = std::numeric_limits<double>::epsilon();
-// Tolerance calibration (ALGORITHMS.md sec. 9): the local error test is against
+// Tolerance calibration (docs/algorithms.md sec. 9): the local error test is against
 // kCalibration sqrt(rtol) times the weights atol + rtol |y|, i.e. a tolerance ~ tol^(3/2). An
 // order-2 method whose steps keep the local error at tol' ends with a global error
 // ~ tol'^(2/3); controlled so, it ends ~ tol, from 1e-3 to 1e-8 (docs/design-notes.md,
@@ -87,7 +87,7 @@ double Solver::error_norm(double h)
 ga_status Solver::step_adaptive(double t_stop)
 {
     // In index 3 every change of h starts a transient in qdd and lambda whose recursion has
-    // the double root -alpha_f/(1 - alpha_f) (ALGORITHMS.md sec. 1.4, 6.2): -rho_inf, so at
+    // the double root -alpha_f/(1 - alpha_f) (docs/algorithms.md sec. 1.4, 6.2): -rho_inf, so at
     // rho_inf = 1 (alpha_f = 1/2) it never decays. The error estimate, built from differences
     // of a, then asks for ever shorter steps, and every shorter step starts another transient:
     // a double pendulum at rtol 1e-6 took 11 million steps to t = 0.36 before h fell below its

@@ -1,4 +1,4 @@
-// Consistent initial values (ALGORITHMS.md sec. 3): positions and velocities onto the
+// Consistent initial values (docs/algorithms.md sec. 3): positions and velocities onto the
 // constraint manifold by minimum-norm corrections, then qdd0 and lambda0 from the
 // saddle-point system with the acceleration-level constraint, and a0 = qdd0 (eq. 3).
 #include <algorithm>
@@ -119,7 +119,7 @@ ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v,
     return st;
 }
 
-// The saddle-point solve of the consistent start and of consistent output (ALGORITHMS.md
+// The saddle-point solve of the consistent start and of consistent output (docs/algorithms.md
 // sec. 3.3, 10) in the workspace w. The first block row is multiplied by
 // sigma = max|Phi_q| / max|M| (active constraints) so that both blocks have the same size;
 // the unknown in the second block is then sigma lambda.
@@ -212,7 +212,7 @@ void Solver::explain_singular_saddle_point()
         diag.append(" ... (%d in all)", m_ - rank);
 }
 
-// Corrected starting values for the first step of size h (ALGORITHMS.md sec. 3.4-3.5):
+// Corrected starting values for the first step of size h (docs/algorithms.md sec. 3.4-3.5):
 // a_0 = qdd_0 + delta_alpha h qddd_0, with h qddd_0 from a central difference of consistent
 // accelerations at t0 -+ h; in the index-3 formulation also v_0 + dv, the normal-direction
 // velocity offset that lets the first step absorb its own position error

@@ -1,4 +1,4 @@
-// The Newton stopping test of galpha (ALGORITHMS.md sec. 4.6: increments, not residuals).
+// The Newton stopping test of galpha (docs/algorithms.md sec. 4.6: increments, not residuals).
 //
 // After each Newton update, with dq the position increment, dw the increment that moves the
 // accelerations (qdd += beta' dw, v += gamma' dw; dw = dq except in the stabilized index-2

@@ -1,9 +1,9 @@
 // What the solver reports besides its state: accelerations and multipliers consistent with
-// (q, v) (ALGORITHMS.md sec. 10), at the last accepted step or at any t inside it, and dense
+// (q, v) (docs/algorithms.md sec. 10), at the last accepted step or at any t inside it, and dense
 // output of q and v over the last step.
 //
 // Index-3 multipliers and accelerations carry eps |q| / (beta h^2) of round-off (paper, sec.
-// 3.3) and, in adaptive runs, a transient after every change of h (ALGORITHMS.md sec. 1.4).
+// 3.3) and, in adaptive runs, a transient after every change of h (docs/algorithms.md sec. 1.4).
 // Solved from the acceleration-level saddle-point system at the step's (q, v) they are as
 // accurate as q and v. The solve has its own matrix and scratch: reading the output must not
 // change what the next step reuses, so that a run does not depend on what was read.

@@ -1,4 +1,4 @@
-// Which constraints depend on the ones before them (redundant constraints, ALGORITHMS.md
+// Which constraints depend on the ones before them (redundant constraints, docs/algorithms.md
 // sec. 5): the rule behind GA_REDUNDANT_DROP and behind the message of a singular start.
 #pragma once
 

@@ -14,7 +14,7 @@ constexpr double kStateVersion = 2.0;
 constexpr std::size_t kStateHeader = 9;
 
 // Reuse of the iteration matrix after a change of h. Scaled, S_t depends on h only through
-// gamma h C_t and beta h^2 K_t; the band is IDA's for its c_j (ALGORITHMS.md sec. 4.5):
+// gamma h C_t and beta h^2 K_t; the band is IDA's for its c_j (docs/algorithms.md sec. 4.5):
 // refactor when (h_old / h_new)^2 leaves [0.6, 5/3].
 bool h_within_reuse_band(double h_matrix, double h)
 {
@@ -333,7 +333,7 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
         return sliver_step(h);
     const State &s = accepted_;
     // The start of the step. a_n carries the shift delta_alpha h_last; rescaled to the h of
-    // this step the scheme stays second order under any sequence of step sizes (ALGORITHMS.md
+    // this step the scheme stays second order under any sequence of step sizes (docs/algorithms.md
     // sec. 1.2): a_n <- qdd_n + (h / h_last) (a_n - qdd_n).
     a_start_ = &s.a;
     v_start_ = &s.v;
@@ -574,7 +574,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         start = Zero;
     else if (predictor == GA_PREDICTOR_EXTRAPOLATE && delta_alpha != 0.0 && s.h_last > 0.0)
         start = Extrapolate;
-    // a_n - qdd_n = delta_alpha h_last qddd + O(h^2) (ALGORITHMS.md sec. 0), hence
+    // a_n - qdd_n = delta_alpha h_last qddd + O(h^2) (docs/algorithms.md sec. 0), hence
     // qdd(t_n + h) = qdd_n + (h / h_last) (a_n - qdd_n) / delta_alpha + O(h^2).
     const double slope = start == Extrapolate ? h / (s.h_last * delta_alpha) : 0.0;
     bool finite = true;

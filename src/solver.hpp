@@ -190,7 +190,7 @@ private:
     bool previous_valid_ = false;
     bool start_pending_ = false;  // first step after ga_init (or a restart): corrected start
 
-    // The start of the step being computed: a_n rescaled to h (ALGORITHMS.md 1.2) and, in the
+    // The start of the step being computed: a_n rescaled to h (docs/algorithms.md 1.2) and, in the
     // first step, the corrected a_0 and v_0 (sec. 3.4-3.5).
     Vec a_n_, v_n_;
     // The a_n and v_n the step starts from: accepted_'s own, or the adjusted ones above (no

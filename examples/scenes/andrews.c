@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-/* ---- data (shared/reference/andrews.md, Test Set "andrews") ------------------------------ */
+/* ---- data (Test Set "andrews", docs/references.md) -------------------------------------- */
 static const double m1 = 0.04325, m2 = 0.00365, m3 = 0.02373, m4 = 0.00706, m5 = 0.07050,
                     m6 = 0.00706, m7 = 0.05498;
 static const double i1 = 2.194e-6, i2 = 4.410e-7, i3 = 5.255e-6, i4 = 5.667e-7, i5 = 1.169e-5,

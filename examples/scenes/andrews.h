@@ -1,6 +1,6 @@
 /* Andrews' squeezing mechanism (Schiehlen 1990; Hairer & Wanner; the Bari IVP Test Set
  * problem "andrews"): 7 rigid bodies in a plane, one degree of freedom, driven by a constant
- * torque, with one spring. Data from shared/reference/andrews.md (Test Set values).
+ * torque, with one spring. Data: the Test Set (docs/references.md).
  *
  * Two models of the same motion:
  *  - andrews7:  the Test Set's 7 relative angles q = (beta, Theta, gamma, Phi, delta, Omega,
@@ -26,9 +26,9 @@ enum { AN7_N = 7, AN7_M = 6, AN31_N = 31, AN31_M = 30 };
 /* Test Set initial values (t = 0, at rest) of the 7 angles, 30 digits as published. */
 extern const double andrews_q0[7];
 /* Test Set reference solution at t = 0.03 (PSIDE, rtol = atol = 1e-14): angles, good to about
- * 1e-10 relative (andrews.md). */
+ * 1e-10 relative (docs/references.md). */
 extern const double andrews_q_ref[7];
-/* Independent recomputation at t = 0.03 (andrews.md: GBS extrapolation in long double):
+/* Independent recomputation at t = 0.03 (docs/references.md: GBS extrapolation in long double):
  * velocities (~1e-11), accelerations and multipliers (~1e-11 between the two integrators;
  * the published vector is good to ~1e-7 there). */
 extern const double andrews_v_ref[7];

@@ -1,4 +1,4 @@
-// The iteration matrix of the stabilized index-2 formulation (ALGORITHMS.md sec. 2; Arnold &
+// The iteration matrix of the stabilized index-2 formulation (docs/algorithms.md sec. 2; Arnold &
 // Hante 2017), in the scaling of eq. (10) extended to the extra multiplier. Unknowns
 // (d, lambda_bar, eta_bar) = (dq, beta h^2 dlambda, h deta), with B = Phi_q(q_n) and
 // A = cM M + gamma h C:
@@ -10,7 +10,7 @@
 //   = -[ beta h^2 r^q ; Phi ; (beta h / gamma) (Phi_q v + Phi_t) ]
 //
 // plus, unless tangents are neglected, the curvature of the velocity constraint in the third
-// row's first block, (beta h / gamma) Z with Z = d(Phi_q v + Phi_t)/dq (ALGORITHMS.md sec. 2.2;
+// row's first block, (beta h / gamma) Z with Z = d(Phi_q v + Phi_t)/dq (docs/algorithms.md sec. 2.2;
 // gena leaves it out by default, and Newton then contracts only like h |v| / length: on
 // Andrews' mechanism, h = 5e-5, 3.5 instead of 2.5 iterations per step).
 // Dense: (n + 2m)^2, Eigen LU. Sparse (declared patterns, KLU): the same matrix, the products

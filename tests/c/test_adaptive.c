@@ -1,6 +1,6 @@
 /* Accuracy on demand: variable steps (a_n rescaled), the stabilized index-2 formulation,
  * corrected starting values, the local error estimate and controller, ga_advance and dense
- * output. Oracles: the mathematics of ALGORITHMS.md (secs. 1, 2.6, 6.5) and independent RK4
+ * output. Oracles: the mathematics of docs/algorithms.md (secs. 1, 2.6, 6.5) and independent RK4
  * solutions; none of the expected values comes from galpha. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -65,7 +65,7 @@ static ga_solver *pendulum_solver(double rho, int formulation, int rescale, int 
     return s;
 }
 
-/* ---- variable steps: rescaling a_n keeps order 2 (ALGORITHMS.md 1.1-1.2) -------------------- */
+/* ---- variable steps: rescaling a_n keeps order 2 (docs/algorithms.md 1.1-1.2) -------------------- */
 /* A fixed pseudo-random pattern of 20 step ratios in [0.5, 1.5], normalized to sum to 1 and
  * repeated 2^k times at 2^-k of the size: h changes at (almost) every step, at every level. */
 static void run_random_steps(int rescale, int level, double *eq, double *ev, double *el)
@@ -112,7 +112,7 @@ static void rescaling_keeps_order_two_under_random_steps(void **state)
     assert_true(oq > 1.8 && ov > 1.8 && ol > 1.8);
 }
 
-/* The same ODE as ALGORITHMS.md 1.1, theta'' = -9.81 sin(theta) from theta = 1 at rest, steps
+/* The same ODE as docs/algorithms.md 1.1, theta'' = -9.81 sin(theta) from theta = 1 at rest, steps
  * h, 2h, h, 2h, ... to t = 1: without rescaling the order drops towards 1. */
 static int pend_ode_mass(double t, const double *q, double *M, void *u)
 {
@@ -178,7 +178,7 @@ static double max_lambda_error(ga_solver *s, exact_pendulum *e, double h, long s
     return worst;
 }
 
-/* ---- multipliers across a step change (ALGORITHMS.md 1.4) ------------------------------------ */
+/* ---- multipliers across a step change (docs/algorithms.md 1.4) ------------------------------------ */
 static double lambda_error_after_change(int formulation, double h)
 {
     /* h until t = 0.5, then 2h; max |lambda error| over (0.5, 0.6] */
@@ -210,7 +210,7 @@ static void index2_multipliers_stay_second_order_across_step_changes(void **stat
     assert_true(o3 < 1.3);
 }
 
-/* ---- start-up transient (ALGORITHMS.md 2.6) ---------------------------------------------- */
+/* ---- start-up transient (docs/algorithms.md 2.6) ---------------------------------------------- */
 static double startup_lambda_error_rho(double rho, int corrected, double h, double t_end)
 {
     ga_solver *s = pendulum_solver(rho, GA_INDEX3, 1, corrected);
@@ -245,7 +245,7 @@ static void corrected_start_removes_the_first_order_transient(void **state)
 
 /* rho_inf = 1 (no numerical damping, the trapezoidal rule): the start-up oscillation of lambda
  * never decays, and without corrected starting values lambda does not converge at all
- * (ALGORITHMS.md 2.6: error about 9 on [0, 1] for every h); the corrected start restores
+ * (docs/algorithms.md 2.6: error about 9 on [0, 1] for every h); the corrected start restores
  * order 2. */
 static void rho_one_needs_the_corrected_start(void **state)
 {
@@ -267,7 +267,7 @@ static void rho_one_needs_the_corrected_start(void **state)
         assert_true(off[k] > 1.0);
 }
 
-/* ---- the error estimate against the true local error (ALGORITHMS.md 1.5, 6.5) -------------- */
+/* ---- the error estimate against the true local error (docs/algorithms.md 1.5, 6.5) -------------- */
 static int ode_mass(double t, const double *q, double *M, void *u)
 {
     (void)t, (void)q, (void)u;
@@ -282,7 +282,7 @@ static int ode_force(double t, const double *q, const double *v, double *f, void
 }
 
 /* One adaptive step of size h of theta'' = -9.81 sin(theta) from smooth starting values (a_n,
- * a_{n-1} on the shifted acceleration of ALGORITHMS.md sec. 0, constant step h); returns
+ * a_{n-1} on the shifted acceleration of docs/algorithms.md sec. 0, constant step h); returns
  * GA_INFO_ERROR_ESTIMATE and, through *truth, the same weighted norm of the true local errors
  * (numerical minus RK4). Tolerances 1 make the weights 1 + max(|y_n|, |y_n+1|). */
 static double estimate_vs_truth(double h, double *truth)
@@ -992,7 +992,7 @@ static void fast_rotation_needs_damping_or_index2(void **state)
     assert_true(i2_09 < 0.01);
 }
 
-/* ---- rho_inf = 1: no adaptive steps in index 3 (ALGORITHMS.md 1.4, 6.2) ------------------- */
+/* ---- rho_inf = 1: no adaptive steps in index 3 (docs/algorithms.md 1.4, 6.2) ------------------- */
 /* In index 3 a change of h starts a transient of qdd and lambda with the double root -rho_inf:
  * at rho_inf = 1 it never decays and the error estimate shrinks the steps without end (a
  * double pendulum took 11 million steps to t = 0.36 before GA_ERR_STEP_SIZE). The call is

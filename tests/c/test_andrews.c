@@ -1,6 +1,6 @@
 /* Andrews' squeezing mechanism (paper sec. 5.2) in the 7 relative angles of the Test Set and
  * in the paper's 31 absolute coordinates. Oracles: the published Test Set reference at
- * t = 0.03 for the angles, and the independent recomputation of andrews.md for the
+ * t = 0.03 for the angles, and the independent recomputation (docs/references.md) for the
  * multipliers (the 31-coordinate model's multiplier of the pair "E on the triangle" is the
  * same physical force as the Test Set's lambda_1, lambda_2). */
 #include <setjmp.h>

@@ -561,7 +561,7 @@ static void scaling_keeps_the_condition_bounded(void **state)
 
 /* Full Newton (GA_REUSE_NEVER, exact K_t) on a fast pendulum, 0.2 rad per step: the
  * stabilized index-2 iteration converges like the index-3 one only with the curvature of the
- * velocity constraint, Z = d(Phi_q v)/dq, in its matrix (ALGORITHMS.md sec. 2.2); without it
+ * velocity constraint, Z = d(Phi_q v)/dq, in its matrix (docs/algorithms.md sec. 2.2); without it
  * the iteration contracts linearly, at about h |v| / L = 0.2 per iteration. The tolerance,
  * 1e-10, is above the round-off floor of the accelerations (eps |q| / (beta h^2) ~ 1e-11
  * relative): below it the counts would measure the round-off exits, which differ between the

@@ -62,7 +62,7 @@ static fixed_errors fixed_run(const catalog_scene *sc, int formulation, double h
  * moves by 2 700 per second at t = 1 and a phase error shows 50 times larger in it than in
  * the crank angle), while the step's index-3 multipliers lose their accuracy to round-off at
  * small h (eps |q| / (beta h^2)); and they reach 1e-7. References: Andrews' published angles
- * (good to 1e-10) and multipliers of an independent recomputation (andrews.md); RK4 on the
+ * (good to 1e-10) and multipliers of an independent recomputation (docs/references.md); RK4 on the
  * index-1 form for the slider-crank. Where the step cannot be taken or the positions are more
  * than 0.5 % off (h >= 3e-4 on Andrews, where the crank turns too far per step; h = 1e-2 on
  * the slider-crank, where lambda is 120 % off either way) there is no accuracy to follow. */

@@ -38,6 +38,27 @@ static scene make_scene(void)
     return sc;
 }
 
+/* The RK4 reference is only an oracle if its own error is orders below the smallest galpha
+ * error asserted against it below: halving its step must not move it. */
+static void reference_integrator_is_resolved(void **state)
+{
+    (void)state;
+    (void)make_scene();
+    rk4_model md = {SC_N, SC_M, sc_mass, sc_force, sc_jacobian, sc_constraint_accel, &P};
+    double q1[SC_N], v1[SC_N], l1[SC_M], q2[SC_N], v2[SC_N], l2[SC_M];
+    memcpy(q1, Q0, sizeof q1);
+    memcpy(v1, V0, sizeof v1);
+    memcpy(q2, Q0, sizeof q2);
+    memcpy(v2, V0, sizeof v2);
+    assert_int_equal(index1_rk4(&md, 0.0, 1.0, 100000, q1, v1, NULL, l1), 0);
+    assert_int_equal(index1_rk4(&md, 0.0, 1.0, 200000, q2, v2, NULL, l2), 0);
+    const double dth = fabs(q1[SC_TH1] - q2[SC_TH1]) / fabs(q2[SC_TH1]);
+    const double dl = fabs(l1[0] - l2[0]) / fabs(l2[0]);
+    printf("  RK4 100000 vs 200000 steps: theta1 %.2e, lambda1 %.2e\n", dth, dl);
+    assert_true(dth < 1e-10);
+    assert_true(dl < 1e-9);
+}
+
 static void order_two_in_crank_angle_and_multiplier(void **state)
 {
     (void)state;
@@ -108,6 +129,7 @@ static void exact_and_fd_tangents_agree(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(reference_integrator_is_resolved),
         cmocka_unit_test(order_two_in_crank_angle_and_multiplier),
         cmocka_unit_test(energy_balance_at_integration_error_level),
         cmocka_unit_test(exact_and_fd_tangents_agree),

@@ -1,4 +1,4 @@
-"""Stability and accuracy facts of the scheme as oracles (ALGORITHMS.md sec. 6): the
+"""Stability and accuracy facts of the scheme as oracles (docs/algorithms.md sec. 6): the
 amplification matrix of q'' = -omega^2 q, measured by stepping galpha from basis states, has
 the spectral radius, damping ratio and period error tabulated there (computed independently
 with sympy), and rho_inf at infinity."""
@@ -47,7 +47,7 @@ def principal(A, big_omega):
     return np.max(np.abs(lam)), -ln.real / abs(ln.imag), big_omega / abs(ln.imag) - 1.0
 
 
-# rho_inf, Omega, spectral radius, damping ratio, period error (ALGORITHMS.md 6.4)
+# rho_inf, Omega, spectral radius, damping ratio, period error (docs/algorithms.md 6.4)
 TABLE = [
     (0.0, 0.1, 0.99995192, 4.830e-4, 4.501e-3),
     (0.0, 1.0, 0.90656333, 1.224e-1, 2.474e-1),
@@ -77,7 +77,7 @@ def test_spectral_radius_at_infinity_is_rho_inf(rho):
 
 
 def test_small_omega_damping_follows_the_series():
-    """xi = 1/2 ((1 - rho)/(1 + rho))^3 Omega^3 + O(Omega^5) (ALGORITHMS.md 6.3)."""
+    """xi = 1/2 ((1 - rho)/(1 + rho))^3 Omega^3 + O(Omega^5) (docs/algorithms.md 6.3)."""
     for rho in (0.6, 0.8):
         big_omega = 0.05
         _, x, p = principal(amplification(rho, big_omega), big_omega)
