@@ -46,19 +46,42 @@ def prepare_metadata_for_build_wheel(metadata_directory, config_settings=None):
     return DIST_INFO
 
 
+def get_requires_for_build_editable(config_settings=None):
+    return []
+
+
+def prepare_metadata_for_build_editable(metadata_directory, config_settings=None):
+    return prepare_metadata_for_build_wheel(metadata_directory, config_settings)
+
+
 def _record_line(name, data):
     digest = base64.urlsafe_b64encode(hashlib.sha256(data).digest()).rstrip(b"=").decode()
     return "%s,sha256=%s,%d" % (name, digest, len(data))
 
 
-def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
-    filename = "%s-%s-py3-none-any.whl" % (NAME, VERSION)
+def _package_files():
     files = []
     pkg = os.path.join(ROOT, NAME)
     for entry in sorted(os.listdir(pkg)):
         if entry.endswith(".py") and entry != "_install.py":  # _install.py: cmake installs only
             with open(os.path.join(pkg, entry), "rb") as f:
                 files.append(("%s/%s" % (NAME, entry), f.read()))
+    return files
+
+
+def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
+    return _write_wheel(wheel_directory, _package_files())
+
+
+def build_editable(wheel_directory, config_settings=None, metadata_directory=None):
+    # PEP 660: a .pth file puts this source tree on sys.path, so edits take effect at once
+    # and the library is found in the build trees next to it
+    return _write_wheel(wheel_directory, [("%s_editable.pth" % NAME, (ROOT + "\n").encode())])
+
+
+def _write_wheel(wheel_directory, files):
+    filename = "%s-%s-py3-none-any.whl" % (NAME, VERSION)
+    files = list(files)
     files.append(("%s/METADATA" % DIST_INFO, METADATA.encode()))
     files.append(("%s/WHEEL" % DIST_INFO, WHEEL.encode()))
     record = [_record_line(n, d) for n, d in files] + ["%s/RECORD,," % DIST_INFO]
