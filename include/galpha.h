@@ -203,9 +203,13 @@ GA_API ga_status ga_init(ga_solver *s, double t0, const double *q0, const double
  *  velocity constraint and qdd, lambda at its end from the acceleration-level equations (as in
  *  ga_init); a keeps its offset from qdd and ga_get_h_last that of the step before, so that the
  *  next steps go on as if the sliver had not been taken. (ga_step_adaptive does so only for a
- *  step that lands on its t_stop.) A step more than 100 times longer than the one before
- *  starts like a first one (corrected starting values, ga_set_corrected_start), instead of
- *  rescaling a_n by that ratio, which would multiply its round-off.
+ *  step that lands on its t_stop.) Consecutive slivers are Taylor steps while together they
+ *  span at most 1/100 of the step before them; a short step beyond that is the caller's new
+ *  step size and an Algorithm 1 step again, started like a first one from the consistent
+ *  state the slivers left. A step more than 100 times longer than the one before
+ *  starts like a first one, from accelerations and multipliers of the acceleration-level
+ *  equations and corrected starting values (ga_set_corrected_start), instead of rescaling a_n
+ *  by that ratio, which would multiply its round-off.
  *  Errors: GA_ERR_ARG (h <= 0, NaN, Inf, or t + h == t), GA_ERR_STATE (before ga_init, or from a
  *  callback), GA_ERR_CALLBACK, GA_ERR_CALLBACK_RETRY, GA_ERR_NONFINITE, GA_ERR_SINGULAR,
  *  GA_ERR_NEWTON, GA_ERR_INTERNAL. */
@@ -616,8 +620,8 @@ GA_API ga_status ga_get_qdd(const ga_solver *s, double *qdd);
 GA_API ga_status ga_get_lambda(const ga_solver *s, double *lambda);
 /** Copy the auxiliary acceleration-like vector a of eq. (3) (n doubles). */
 GA_API ga_status ga_get_a(const ga_solver *s, double *a);
-/** Size of the last accepted step (0 before the first; a sliver, a step more than 100 times
- *  shorter than the one before it, leaves it: see ga_step). */
+/** Size of the last accepted step of Algorithm 1 (0 before the first; a sliver, a Taylor step
+ *  more than 100 times shorter than the one before it, leaves it: see ga_step). */
 GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
 /**@}*/
 
@@ -625,9 +629,11 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
  *  The full state as a flat array of doubles, so a host simulator can save, restore and
  *  restart: a run restarted from a checkpoint continues bit-identically, in fixed-step and in
  *  adaptive mode (from a checkpoint taken before the first step too: that step still applies
- *  the corrected start). Layout 2: [magic, layout version, n, m, t, h_last, h_next, err_prev,
- *  grew, q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n)] (h_next, err_prev, grew: the step-size
- *  controller; a_prev: the a of the step before, for the error estimate); treat it as opaque.
+ *  the corrected start). Layout 3: [magic, layout version, n, m, t, h_last, h_next, err_prev,
+ *  grew, sliver_span, q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n)] (h_next, err_prev, grew:
+ *  the step-size controller; sliver_span: the time covered by slivers since the last step of
+ *  Algorithm 1, see ga_step; a_prev: the a of the step before, for the error estimate); treat
+ *  it as opaque. ga_set_state also reads layout 2 (galpha 0.2: without sliver_span).
  *  The factorized iteration matrix is not part of it: taking a checkpoint (or restoring one)
  *  makes the next step start with a fresh one, as a restart does; on the sparse path with
  *  pivots chosen afresh too (in the storage the factors already have), since a new solver
@@ -641,7 +647,8 @@ GA_API ga_status ga_state_size(const ga_solver *s, size_t *len);
 GA_API ga_status ga_get_state(const ga_solver *s, double *buf, size_t len);
 /** Errors: GA_ERR_ARG (NULL, wrong length, magic, version or sizes, non-finite values, or
  *  step-size entries galpha never writes: h_last or h_next negative or too small to move t,
- *  err_prev negative, grew other than 0 or 1), GA_ERR_STATE (callbacks not set),
+ *  err_prev negative, grew other than 0 or 1, sliver_span negative or over h_last / 100),
+ *  GA_ERR_STATE (callbacks not set),
  *  GA_ERR_NOMEM. */
 GA_API ga_status ga_set_state(ga_solver *s, const double *buf, size_t len);
 /**@}*/

@@ -68,6 +68,7 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
     State &x = trial_;
     x.t = t0;
     x.h_last = 0.0;
+    x.sliver_span = 0.0;
     x.q = Eigen::Map<const Vec>(q0, n_);
     x.v = Eigen::Map<const Vec>(v0, n_);
     if (!all_finite(x.q) || !all_finite(x.v))
@@ -227,8 +228,8 @@ ga_status Solver::starting_values(double h)
     State &x = trial_;  // scratch: the step has not started
     for (int side = 0; side < 2; ++side) {
         const double sh = side == 0 ? h : -h;
-        x.q = s.q + sh * s.v + (0.5 * sh * sh) * s.qdd;
-        x.v = s.v + sh * s.qdd;
+        x.q = s.q + sh * s.v + (0.5 * sh * sh) * *qdd_start_;
+        x.v = s.v + sh * *qdd_start_;
         Vec &out = side == 0 ? x.a : x.a_prev;
         if (auto st = consistent_accelerations(s.t + sh, x.q, x.v, out, lambda_tmp_)) {
             diag.append(" (corrected starting values for the first step, h = %g)", h);
@@ -236,7 +237,7 @@ ga_status Solver::starting_values(double h)
         }
     }
     qdd_tmp_ = 0.5 * (x.a - x.a_prev);  // h qddd_0
-    a_n_ = s.qdd + delta_alpha * qdd_tmp_;
+    a_n_ = *qdd_start_ + delta_alpha * qdd_tmp_;
     a_start_ = &a_n_;
     if (formulation == GA_INDEX3 && m_ > 0) {
         // [M Phi_q^T; Phi_q 0] [dv; dlambda] = [0; Phi_q l_0 / h] at the start

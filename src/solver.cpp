@@ -9,9 +9,11 @@ namespace ga {
 
 namespace {
 constexpr double kStateMagic = 26465.0;  // 0x6761, "ga"
-constexpr double kStateVersion = 2.0;
-// magic, version, n, m, t, h_last, h_next, err_prev, grew
-constexpr std::size_t kStateHeader = 9;
+constexpr double kStateVersion = 3.0;
+// magic, version, n, m, t, h_last, h_next, err_prev, grew, sliver_span (layout 2: without the
+// last, which it reads as 0: a checkpoint taken after Algorithm 1 steps)
+constexpr std::size_t kStateHeader = 10;
+constexpr std::size_t kStateHeader2 = 9;
 
 // Reuse of the iteration matrix after a change of h. Scaled, S_t depends on h only through
 // gamma h C_t and beta h^2 K_t; the band is IDA's for its c_j (docs/algorithms.md sec. 4.5):
@@ -106,6 +108,7 @@ void State::swap(State &other)
 {
     std::swap(t, other.t);
     std::swap(h_last, other.h_last);
+    std::swap(sliver_span, other.sliver_span);
     q.swap(other.q);
     v.swap(other.v);
     qdd.swap(other.qdd);
@@ -122,6 +125,8 @@ Solver::Solver(int n, int m)
     previous_.allocate(n, m);
     a_n_.setZero(n);
     v_n_.setZero(n);
+    qdd_n_.setZero(n);
+    lambda_n_.setZero(m);
     M_.set_dense(n, n);
     J_.set_dense(m, n);
     K_.set_dense(n, n);
@@ -329,24 +334,39 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
         O_.forget_pivots();
         pivots_forgotten_ = false;
     }
-    if (sliver_allowed && accepted_.h_last > 0.0 && h < accepted_.h_last / kShortStepRatio)
-        return sliver_step(h);
     const State &s = accepted_;
+    const double short_limit = s.h_last / kShortStepRatio;
+    const bool short_step = s.h_last > 0.0 && h < short_limit;
+    if (sliver_allowed && short_step && s.sliver_span + h <= short_limit)
+        return sliver_step(h);
+    // Short steps beyond a sliver's span are the caller's new step size: Algorithm 1 again,
+    // started afresh from the consistent state the slivers left (Taylor steps do not last).
+    const bool restart_short = short_step && s.sliver_span > 0.0;
     // The start of the step. a_n carries the shift delta_alpha h_last; rescaled to the h of
     // this step the scheme stays second order under any sequence of step sizes (docs/algorithms.md
     // sec. 1.2): a_n <- qdd_n + (h / h_last) (a_n - qdd_n).
     a_start_ = &s.a;
     v_start_ = &s.v;
-    if (rescale_a && s.h_last > 0.0 && h != s.h_last) {
-        a_n_ = s.qdd + (h / s.h_last) * (s.a - s.qdd);
-        a_start_ = &a_n_;
-    }
+    qdd_start_ = &s.qdd;
+    lambda_start_ = &s.lambda;
     const bool long_after_short = s.h_last > 0.0 && h > kShortStepRatio * s.h_last;
-    if ((start_pending_ || long_after_short) && corrected_start) {
+    fresh_start_ = start_pending_ || long_after_short || restart_short;
+    if (long_after_short) {
+        if (auto st = consistent_accelerations(s.t, s.q, s.v, qdd_n_, lambda_n_)) {
+            diag.append(" (start of a step %g times longer than the one before)", h / s.h_last);
+            return st;
+        }
+        qdd_start_ = &qdd_n_;
+        lambda_start_ = &lambda_n_;
+    }
+    if (fresh_start_ && corrected_start) {
         if (auto st = starting_values(h))  // sets a_start_ and, in index 3, v_start_
             return st;
-    } else if (long_after_short) {
-        a_start_ = &s.qdd;
+    } else if (fresh_start_) {
+        a_start_ = qdd_start_;
+    } else if (rescale_a && s.h_last > 0.0 && h != s.h_last) {
+        a_n_ = s.qdd + (h / s.h_last) * (s.a - s.qdd);
+        a_start_ = &a_n_;
     }
 
     // After a reused matrix was too slow, the next steps start with a fresh one; how many
@@ -428,14 +448,15 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     const Params &p = params;
     // Algorithm 1, last line: a_{n+1} from eq. (3) with the converged qdd_{n+1}; a_n kept for
     // the error estimate of the next step (one pass for both)
-    const Vec &a_n = *a_start_;
+    const Vec &a_n = *a_start_, &qdd_n = *qdd_start_;
     for (Eigen::Index i = 0; i < n_; ++i) {
-        x.a[i] = (p.alpha_f * s.qdd[i] - p.alpha_m * a_n[i] + (1.0 - p.alpha_f) * x.qdd[i]) /
+        x.a[i] = (p.alpha_f * qdd_n[i] - p.alpha_m * a_n[i] + (1.0 - p.alpha_f) * x.qdd[i]) /
                  (1.0 - p.alpha_m);
         x.a_prev[i] = a_n[i];
     }
     x.t = s.t + h;
     x.h_last = h;
+    x.sliver_span = 0.0;
     if (convergence_.rate() >= 0.0)
         theta_prev_ = convergence_.rate();
     return GA_OK;
@@ -485,6 +506,7 @@ ga_status Solver::sliver_step(double h)
     x.a = s.a + qdd_tmp_;
     x.a_prev = s.a_prev + qdd_tmp_;
     x.h_last = s.h_last;
+    x.sliver_span = s.sliver_span + h;
     a_start_ = &x.a;  // for the error estimate of adaptive steps: none from this step
     last_newton_iters_ = 0;
     return GA_OK;
@@ -572,7 +594,8 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
     enum { Zero, Extrapolate, ConstantA } start = ConstantA;
     if (predictor == GA_PREDICTOR_ZERO)
         start = Zero;
-    else if (predictor == GA_PREDICTOR_EXTRAPOLATE && delta_alpha != 0.0 && s.h_last > 0.0)
+    else if (predictor == GA_PREDICTOR_EXTRAPOLATE && delta_alpha != 0.0 && s.h_last > 0.0 &&
+             !fresh_start_)  // a_n - qdd_n of the steps before says nothing about this one
         start = Extrapolate;
     // a_n - qdd_n = delta_alpha h_last qddd + O(h^2) (docs/algorithms.md sec. 0), hence
     // qdd(t_n + h) = qdd_n + (h / h_last) (a_n - qdd_n) / delta_alpha + O(h^2).
@@ -580,7 +603,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
     bool finite = true;
     for (Eigen::Index i = 0; i < n_; i += kBlock) {  // blocks in L1: one trip to memory
         const Eigen::Index len = std::min(kBlock, n_ - i);
-        const auto qdd_n = s.qdd.segment(i, len), an = a_n.segment(i, len);
+        const auto qdd_n = qdd_start_->segment(i, len), an = a_n.segment(i, len);
         auto qdd = x.qdd.segment(i, len), a = x.a.segment(i, len), q = x.q.segment(i, len),
              v = x.v.segment(i, len);
         if (start == Zero)
@@ -599,7 +622,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
     if (start == Zero)
         x.lambda.setZero();
     else
-        x.lambda = s.lambda;  // finite, as every accepted state
+        x.lambda = *lambda_start_;  // finite, as every accepted state
     // The iteration starts from a finite iterate (the updates keep it so or report it): a
     // predictor can overflow where the accepted state is huge or h is.
     if (!finite)
@@ -770,6 +793,7 @@ void Solver::get_state(double *buf) const
     buf[6] = control.h_next;
     buf[7] = control.err_prev;
     buf[8] = control.grew ? 1.0 : 0.0;
+    buf[9] = s.sliver_span;
     double *p = buf + kStateHeader;
     for (const Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev}) {
         Eigen::Map<Vec>(p, x->size()) = *x;
@@ -781,10 +805,13 @@ void Solver::get_state(double *buf) const
 
 ga_status Solver::set_state(const double *buf, std::size_t len)
 {
-    if (len != state_size())
+    // Layout 2 (galpha 0.2) is read too.
+    const bool layout2 = len >= 2 && buf[0] == kStateMagic && buf[1] == 2.0;
+    const std::size_t header = layout2 ? kStateHeader2 : kStateHeader;
+    if (len != state_size() - kStateHeader + header)
         return diag.fail(GA_ERR_ARG, "checkpoint has %zu doubles, this solver needs %zu", len,
-                         state_size());
-    if (buf[0] != kStateMagic || buf[1] != kStateVersion)
+                         state_size() - kStateHeader + header);
+    if (buf[0] != kStateMagic || (buf[1] != kStateVersion && !layout2))
         return diag.fail(GA_ERR_ARG, "not a galpha checkpoint (magic %g, layout version %g)",
                          buf[0], buf[1]);
     if (buf[2] != n_ || buf[3] != m_)
@@ -808,12 +835,16 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
     if (buf[7] < 0.0 || (buf[8] != 0.0 && buf[8] != 1.0))
         return diag.fail(GA_ERR_ARG, "checkpoint entries 7-8 (err_prev = %g, grew = %g) are "
                          "not those of galpha's step-size control", buf[7], buf[8]);
+    const double sliver_span = layout2 ? 0.0 : buf[9];
+    if (sliver_span < 0.0 || sliver_span > buf[5] / kShortStepRatio)
+        return diag.fail(GA_ERR_ARG, "checkpoint entry 9 (sliver_span = %g) is not a span of "
+                         "short steps after steps of h_last = %g", sliver_span, buf[5]);
     if (!model.ready())
         return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
     if (auto st = setup())
         return st;
     if (redundancy == GA_REDUNDANT_DROP && m_ > 0) {
-        const Vec q = Eigen::Map<const Vec>(buf + kStateHeader, n_);
+        const Vec q = Eigen::Map<const Vec>(buf + header, n_);
         const std::vector<unsigned char> active_before = active_;
         if (auto st = select_active_constraints(buf[4], q)) {
             restore_active(active_before);
@@ -823,10 +854,11 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
     State &s = accepted_;
     s.t = buf[4];
     s.h_last = buf[5];
+    s.sliver_span = sliver_span;
     control.h_next = buf[6];
     control.err_prev = buf[7];
     control.grew = buf[8] != 0.0;
-    const double *p = buf + kStateHeader;
+    const double *p = buf + header;
     for (Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev}) {
         *x = Eigen::Map<const Vec>(p, x->size());
         p += x->size();

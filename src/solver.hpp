@@ -17,6 +17,9 @@ namespace ga {
 struct State {
     double t = 0.0;
     double h_last = 0.0;  // size of the step that produced this state (0 at the start)
+    // Time covered by Taylor steps (sliver_step) since the last step of Algorithm 1: once it
+    // passes h_last / kShortStepRatio, short steps are Algorithm 1 steps again.
+    double sliver_span = 0.0;
     Vec q, v, qdd, lambda, a;
     Vec a_prev;           // a of the state before (variable-step error estimate)
 
@@ -134,8 +137,8 @@ public:
     int last_newton_iters() const { return last_newton_iters_; }
     double last_newton_ratio() const { return convergence_.ratio(); }
 
-    // Checkpoint (layout 2): [magic, 2, n, m, t, h_last, h_next, err_prev, grew, q, v, qdd,
-    // lambda, a, a_prev]. Taking one (or restoring one) also drops the reusable iteration
+    // Checkpoint (layout 3): [magic, 3, n, m, t, h_last, h_next, err_prev, grew, sliver_span,
+    // q, v, qdd, lambda, a, a_prev]; layout 2 (without sliver_span) is read too. Taking one (or restoring one) also drops the reusable iteration
     // matrix and, on the sparse path, the pivot order and row scaling KLU keeps from its last
     // full factorization, so that the run continues exactly as a restart from the checkpoint
     // does (neither is part of it): the next step factorizes afresh.
@@ -193,10 +196,16 @@ private:
     // The start of the step being computed: a_n rescaled to h (docs/algorithms.md 1.2) and, in the
     // first step, the corrected a_0 and v_0 (sec. 3.4-3.5).
     Vec a_n_, v_n_;
-    // The a_n and v_n the step starts from: accepted_'s own, or the adjusted ones above (no
-    // copy of a vector the step only reads: at 100 000 chain links each costs 2.4 MB of
+    // A step far longer than the one before starts from consistent accelerations and
+    // multipliers (as at ga_init): those of steps of 1e-8 in index 3 are known only to
+    // eps / (beta h^2), of the order of themselves.
+    Vec qdd_n_, lambda_n_;
+    // The a_n, v_n and qdd_n the step starts from: accepted_'s own, or the adjusted ones above
+    // (no copy of a vector the step only reads: at 100 000 chain links each costs 2.4 MB of
     // memory traffic).
-    const Vec *a_start_ = nullptr, *v_start_ = nullptr;
+    const Vec *a_start_ = nullptr, *v_start_ = nullptr, *qdd_start_ = nullptr,
+              *lambda_start_ = nullptr;
+    bool fresh_start_ = false;  // this step starts like a first one
 
     // Reuse of the factorized iteration matrix across iterations and steps.
     mutable bool jacobian_valid_ = false;

@@ -301,7 +301,7 @@ static double estimate_vs_truth(double h, double *truth)
     const double a4 = g * sin(th) * om * om - g * cos(th) * a2;
     const double a5 = g * cos(th) * om * om * om + 3 * g * sin(th) * om * a2 - g * cos(th) * a3;
     /* a(t) = qdd(t + da h) + da (am - 1/2) h^2 qdddd(t + ...): shifted accelerations */
-    double buf[9 + 5 * 1 + 0];
+    double buf[9 + 5 * 1 + 0]; /* layout 2 (galpha 0.2), still read */
     buf[0] = 26465.0, buf[1] = 2.0, buf[2] = 1.0, buf[3] = 0.0;
     buf[4] = 0.0, buf[5] = h, buf[6] = h, buf[7] = 1.0, buf[8] = 0.0;
     buf[9] = th, buf[10] = om, buf[11] = a2;
@@ -382,10 +382,10 @@ static void interpolation_agrees_with_a_step_ending_there(void **state)
     (void)state;
     ga_solver *s = pendulum_solver(0.9, GA_INDEX2_STABILIZED, 1, 1);
     assert_int_equal(ga_set_tolerances(s, 1e-5, 1e-5), GA_OK);
-    double ckpt[9 + 5 * 2 + 1], t0, t1;
+    double ckpt[10 + 5 * 2 + 1], t0, t1;
     for (int k = 0; k < 25; ++k)
         assert_int_equal(ga_step_adaptive(s, 10.0), GA_OK);
-    assert_int_equal(ga_get_state(s, ckpt, 20), GA_OK);
+    assert_int_equal(ga_get_state(s, ckpt, 21), GA_OK);
     ga_get_t(s, &t0);
     assert_int_equal(ga_step_adaptive(s, 10.0), GA_OK);
     ga_get_t(s, &t1);
@@ -400,7 +400,7 @@ static void interpolation_agrees_with_a_step_ending_there(void **state)
     assert_int_equal(ga_interpolate(s, tau, q, v, &lam), GA_OK);
     ga_get_info(s, GA_INFO_ERROR_ESTIMATE, &est);
     ga_solver *r = pendulum_solver(0.9, GA_INDEX2_STABILIZED, 1, 1);
-    assert_int_equal(ga_set_state(r, ckpt, 20), GA_OK);
+    assert_int_equal(ga_set_state(r, ckpt, 21), GA_OK);
     assert_int_equal(ga_step(r, tau - t0), GA_OK);
     double qr[2], vr[2];
     ga_get_q(r, qr);
@@ -603,14 +603,14 @@ static void step_size_floor_is_reported(void **state)
 {
     (void)state;
     ga_solver *s = pendulum_solver(0.9, GA_INDEX3, 1, 1);
-    double before[20], after[20];
+    double before[21], after[21];
     assert_int_equal(ga_set_tolerances(s, 1e-12, 1e-12), GA_OK);
     assert_int_equal(ga_set_step_limits(s, 0.05, 0.0), GA_OK);
     assert_int_equal(ga_set_initial_step(s, 0.05), GA_OK);
-    assert_int_equal(ga_get_state(s, before, 20), GA_OK);
+    assert_int_equal(ga_get_state(s, before, 21), GA_OK);
     assert_int_equal(ga_advance(s, 1.0), GA_ERR_STEP_SIZE);
     assert_non_null(strstr(ga_last_error(s), "fell below the minimum"));
-    assert_int_equal(ga_get_state(s, after, 20), GA_OK);
+    assert_int_equal(ga_get_state(s, after, 21), GA_OK);
     assert_memory_equal(before, after, sizeof before);
     assert_int_equal(ga_set_step_limits(s, 0.2, 0.1), GA_ERR_ARG);
     assert_int_equal(ga_set_tolerances(s, 0.0, 1e-6), GA_ERR_ARG);
@@ -709,7 +709,7 @@ static void adaptive_fatal_failure_keeps_the_last_accepted_step(void **state)
     (void)state;
     guarded_pendulum g = {P, {0, 0}, INFINITY, 0.5, 0};
     ga_solver *s = guarded_solver(&g, 1e-6);
-    double t, t_before, h_last, before[20], after[20];
+    double t, t_before, h_last, before[21], after[21];
     assert_int_equal(ga_advance(s, 1.0), GA_ERR_CALLBACK);
     assert_non_null(strstr(ga_last_error(s), "force callback returned -2"));
     ga_get_t(s, &t);
@@ -718,10 +718,10 @@ static void adaptive_fatal_failure_keeps_the_last_accepted_step(void **state)
     long long failed;
     ga_get_counter(s, GA_COUNT_FAILED_STEPS, &failed);
     assert_int_equal(failed, 1);
-    assert_int_equal(ga_get_state(s, before, 20), GA_OK);
+    assert_int_equal(ga_get_state(s, before, 21), GA_OK);
     t_before = t;
     assert_int_equal(ga_step_adaptive(s, 1.0), GA_ERR_CALLBACK); /* the same again */
-    assert_int_equal(ga_get_state(s, after, 20), GA_OK);
+    assert_int_equal(ga_get_state(s, after, 21), GA_OK);
     assert_memory_equal(before, after, sizeof before);
     g.t_fatal = INFINITY;
     assert_int_equal(ga_advance(s, 1.0), GA_OK);
@@ -892,6 +892,59 @@ static void sliver_steps_do_not_derail_the_run(void **state)
     }
 }
 
+/* A caller who lowers h for good (here 200 times: steps of 1e-2, then of 5e-5) gets steps of
+ * Algorithm 1: only the first short steps, up to 1/100 of the long one, are Taylor steps.
+ * All of them were, because a sliver leaves h_last: 10 000 steps without a Newton iteration,
+ * with the constraint drifting. */
+static void lowering_h_for_good_gives_algorithm_1_steps(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+        double q[2], v[2], t, h_last, phi;
+        long long iters0, iters1;
+        ga_solver *s = pendulum_new_solver(&p, 1);
+        assert_non_null(s);
+        assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+        pendulum_state(&p, 1.0, 0.5, q, v);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        for (int k = 0; k < 50; ++k)
+            assert_int_equal(ga_step(s, 1e-2), GA_OK);
+        ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &iters0);
+        /* what the short steps should do: those of a solver started (ga_init) there */
+        double t_half, q_fresh[2];
+        ga_solver *fresh = pendulum_new_solver(&p, 1);
+        assert_non_null(fresh);
+        assert_int_equal(ga_set_formulation(fresh, formulation), GA_OK);
+        ga_get_t(s, &t_half);
+        ga_get_q(s, q);
+        ga_get_v(s, v);
+        assert_int_equal(ga_init(fresh, t_half, q, v), GA_OK);
+        for (int k = 0; k < 10000; ++k) {
+            assert_int_equal(ga_step(s, 5e-5), GA_OK);
+            assert_int_equal(ga_step(fresh, 5e-5), GA_OK);
+        }
+        ga_get_q(fresh, q_fresh);
+        ga_free(fresh);
+        ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &iters1);
+        ga_get_t(s, &t);
+        ga_get_q(s, q);
+        ga_get_h_last(s, &h_last);
+        pendulum_constraint(t, q, &phi, &p);
+        const pendulum_exact r = pendulum_reference(&p, 1.0, 0.5, t, 200000);
+        const double eq = max_abs_diff(q, r.q, 2), eq_fresh = max_abs_diff(q_fresh, r.q, 2);
+        printf("  %s: %lld Newton iterations in 10 000 short steps, h_last %g, |Phi| %.1e, "
+               "error in q %.3e (a solver started at t = 0.5: %.3e)\n",
+               formulation == GA_INDEX3 ? "index 3" : "index 2", iters1 - iters0, h_last,
+               fabs(phi), eq, eq_fresh);
+        assert_true(iters1 - iters0 >= 10000 - 2); /* two slivers: 1e-4 is 1/100 of 1e-2 */
+        assert_true(h_last == 5e-5);
+        assert_true(fabs(phi) <= 1e-12);
+        assert_true(eq <= 1.01 * eq_fresh);
+        ga_free(s);
+    }
+}
+
 /* The pendulum (exact K_t): `count` steps of h1, then steps of h2 up to about t = 1; the
  * errors in q and lambda at the end against the RK4 reference of helpers.h. */
 static void pendulum_two_step_sizes(int formulation, int count, double h1, double h2,
@@ -922,19 +975,25 @@ static void pendulum_two_step_sizes(int formulation, int count, double h1, doubl
  * starting values from consistent accelerations): rescaling a_n - qdd_n by h / h_last = 1e4
  * multiplied its round-off (in index 3 the multiplier of steps of 1e-6 is known only to
  * eps / (beta h^2) ~ 1e-3), and the index-3 multiplier was still 0.3 off after 99 more steps.
- * Now 1 000 steps of 1e-6 and then steps of 1e-2 end with the errors of steps of 1e-2. */
+ * It starts from consistent accelerations and multipliers too: those of index-3 steps of 1e-10
+ * are known only to eps / (beta h^2), far beyond their own size, and steps of 1e-2 after
+ * 1 000 of them ended 1.1 off in q. Now 1 000 steps of 1e-6, 1e-8 or 1e-10 and then steps of 1e-2 end with
+ * the errors of steps of 1e-2. */
 static void long_step_after_short_ones_starts_afresh(void **state)
 {
     (void)state;
     for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
         double eq_uniform, el_uniform, eq, el;
         pendulum_two_step_sizes(formulation, 0, 1e-2, 1e-2, &eq_uniform, &el_uniform);
-        pendulum_two_step_sizes(formulation, 1000, 1e-6, 1e-2, &eq, &el);
-        printf("  %s: steps of 1e-2: errors %.1e in q, %.1e in lambda; after 1000 of 1e-6: "
-               "%.1e, %.1e\n",
-               formulation == GA_INDEX3 ? "index 3" : "index 2", eq_uniform, el_uniform, eq, el);
-        assert_true(eq <= 2.0 * eq_uniform);
-        assert_true(el <= 2.0 * el_uniform);
+        for (double h_short = 1e-6; h_short > 1e-11; h_short *= 1e-2) {
+            pendulum_two_step_sizes(formulation, 1000, h_short, 1e-2, &eq, &el);
+            printf("  %s: steps of 1e-2: errors %.1e in q, %.1e in lambda; after 1000 of %g: "
+                   "%.1e, %.1e\n",
+                   formulation == GA_INDEX3 ? "index 3" : "index 2", eq_uniform, el_uniform,
+                   h_short, eq, el);
+            assert_true(eq <= 2.0 * eq_uniform);
+            assert_true(el <= 2.0 * el_uniform);
+        }
     }
 }
 
@@ -1025,14 +1084,14 @@ static void rho_one_adaptive_needs_index2_or_no_constraints(void **state)
 {
     (void)state;
     ga_solver *s = pendulum_solver(1.0, GA_INDEX3, 1, 1);
-    double before[20], after[20];
+    double before[21], after[21];
     long long residuals = -1, steps = -1;
     assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
-    assert_int_equal(ga_get_state(s, before, 20), GA_OK);
+    assert_int_equal(ga_get_state(s, before, 21), GA_OK);
     assert_int_equal(ga_step_adaptive(s, 1.0), GA_ERR_ARG);
     assert_non_null(strstr(ga_last_error(s), "need rho_inf < 1"));
     assert_int_equal(ga_advance(s, 1.0), GA_ERR_ARG);
-    assert_int_equal(ga_get_state(s, after, 20), GA_OK);
+    assert_int_equal(ga_get_state(s, after, 21), GA_OK);
     assert_memory_equal(before, after, sizeof before);
     assert_int_equal(ga_get_counter(s, GA_COUNT_RESIDUALS, &residuals), GA_OK);
     assert_int_equal(ga_get_counter(s, GA_COUNT_STEPS, &steps), GA_OK);
@@ -1065,6 +1124,7 @@ int main(void)
         cmocka_unit_test(fast_rotation_needs_damping_or_index2),
         cmocka_unit_test(rho_one_adaptive_needs_index2_or_no_constraints),
         cmocka_unit_test(sliver_steps_do_not_derail_the_run),
+        cmocka_unit_test(lowering_h_for_good_gives_algorithm_1_steps),
         cmocka_unit_test(landing_on_t_stop_keeps_the_planned_step),
         cmocka_unit_test(long_step_after_short_ones_starts_afresh),
         cmocka_unit_test(error_estimate_tends_to_the_true_local_error),

@@ -15,7 +15,7 @@
 #include "helpers.h"
 #include "chain_solver.h"
 
-enum { LEN = 9 + 5 * 2 + 1 };
+enum { LEN = 10 + 5 * 2 + 1 };
 static pendulum P = {1.0, 1.0, 9.81};
 
 static ga_solver *make(void)
@@ -126,7 +126,7 @@ static void sparse_restart(int formulation, int adaptive, int sliver_first)
     advance(s[0], 5);
     size_t len = 0;
     assert_int_equal(ga_state_size(s[0], &len), GA_OK);
-    assert_int_equal(len, 9 + 5 * (size_t)n + 2 * (size_t)c.links);
+    assert_int_equal(len, 10 + 5 * (size_t)n + 2 * (size_t)c.links);
     double *ckpt = malloc(3 * len * sizeof(double)), *a = ckpt + len, *b = a + len;
     assert_non_null(ckpt);
     assert_int_equal(ga_get_state(s[0], ckpt, len), GA_OK);
@@ -180,12 +180,52 @@ static void checkpoint_without_a_would_not_restart_exactly(void **state)
     assert_int_equal(ga_get_state(s, ckpt, LEN), GA_OK);
     steps(s, 10);
     assert_int_equal(ga_get_state(s, a, LEN), GA_OK);
-    memcpy(ckpt + 9 + 3 * 2 + 1, ckpt + 9 + 2 * 2, 2 * sizeof(double)); /* a := qdd */
+    memcpy(ckpt + 10 + 3 * 2 + 1, ckpt + 10 + 2 * 2, 2 * sizeof(double)); /* a := qdd */
     assert_int_equal(ga_set_state(s, ckpt, LEN), GA_OK);
     steps(s, 10);
     assert_int_equal(ga_get_state(s, b, LEN), GA_OK);
-    assert_true(max_abs_diff(a + 9, b + 9, 2) > 0.0);
+    assert_true(max_abs_diff(a + 10, b + 10, 2) > 0.0);
     ga_free(s);
+}
+
+/* A checkpoint between slivers (steps over 100 times shorter than the one before) carries how
+ * much time they spanned: restored, the same next short step is a Taylor step or a step of
+ * Algorithm 1 as in the run it came from. Read as layout 2 (that span dropped), the restored
+ * run takes one more Taylor step and parts from the run. */
+static void restart_between_slivers_is_bit_identical(void **state)
+{
+    (void)state;
+    double q[2], v[2], ckpt[LEN], old[LEN - 1], a[LEN], b[LEN];
+    pendulum_state(&P, 1.2, 0.8, q, v);
+    ga_solver *s = make();
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    steps(s, 20);
+    for (int k = 0; k < 10; ++k) /* 10 slivers of 3e-6 span 3e-5, 1/100 of 3e-3 */
+        assert_int_equal(ga_step(s, 3e-6), GA_OK);
+    assert_int_equal(ga_get_state(s, ckpt, LEN), GA_OK);
+    assert_true(ckpt[9] > 2.9e-5);
+    for (int k = 0; k < 100; ++k)
+        assert_int_equal(ga_step(s, 3e-6), GA_OK);
+    assert_int_equal(ga_get_state(s, a, LEN), GA_OK);
+
+    ga_solver *r = make();
+    assert_int_equal(ga_set_state(r, ckpt, LEN), GA_OK);
+    for (int k = 0; k < 100; ++k)
+        assert_int_equal(ga_step(r, 3e-6), GA_OK);
+    assert_int_equal(ga_get_state(r, b, LEN), GA_OK);
+    assert_memory_equal(a, b, sizeof a);
+
+    old[0] = ckpt[0];
+    old[1] = 2.0;
+    memcpy(old + 2, ckpt + 2, 7 * sizeof(double));
+    memcpy(old + 9, ckpt + 10, (LEN - 10) * sizeof(double));
+    assert_int_equal(ga_set_state(r, old, LEN - 1), GA_OK);
+    for (int k = 0; k < 100; ++k)
+        assert_int_equal(ga_step(r, 3e-6), GA_OK);
+    assert_int_equal(ga_get_state(r, b, LEN), GA_OK);
+    assert_true(max_abs_diff(a + 10, b + 10, 2) > 0.0);
+    ga_free(s);
+    ga_free(r);
 }
 
 int main(void)
@@ -195,6 +235,7 @@ int main(void)
         cmocka_unit_test(rewind_same_solver_is_bit_identical),
         cmocka_unit_test(sparse_restart_is_bit_identical),
         cmocka_unit_test(checkpoint_without_a_would_not_restart_exactly),
+        cmocka_unit_test(restart_between_slivers_is_bit_identical),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -505,6 +505,27 @@ static void bad_checkpoints_are_refused(void **state)
         expect_message(x->s, bad_controls[k][0] <= 6 ? "is not a step from"
                                                       : "step-size control");
     }
+    /* the span of slivers (entry 9): at least 0, at most h_last / 100 */
+    const double bad_spans[] = {-1e-9, 1.0};
+    for (size_t k = 0; k < 2; ++k) {
+        memcpy(buf, before, len * sizeof(double));
+        buf[9] = bad_spans[k];
+        assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
+        expect_message(x->s, "sliver_span");
+    }
+    /* layout 2 (galpha 0.2, no sliver_span) is read: the same state as layout 3 with span 0
+     * (before[9] is 0 after Algorithm 1 steps); layout 2's size with layout 3's number not */
+    assert_true(before[9] == 0.0);
+    buf[0] = before[0];
+    buf[1] = 2.0;
+    memcpy(buf + 2, before + 2, 7 * sizeof(double));
+    memcpy(buf + 9, before + 10, (len - 10) * sizeof(double));
+    assert_int_equal(ga_set_state(x->s, buf, len - 1), GA_OK);
+    assert_int_equal(ga_get_state(x->s, after, len), GA_OK);
+    assert_memory_equal(after, before, len * sizeof(double));
+    buf[1] = 3.0;
+    assert_int_equal(ga_set_state(x->s, buf, len - 1), GA_ERR_ARG);
+    expect_message(x->s, "doubles");
     memcpy(buf, before, len * sizeof(double));
     buf[5] = 0.0; /* a checkpoint from before the first step */
     buf[6] = 0.0;
@@ -597,9 +618,8 @@ static void overflow_in_the_residual(void **state)
 /* The Phi_t callback is called in every Newton iteration of a stabilized index-2 step: its
  * failures (fatal, recoverable, NaN, Inf) are reported like any callback's, the state kept. */
 /* Finite callback outputs whose Newton increment overflows (a force of 1e308 against the small
- * beta' M of a step of 10 s): reported as non-finite, with the state kept. (A step 1000 times
- * longer than the one before starts like a first one, whose corrected starting values would
- * meet the force first: they are switched off for this step.) */
+ * beta' M of a step of 10 s): reported as non-finite, with the state kept, wherever the
+ * overflow shows first. */
 static void overflow_in_the_newton_increment(void **state)
 {
     fixture *x = *state;
@@ -608,14 +628,27 @@ static void overflow_in_the_newton_increment(void **state)
     x->model.site = FORCE;
     x->model.rc = 0;
     x->model.value = 1e308;
-    assert_int_equal(ga_set_corrected_start(x->s, 0), GA_OK);
-    assert_int_equal(ga_step(x->s, 10.0), GA_ERR_NONFINITE);
-    expect_message(x->s, "Newton increment is not finite in iteration 1");
-    assert_int_equal(ga_set_corrected_start(x->s, 1), GA_OK);
+    /* a step of 10 after steps of 0.01 starts afresh (over 100 times longer), from the
+     * acceleration-level equations: the overflow shows in the corrected start, or without it
+     * in the predictor */
     assert_int_equal(ga_step(x->s, 10.0), GA_ERR_NONFINITE);
     expect_message(x->s, "corrected starting values");
+    assert_int_equal(ga_set_corrected_start(x->s, 0), GA_OK);
+    assert_int_equal(ga_step(x->s, 10.0), GA_ERR_NONFINITE);
+    expect_message(x->s, "predicted Newton iterate is not finite");
     snapshot(x->s, after);
     assert_memory_equal(before, after, len * sizeof(double));
+    /* after steps of 0.1 it is a step of Algorithm 1, whose first increment overflows */
+    double shifted[STATE_MAX];
+    memcpy(shifted, before, len * sizeof(double));
+    shifted[5] = 0.1; /* h_last */
+    assert_int_equal(ga_set_state(x->s, shifted, len), GA_OK);
+    assert_int_equal(ga_step(x->s, 10.0), GA_ERR_NONFINITE);
+    expect_message(x->s, "Newton increment is not finite in iteration 1");
+    snapshot(x->s, after);
+    assert_memory_equal(shifted, after, len * sizeof(double));
+    assert_int_equal(ga_set_corrected_start(x->s, 1), GA_OK);
+    assert_int_equal(ga_set_state(x->s, before, len), GA_OK);
     x->model.site = NONE;
     continues_undisturbed(x, before, len);
 }
