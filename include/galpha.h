@@ -34,8 +34,8 @@
  * it exists: ga_set_formulation to index 2, tangent options that call for finite differences,
  * the first adaptive step); ga_step never allocates. On the sparse path the storage of the
  * LU factors is reserved with the workspace (ga_init), from the fill of the ordering; a step
- * that chooses new pivots (the first after a checkpoint is taken or restored, see
- * ga_get_state, or one whose refactorization with the old pivots comes out numerically
+ * that chooses new pivots (the first after a layout-2 checkpoint is restored, see
+ * ga_set_state, or one whose refactorization with the old pivots comes out numerically
  * singular, pivot ratio below 1e-12) allocates only if its factors fill more than that.
  *
  * ## Conventions
@@ -628,18 +628,25 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
 /** @name Checkpoint and restart
  *  The full state as a flat array of doubles, so a host simulator can save, restore and
  *  restart: a run restarted from a checkpoint continues bit-identically, in fixed-step and in
- *  adaptive mode (from a checkpoint taken before the first step too: that step still applies
- *  the corrected start). Layout 3: [magic, layout version, n, m, t, h_last, h_next, err_prev,
- *  grew, sliver_span, q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n)] (h_next, err_prev, grew:
- *  the step-size controller; sliver_span: the time covered by slivers since the last step of
- *  Algorithm 1, see ga_step; a_prev: the a of the step before, for the error estimate); treat
- *  it as opaque. ga_set_state also reads layout 2 (galpha 0.2: without sliver_span).
- *  The factorized iteration matrix is not part of it: taking a checkpoint (or restoring one)
- *  makes the next step start with a fresh one, as a restart does; on the sparse path with
- *  pivots chosen afresh too (in the storage the factors already have), since a new solver
- *  has no earlier pivots to keep. ga_set_state needs callbacks set, allocates like
- *  ga_init (when the solver was not initialized) and makes the solver initialized; dense
- *  output (ga_interpolate) is available again after the next step. */
+ *  adaptive mode, dense and sparse, in both formulations (from a checkpoint taken before the
+ *  first step too: that step still applies the corrected start). Taking a checkpoint only
+ *  reads: a run that takes them is the run that does not, bit for bit and with the same work.
+ *  Layout 3 (treat it as opaque): a header [magic, layout version, n, m, t, h_last, h_next,
+ *  err_prev, grew, sliver_span, then 9 entries on the kept iteration matrix and its reuse],
+ *  the state q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n), the iterate the kept matrix was
+ *  factorized at, and the pivots of the sparse factorizations (zeros on the dense path).
+ *  h_next, err_prev, grew: the step-size controller; sliver_span: the time covered by slivers
+ *  since the last step of Algorithm 1 (see ga_step); a_prev: the a of the step before, for
+ *  the error estimate. ga_set_state rebuilds the kept matrix from the callbacks at that
+ *  iterate (one evaluation and one factorization, counted like any other; should a callback
+ *  fail there, the next step factorizes afresh instead, and the run continues as after a
+ *  restart) and gives each sparse factorization its pivots back. A failed step drops the
+ *  kept matrix, so the checkpoint taken after it has none. ga_set_state also reads layout 2
+ *  (galpha 0.2), as a restart: a fresh iteration matrix, sparse pivots chosen afresh.
+ *  With GA_REDUNDANT_DROP, ga_set_state selects the active constraints anew at the
+ *  checkpoint's q. ga_set_state needs callbacks set, allocates like ga_init (when the solver
+ *  was not initialized) and makes the solver initialized; dense output (ga_interpolate) is
+ *  available again after the next step. */
 /**@{*/
 /** Number of doubles in a checkpoint. Errors: GA_ERR_ARG. */
 GA_API ga_status ga_state_size(const ga_solver *s, size_t *len);
@@ -647,8 +654,9 @@ GA_API ga_status ga_state_size(const ga_solver *s, size_t *len);
 GA_API ga_status ga_get_state(const ga_solver *s, double *buf, size_t len);
 /** Errors: GA_ERR_ARG (NULL, wrong length, magic, version or sizes, non-finite values, or
  *  step-size entries galpha never writes: h_last or h_next negative or too small to move t,
- *  err_prev negative, grew other than 0 or 1, sliver_span negative or over h_last / 100),
- *  GA_ERR_STATE (callbacks not set),
+ *  err_prev negative, grew other than 0 or 1, sliver_span negative or over h_last / 100,
+ *  entries 10-18 or the pivots not as a solver writes them), GA_ERR_STATE (callbacks not
+ *  set),
  *  GA_ERR_NOMEM. */
 GA_API ga_status ga_set_state(ga_solver *s, const double *buf, size_t len);
 /**@}*/

@@ -8,12 +8,6 @@
 namespace ga {
 
 namespace {
-constexpr double kStateMagic = 26465.0;  // 0x6761, "ga"
-constexpr double kStateVersion = 3.0;
-// magic, version, n, m, t, h_last, h_next, err_prev, grew, sliver_span (layout 2: without the
-// last, which it reads as 0: a checkpoint taken after Algorithm 1 steps)
-constexpr std::size_t kStateHeader = 10;
-constexpr std::size_t kStateHeader2 = 9;
 
 // Reuse of the iteration matrix after a change of h. Scaled, S_t depends on h only through
 // gamma h C_t and beta h^2 K_t; the band is IDA's for its c_j (docs/algorithms.md sec. 4.5):
@@ -127,6 +121,9 @@ Solver::Solver(int n, int m)
     v_n_.setZero(n);
     qdd_n_.setZero(n);
     lambda_n_.setZero(m);
+    for (Vec *x : {&recipe_.q, &recipe_.v, &recipe_.qdd, &recipe_.q_b})
+        x->setZero(n);
+    recipe_.lambda.setZero(m);
     M_.set_dense(n, n);
     J_.set_dense(m, n);
     K_.set_dense(n, n);
@@ -538,8 +535,10 @@ ga_status Solver::residual(double t, const State &x)
     return GA_OK;
 }
 
-// Rebuild and factorize the iteration matrix at the current iterate.
-ga_status Solver::factorize(double h, bool tangents_K, bool tangents_C, bool tangent_Z, int iter)
+// Rebuild and factorize the iteration matrix at the iterate x at time t (M_, J_, the tangents
+// and in index 2 B_ evaluated there by the caller), and remember where (checkpoints).
+ga_status Solver::factorize(double t, const State &x, double h, bool tangents_K,
+                            bool tangents_C, bool tangent_Z, int iter)
 {
     count(counters, GA_COUNT_FACTORIZATIONS);
     jacobian_valid_ = false;
@@ -568,6 +567,21 @@ ga_status Solver::factorize(double h, bool tangents_K, bool tangents_C, bool tan
     jacobian_h_ = h;
     theta_prev_ = -1.0;
     convergence_.matrix_changed();
+    MatrixRecipe &r = recipe_;
+    r.t = t;
+    r.h = h;
+    r.K = tangents_K;
+    r.C = tangents_C;
+    r.Z = tangent_Z;
+    r.q = x.q;
+    r.v = x.v;
+    r.qdd = x.qdd;
+    r.lambda = x.lambda;
+    if (formulation == GA_INDEX2_STABILIZED && m_ > 0) {
+        r.t_b = b_t_;
+        if (b_q_ != &r.q_b)
+            r.q_b = *b_q_;
+    }
     return GA_OK;
 }
 
@@ -634,6 +648,8 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         // B = Phi_q(q_n): the direction of the position correction -h B^T eta (sec. 2.1)
         if (auto st = model.jacobian(s.t, s.q, B_))
             return st;
+        b_t_ = s.t;
+        b_q_ = &s.q;
     }
 
     // Tangents the user gives are always in the matrix. Missing ones (GA_TANGENT_AUTO) cost
@@ -669,7 +685,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         if (!st && refresh && tangent_Z)
             st = model.velocity_constraint_tangent(t1, x.q, x.v, J_, Z_);
         if (!st && refresh) {
-            st = factorize(h, tangents_K, tangents_C, tangent_Z, iter);
+            st = factorize(t1, x, h, tangents_K, tangents_C, tangent_Z, iter);
             refresh = false;
             refresh_done = true;
         } else if (!st) {
@@ -756,6 +772,8 @@ const char *Solver::linear_backend() const
 
 ga_status Solver::unavoidable_work(double h)
 {
+    if (formulation != GA_INDEX3)  // the index-3 step's work
+        return GA_ERR_ARG;
     const State &x = accepted_;
     const double t = x.t + h;
     ga_status st = residual(t, x);
@@ -767,111 +785,10 @@ ga_status Solver::unavoidable_work(double h)
             return st;
         if (C && (st = model.damping(t, x.q, x.v, f_, C_)))
             return st;
-        if (!S_.factorize_step(M_, C ? &C_ : nullptr, K ? &K_ : nullptr, J_, params, h, scaling))
-            return GA_ERR_SINGULAR;
-        jacobian_valid_ = true;
-        jacobian_h_ = h;
+        if ((st = factorize(t, x, h, K, C, false, 0)))
+            return st;
     }
     S_.solve(rq_, phi_, dq_, dlambda_, step_row_scale(params, h, scaling));
-    return GA_OK;
-}
-
-std::size_t Solver::state_size() const
-{
-    return kStateHeader + 5 * static_cast<std::size_t>(n_) + static_cast<std::size_t>(m_);
-}
-
-void Solver::get_state(double *buf) const
-{
-    const State &s = accepted_;
-    buf[0] = kStateMagic;
-    buf[1] = kStateVersion;
-    buf[2] = n_;
-    buf[3] = m_;
-    buf[4] = s.t;
-    buf[5] = s.h_last;
-    buf[6] = control.h_next;
-    buf[7] = control.err_prev;
-    buf[8] = control.grew ? 1.0 : 0.0;
-    buf[9] = s.sliver_span;
-    double *p = buf + kStateHeader;
-    for (const Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev}) {
-        Eigen::Map<Vec>(p, x->size()) = *x;
-        p += x->size();
-    }
-    invalidate_jacobian();
-    pivots_forgotten_ = true;
-}
-
-ga_status Solver::set_state(const double *buf, std::size_t len)
-{
-    // Layout 2 (galpha 0.2) is read too.
-    const bool layout2 = len >= 2 && buf[0] == kStateMagic && buf[1] == 2.0;
-    const std::size_t header = layout2 ? kStateHeader2 : kStateHeader;
-    if (len != state_size() - kStateHeader + header)
-        return diag.fail(GA_ERR_ARG, "checkpoint has %zu doubles, this solver needs %zu", len,
-                         state_size() - kStateHeader + header);
-    if (buf[0] != kStateMagic || (buf[1] != kStateVersion && !layout2))
-        return diag.fail(GA_ERR_ARG, "not a galpha checkpoint (magic %g, layout version %g)",
-                         buf[0], buf[1]);
-    if (buf[2] != n_ || buf[3] != m_)
-        return diag.fail(GA_ERR_ARG, "checkpoint is for n = %g, m = %g; this solver has n = %d, "
-                         "m = %d", buf[2], buf[3], n_, m_);
-    for (std::size_t k = 4; k < len; ++k)
-        if (!std::isfinite(buf[k]))
-            return diag.fail(GA_ERR_ARG, "checkpoint entry %zu is not finite", k);
-    // The step-size controller's entries as a solver writes them: h_last and h_next are 0 (no
-    // step yet, no proposal) or steps that move t (ga_step refuses others); err_prev is not
-    // negative; grew is a flag. Anything else was not written by galpha, and would fail later,
-    // far from here (h_last = 1e-320 multiplies a_n by 1e317 when it is rescaled for the next
-    // step; h_next = 1e-320 ends the next adaptive step below its minimum).
-    const double t = buf[4];
-    for (const int k : {5, 6}) {
-        const double h = buf[k];
-        if (h < 0.0 || (h > 0.0 && t + h == t && t - h == t))
-            return diag.fail(GA_ERR_ARG, "checkpoint entry %d (%s = %g) is not a step from "
-                             "t = %.17g", k, k == 5 ? "h_last" : "h_next", h, t);
-    }
-    if (buf[7] < 0.0 || (buf[8] != 0.0 && buf[8] != 1.0))
-        return diag.fail(GA_ERR_ARG, "checkpoint entries 7-8 (err_prev = %g, grew = %g) are "
-                         "not those of galpha's step-size control", buf[7], buf[8]);
-    const double sliver_span = layout2 ? 0.0 : buf[9];
-    if (sliver_span < 0.0 || sliver_span > buf[5] / kShortStepRatio)
-        return diag.fail(GA_ERR_ARG, "checkpoint entry 9 (sliver_span = %g) is not a span of "
-                         "short steps after steps of h_last = %g", sliver_span, buf[5]);
-    if (!model.ready())
-        return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
-    if (auto st = setup())
-        return st;
-    if (redundancy == GA_REDUNDANT_DROP && m_ > 0) {
-        const Vec q = Eigen::Map<const Vec>(buf + header, n_);
-        const std::vector<unsigned char> active_before = active_;
-        if (auto st = select_active_constraints(buf[4], q)) {
-            restore_active(active_before);
-            return st;
-        }
-    }
-    State &s = accepted_;
-    s.t = buf[4];
-    s.h_last = buf[5];
-    s.sliver_span = sliver_span;
-    control.h_next = buf[6];
-    control.err_prev = buf[7];
-    control.grew = buf[8] != 0.0;
-    const double *p = buf + header;
-    for (Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev}) {
-        *x = Eigen::Map<const Vec>(p, x->size());
-        p += x->size();
-    }
-
-    invalidate_jacobian();
-    pivots_forgotten_ = true;
-    previous_valid_ = false;
-    ++state_id_;
-    // A checkpoint from before the first step (h_last = 0) still owes that step its corrected
-    // starting values, as the solver it was taken from does.
-    start_pending_ = s.h_last == 0.0;
-    initialized_ = true;
     return GA_OK;
 }
 

@@ -137,11 +137,10 @@ public:
     int last_newton_iters() const { return last_newton_iters_; }
     double last_newton_ratio() const { return convergence_.ratio(); }
 
-    // Checkpoint (layout 3): [magic, 3, n, m, t, h_last, h_next, err_prev, grew, sliver_span,
-    // q, v, qdd, lambda, a, a_prev]; layout 2 (without sliver_span) is read too. Taking one (or restoring one) also drops the reusable iteration
-    // matrix and, on the sparse path, the pivot order and row scaling KLU keeps from its last
-    // full factorization, so that the run continues exactly as a restart from the checkpoint
-    // does (neither is part of it): the next step factorizes afresh.
+    // Checkpoint (checkpoint.cpp, layout 3): the state, the step-size control, and what
+    // rebuilds the kept iteration matrix and the pivots of every sparse LU bit for bit, so
+    // that taking one changes nothing and a restored run continues as the run it came from.
+    // Layout 2 (galpha 0.2: the state and the control only) is read as a restart.
     std::size_t state_size() const;
     void get_state(double *buf) const;
     ga_status set_state(const double *buf, std::size_t len);
@@ -161,7 +160,9 @@ private:
     static constexpr double kShortStepRatio = 100.0;
     ga_status newton(double h, double tol, bool refresh, bool &converged, bool &used_stale);
     ga_status residual(double t, const State &x);
-    ga_status factorize(double h, bool tangents_K, bool tangents_C, bool tangent_Z, int iter);
+    ga_status factorize(double t, const State &x, double h, bool tangents_K, bool tangents_C,
+                        bool tangent_Z, int iter);
+    ga_status rebuild_matrix();  // checkpoint.cpp: the kept matrix again, from recipe_
     ga_status evaluate_mass(double t, const Vec &q);
     void commit(bool land_on, double t_land);
     double error_norm(double h);  // control.cpp
@@ -220,8 +221,17 @@ private:
     // choice is made again whenever the matrix is dropped.
     static constexpr double kDeferredTangentRate = 0.1;
     mutable bool fd_tangents_ = false;
-    // A checkpoint was taken or restored: the next step forgets the pivots (get_state).
-    mutable bool pivots_forgotten_ = false;
+    // A checkpoint of layout 2 was restored: the next step forgets the pivots (set_state).
+    bool pivots_forgotten_ = false;
+    // What rebuilds the kept iteration matrix bit for bit (checkpoint): the time, iterate and
+    // h it was factorized at, the tangents it holds and, in index 2, the q_n of B = Phi_q(q_n).
+    struct MatrixRecipe {
+        double t = 0.0, h = 0.0, t_b = 0.0;
+        bool K = false, C = false, Z = false;
+        Vec q, v, qdd, lambda, q_b;
+    } recipe_;
+    double b_t_ = 0.0;            // where B_ was evaluated last (index 2)
+    const Vec *b_q_ = nullptr;
     bool tangents_deferred_ = false;  // the last Newton iteration ran without them
 
     // Consistent output (output.cpp): its own saddle-point matrix and scratch, and the

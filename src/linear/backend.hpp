@@ -10,11 +10,26 @@
 // whatever the right-hand side says (the callers pass 0).
 #pragma once
 
+#include <cstddef>
 #include <memory>
 
 #include "../matrix.hpp"
 
 namespace ga {
+
+// What a factorization keeps for the next one, which a checkpoint carries so that a restored
+// solver factorizes bit for bit as the one it came from (the sparse LU: its pivots, ordering
+// and row scaling, KluSystem::save_pivots; a dense LU keeps nothing): a block of
+// pivot_state_size(N) doubles for a system of at most N unknowns, [kept (0/1), N, ordering
+// (0/1), switched (0/1), ...]. A block with nothing kept, or from a system of another size,
+// loads as "choose pivots afresh".
+inline std::size_t pivot_state_size(int N) { return 4 + 2 * static_cast<std::size_t>(N); }
+inline bool pivot_block_header_ok(const double *in)
+{
+    const auto flag = [](double x) { return x == 0.0 || x == 1.0; };
+    return flag(in[0]) && flag(in[2]) && flag(in[3]) && in[1] >= 0.0 && in[1] < 2147483647.0 &&
+           in[1] == static_cast<double>(static_cast<long>(in[1]));
+}
 
 struct SaddleBlocks {
     const ModelMatrix *M = nullptr;  // null: identity in the top-left block
@@ -54,6 +69,11 @@ public:
     // The next factorization chooses its pivots (and the sparse row scaling) afresh, as in a
     // new solver; a dense LU does so at every factorization anyway.
     virtual void forget_pivots() {}
+    // The pivot state (see pivot_state_size): written into a zeroed block, checked, taken
+    // over (load never allocates).
+    virtual void save_pivots(double *out) const { (void)out; }
+    virtual bool pivots_loadable(const double *in) const { return pivot_block_header_ok(in); }
+    virtual void load_pivots(const double *in) { (void)in; }
     // Allocates now the storage of the factors that factorize() would otherwise allocate in
     // its first call (the sparse LU: from the fill of the ordering). Called once all setups
     // are done, so that it never adds to the peak of their temporary memory.

@@ -79,7 +79,8 @@ void FixedPivotLU::reserve(int N, int nnz, double expected_entries)
 FixedPivotLU::Outcome FixedPivotLU::factorize(int N, const int *colptr, const int *rowind,
                                               const double *values, const double *row_scale,
                                               const int *diagonal_row, const int *Q,
-                                              double expected_entries, double fill_budget)
+                                              double expected_entries, double fill_budget,
+                                              const int *forced_rows)
 {
     ready_ = false;
     N_ = N;
@@ -139,12 +140,17 @@ FixedPivotLU::Outcome FixedPivotLU::factorize(int N, const int *colptr, const in
         if (pivot >= 0 && mark[diagonal] == k && pinv[diagonal] < 0 &&
             std::abs(x[diagonal]) >= kDiagonalPreference * largest)
             pivot = diagonal;
-        if (pivot < 0 || !(largest > 0.0) || !std::isfinite(largest)) {
+        bool usable = pivot >= 0 && largest > 0.0 && std::isfinite(largest);
+        if (forced_rows) {  // the structure only: any nonzero divisor will do
+            pivot = forced_rows[k];
+            usable = pivot >= 0 && pivot < N && mark[pivot] == k && pinv[pivot] < 0;
+        }
+        if (!usable) {
             for (int t = top; t < N; ++t)
                 x[reach[t]] = 0.0;
             return Outcome::Singular;  // no usable pivot
         }
-        const double d = x[pivot];
+        const double d = x[pivot] != 0.0 || !forced_rows ? x[pivot] : 1.0;
         pinv[pivot] = k;
         Ud_[k] = d;
         for (int t = top; t < N; ++t) {

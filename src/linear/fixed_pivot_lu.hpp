@@ -38,9 +38,15 @@ public:
     // undo the ordering, and another ordering may do better. The factors are ready only when
     // Factorized. Allocates the first time, and later only where new pivots fill more than
     // earlier ones; throws std::bad_alloc.
+    // forced_rows (optional): the pivot row of every column, as pivot_rows() gave them -- the
+    // factors then have the structure of that factorization (for a refactor() to follow: the
+    // values computed here may hold a zero pivot); Singular if a row is no candidate there.
     Outcome factorize(int N, const int *colptr, const int *rowind, const double *values,
                       const double *row_scale, const int *diagonal_row, const int *Q,
-                      double expected_entries, double fill_budget);
+                      double expected_entries, double fill_budget,
+                      const int *forced_rows = nullptr);
+    // The pivot row of each column of the factors at hand (valid when ready()).
+    const std::vector<int> &pivot_rows() const { return P_; }
     // Allocates up front what factorize() needs for an N x N matrix with nnz entries whose
     // factors hold expected_entries each (at setup: the first factorization then allocates
     // only if it fills more). Throws std::bad_alloc.

@@ -454,6 +454,35 @@ void Index2Matrix::forget_pivots()
 #endif
 }
 
+void Index2Matrix::save_pivots(double *out) const
+{
+#ifdef GALPHA_HAVE_KLU
+    if (sparse_)
+        sparse_->S.save_pivots(out);
+#else
+    (void)out;
+#endif
+}
+
+bool Index2Matrix::pivots_loadable(const double *in) const
+{
+#ifdef GALPHA_HAVE_KLU
+    if (sparse_)
+        return sparse_->S.pivots_loadable(in);
+#endif
+    return pivot_block_header_ok(in);
+}
+
+void Index2Matrix::load_pivots(const double *in)
+{
+#ifdef GALPHA_HAVE_KLU
+    if (sparse_)
+        sparse_->S.load_pivots(in);
+#else
+    (void)in;
+#endif
+}
+
 void Index2Matrix::reserve_factors()
 {
 #ifdef GALPHA_HAVE_KLU

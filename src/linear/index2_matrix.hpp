@@ -66,6 +66,10 @@ public:
     // The next factorization picks its pivots afresh (LinearBackend::forget_pivots).
     void forget_pivots();
     void reserve_factors();  // LinearBackend::reserve_factors
+    // LinearBackend::save_pivots etc. (the sparse system's; a dense one keeps nothing)
+    void save_pivots(double *out) const;
+    bool pivots_loadable(const double *in) const;
+    void load_pivots(const double *in);
 
 private:
     struct Dense;

@@ -41,6 +41,21 @@ public:
         if (backend_)
             backend_->forget_pivots();
     }
+    // LinearBackend::save_pivots etc.; a matrix not set up keeps nothing
+    void save_pivots(double *out) const
+    {
+        if (backend_)
+            backend_->save_pivots(out);
+    }
+    bool pivots_loadable(const double *in) const
+    {
+        return backend_ ? backend_->pivots_loadable(in) : pivot_block_header_ok(in);
+    }
+    void load_pivots(const double *in)
+    {
+        if (backend_)
+            backend_->load_pivots(in);
+    }
     // LinearBackend::reserve_factors
     void reserve_factors()
     {

@@ -123,6 +123,8 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries, Ordering 
     for (int j = 0; j < N; ++j)
         colptr_[j + 1] += colptr_[j];
     values_.assign(entries.size(), 0.0);
+    loaded_rows_.assign(N, 0);
+    loaded_ = false;
     std::vector<std::pair<int, int>>().swap(entries);  // freed before the factors' storage
     row_scale_.assign(N, 1.0);
     // Two orderings: KLU's AMD (least fill) and reverse Cuthill-McKee (a band). For
@@ -175,10 +177,73 @@ int KluSystem::slot(int row, int col) const
 void KluSystem::forget_pivots()
 {
     lu_.clear();
+    loaded_ = false;
+}
+
+void KluSystem::save_pivots(double *out) const
+{
+    const bool kept = loaded_ || lu_.ready();
+    out[0] = kept ? 1.0 : 0.0;
+    out[1] = N_;
+    out[2] = in_use_;
+    out[3] = switched_ ? 1.0 : 0.0;
+    const int *rows = loaded_ ? loaded_rows_.data() : lu_.pivot_rows().data();
+    for (int k = 0; k < N_; ++k) {
+        out[4 + k] = kept ? rows[k] : 0.0;
+        out[4 + N_ + k] = row_scale_[k];
+    }
+}
+
+bool KluSystem::pivots_loadable(const double *in) const
+{
+    if (!pivot_block_header_ok(in))
+        return false;
+    if (in[0] == 0.0 || in[1] != N_)
+        return true;  // loads as "pivots afresh"
+    std::vector<char> seen(N_, 0);
+    for (int k = 0; k < N_; ++k) {
+        const double r = in[4 + k], d = in[4 + N_ + k];
+        if (!(d > 0.0) || !std::isfinite(d))
+            return false;
+        if (!(r >= 0.0 && r < N_) || r != std::floor(r) || seen[static_cast<int>(r)])
+            return false;
+        seen[static_cast<int>(r)] = 1;
+    }
+    return true;
+}
+
+void KluSystem::load_pivots(const double *in)
+{
+    if (in[0] == 0.0 || in[1] != N_) {
+        forget_pivots();
+        return;
+    }
+    lu_.clear();
+    loaded_ = true;
+    const int ordering = static_cast<int>(in[2]);
+    if (ordering != in_use_)
+        symbolic_stale_ = true;
+    in_use_ = ordering;
+    switched_ = in[3] != 0.0;
+    for (int k = 0; k < N_; ++k) {
+        loaded_rows_[k] = static_cast<int>(in[4 + k]);
+        row_scale_[k] = in[4 + N_ + k];
+    }
 }
 
 bool KluSystem::factorize()
 {
+    if (loaded_) {
+        // Pivots from a checkpoint: the structure of their factors (the values do not matter,
+        // the refactorization below computes them). Rows that do not fit: pivots afresh.
+        loaded_ = false;
+        const FlushSubnormals flush;
+        const int *order = orders_[in_use_].data();
+        if (lu_.factorize(N_, colptr_.data(), rowind_.data(), values_.data(), row_scale_.data(),
+                          order, order, expected_[in_use_], 0.0, loaded_rows_.data()) !=
+            FixedPivotLU::Outcome::Factorized)
+            lu_.clear();
+    }
     if (lu_.ready()) {
         const FlushSubnormals flush;
         const double ratio = lu_.refactor(values_.data());  // rows scaled as it reads them
@@ -213,7 +278,9 @@ bool KluSystem::factorize()
         rcond_ = 0.0;
         return false;  // singular
     }
-    rcond_ = lu_.pivot_ratio();
+    // The numbers once more, as a refactorization computes them (its sums run in another
+    // order): then pivots saved in a checkpoint reproduce them bit for bit.
+    rcond_ = lu_.refactor(values_.data());
     return rcond_ >= std::numeric_limits<double>::epsilon();
 }
 

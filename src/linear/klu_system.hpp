@@ -11,6 +11,7 @@
 #ifdef GALPHA_HAVE_KLU
 #include <klu.h>
 
+#include "backend.hpp"
 #include "fixed_pivot_lu.hpp"
 
 #include <utility>
@@ -71,6 +72,15 @@ public:
     // Factorizations with new pivots so far (the others were refactorizations).
     int full_factorizations() const { return full_factorizations_; }
 
+    // What the next factorize() keeps from the last full one (backend.hpp, pivot_state_size):
+    // [pivots kept (0/1), N, ordering in use, ordering switched, pivot row of each column
+    // (N), row scaling (N)]. Every factorization's numbers come from a refactorization with
+    // these (after a full one too), so a solver that loads them factorizes the next matrix
+    // bit for bit as the one that saved them.
+    void save_pivots(double *out) const;
+    bool pivots_loadable(const double *in) const;  // saved by a system of this pattern
+    void load_pivots(const double *in);            // never allocates
+
 private:
     std::vector<std::vector<int>> symmetric_adjacency() const;
     std::vector<int> reverse_cuthill_mckee(const std::vector<std::vector<int>> &adj) const;
@@ -97,6 +107,9 @@ private:
     int in_use_ = 0;
     bool switched_ = false;
     int full_factorizations_ = 0;
+    // Pivots loaded from a checkpoint: the next factorize() builds their structure first.
+    bool loaded_ = false;
+    std::vector<int> loaded_rows_;
 };
 
 }  // namespace ga

@@ -131,6 +131,9 @@ public:
     const char *name() const override { return "sparse KLU"; }
     void forget_pivots() override { S_.forget_pivots(); }
     void reserve_factors() override { S_.reserve_factors(); }
+    void save_pivots(double *out) const override { S_.save_pivots(out); }
+    bool pivots_loadable(const double *in) const override { return S_.pivots_loadable(in); }
+    void load_pivots(const double *in) override { S_.load_pivots(in); }
 
 private:
     int n_ = 0, m_ = 0;

@@ -5,10 +5,39 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include <galpha.h>
 
 #include "scenes/pendulum.h"
+
+/* Checkpoint layout 3 (src/checkpoint.cpp), as far as tests look into it: 19 header entries
+ * (entry 9: the span of slivers), then q, v, qdd, lambda, a, a_prev; then what rebuilds the
+ * kept matrix (4n + m + n) and four pivot blocks. The pendulum's takes 85 doubles. */
+enum { CKPT_HEADER = 19, CKPT_PENDULUM = 85 };
+
+/* The layout-2 checkpoint (galpha 0.2) of the same state: header entries 0-8 with version 2,
+ * then the state; its length. */
+static inline size_t ckpt_as_layout2(const double *c3, double *c2)
+{
+    const size_t state = 5 * (size_t)c3[2] + (size_t)c3[3];
+    for (int k = 0; k < 9; ++k)
+        c2[k] = c3[k];
+    c2[1] = 2.0;
+    for (size_t k = 0; k < state; ++k)
+        c2[9 + k] = c3[CKPT_HEADER + k];
+    return 9 + state;
+}
+
+/* What a failed step must leave as it was: header entries 0-9 (t, the step-size control) and
+ * q, v, qdd, lambda, a, a_prev. (The rest rebuilds the kept matrix, which a failed step drops
+ * on purpose: the next attempt starts with a fresh one.) */
+static inline int ckpt_same_state(const double *x, const double *y)
+{
+    const size_t state = 5 * (size_t)x[2] + (size_t)x[3];
+    return memcmp(x, y, 10 * sizeof(double)) == 0 &&
+           memcmp(x + CKPT_HEADER, y + CKPT_HEADER, state * sizeof(double)) == 0;
+}
 
 /* Slope of the least-squares line through (log h_i, log e_i). */
 static inline double fit_order(const double *h, const double *e, int k)

@@ -382,10 +382,10 @@ static void interpolation_agrees_with_a_step_ending_there(void **state)
     (void)state;
     ga_solver *s = pendulum_solver(0.9, GA_INDEX2_STABILIZED, 1, 1);
     assert_int_equal(ga_set_tolerances(s, 1e-5, 1e-5), GA_OK);
-    double ckpt[10 + 5 * 2 + 1], t0, t1;
+    double ckpt[CKPT_PENDULUM], t0, t1;
     for (int k = 0; k < 25; ++k)
         assert_int_equal(ga_step_adaptive(s, 10.0), GA_OK);
-    assert_int_equal(ga_get_state(s, ckpt, 21), GA_OK);
+    assert_int_equal(ga_get_state(s, ckpt, CKPT_PENDULUM), GA_OK);
     ga_get_t(s, &t0);
     assert_int_equal(ga_step_adaptive(s, 10.0), GA_OK);
     ga_get_t(s, &t1);
@@ -400,7 +400,7 @@ static void interpolation_agrees_with_a_step_ending_there(void **state)
     assert_int_equal(ga_interpolate(s, tau, q, v, &lam), GA_OK);
     ga_get_info(s, GA_INFO_ERROR_ESTIMATE, &est);
     ga_solver *r = pendulum_solver(0.9, GA_INDEX2_STABILIZED, 1, 1);
-    assert_int_equal(ga_set_state(r, ckpt, 21), GA_OK);
+    assert_int_equal(ga_set_state(r, ckpt, CKPT_PENDULUM), GA_OK);
     assert_int_equal(ga_step(r, tau - t0), GA_OK);
     double qr[2], vr[2];
     ga_get_q(r, qr);
@@ -603,15 +603,15 @@ static void step_size_floor_is_reported(void **state)
 {
     (void)state;
     ga_solver *s = pendulum_solver(0.9, GA_INDEX3, 1, 1);
-    double before[21], after[21];
+    double before[CKPT_PENDULUM], after[CKPT_PENDULUM];
     assert_int_equal(ga_set_tolerances(s, 1e-12, 1e-12), GA_OK);
     assert_int_equal(ga_set_step_limits(s, 0.05, 0.0), GA_OK);
     assert_int_equal(ga_set_initial_step(s, 0.05), GA_OK);
-    assert_int_equal(ga_get_state(s, before, 21), GA_OK);
+    assert_int_equal(ga_get_state(s, before, CKPT_PENDULUM), GA_OK);
     assert_int_equal(ga_advance(s, 1.0), GA_ERR_STEP_SIZE);
     assert_non_null(strstr(ga_last_error(s), "fell below the minimum"));
-    assert_int_equal(ga_get_state(s, after, 21), GA_OK);
-    assert_memory_equal(before, after, sizeof before);
+    assert_int_equal(ga_get_state(s, after, CKPT_PENDULUM), GA_OK);
+    assert_true(ckpt_same_state(before, after));
     assert_int_equal(ga_set_step_limits(s, 0.2, 0.1), GA_ERR_ARG);
     assert_int_equal(ga_set_tolerances(s, 0.0, 1e-6), GA_ERR_ARG);
     assert_int_equal(ga_advance(s, -1.0), GA_ERR_ARG);
@@ -709,7 +709,7 @@ static void adaptive_fatal_failure_keeps_the_last_accepted_step(void **state)
     (void)state;
     guarded_pendulum g = {P, {0, 0}, INFINITY, 0.5, 0};
     ga_solver *s = guarded_solver(&g, 1e-6);
-    double t, t_before, h_last, before[21], after[21];
+    double t, t_before, h_last, before[CKPT_PENDULUM], after[CKPT_PENDULUM];
     assert_int_equal(ga_advance(s, 1.0), GA_ERR_CALLBACK);
     assert_non_null(strstr(ga_last_error(s), "force callback returned -2"));
     ga_get_t(s, &t);
@@ -718,11 +718,11 @@ static void adaptive_fatal_failure_keeps_the_last_accepted_step(void **state)
     long long failed;
     ga_get_counter(s, GA_COUNT_FAILED_STEPS, &failed);
     assert_int_equal(failed, 1);
-    assert_int_equal(ga_get_state(s, before, 21), GA_OK);
+    assert_int_equal(ga_get_state(s, before, CKPT_PENDULUM), GA_OK);
     t_before = t;
     assert_int_equal(ga_step_adaptive(s, 1.0), GA_ERR_CALLBACK); /* the same again */
-    assert_int_equal(ga_get_state(s, after, 21), GA_OK);
-    assert_memory_equal(before, after, sizeof before);
+    assert_int_equal(ga_get_state(s, after, CKPT_PENDULUM), GA_OK);
+    assert_true(ckpt_same_state(before, after));
     g.t_fatal = INFINITY;
     assert_int_equal(ga_advance(s, 1.0), GA_OK);
     ga_get_t(s, &t);
@@ -1084,14 +1084,14 @@ static void rho_one_adaptive_needs_index2_or_no_constraints(void **state)
 {
     (void)state;
     ga_solver *s = pendulum_solver(1.0, GA_INDEX3, 1, 1);
-    double before[21], after[21];
+    double before[CKPT_PENDULUM], after[CKPT_PENDULUM];
     long long residuals = -1, steps = -1;
     assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
-    assert_int_equal(ga_get_state(s, before, 21), GA_OK);
+    assert_int_equal(ga_get_state(s, before, CKPT_PENDULUM), GA_OK);
     assert_int_equal(ga_step_adaptive(s, 1.0), GA_ERR_ARG);
     assert_non_null(strstr(ga_last_error(s), "need rho_inf < 1"));
     assert_int_equal(ga_advance(s, 1.0), GA_ERR_ARG);
-    assert_int_equal(ga_get_state(s, after, 21), GA_OK);
+    assert_int_equal(ga_get_state(s, after, CKPT_PENDULUM), GA_OK);
     assert_memory_equal(before, after, sizeof before);
     assert_int_equal(ga_get_counter(s, GA_COUNT_RESIDUALS, &residuals), GA_OK);
     assert_int_equal(ga_get_counter(s, GA_COUNT_STEPS, &steps), GA_OK);

@@ -217,13 +217,14 @@ static int chain_force_maybe_failing(double t, const double *q, const double *v,
     return chain_force_fails;
 }
 
-/* A checkpoint on the sparse path: the step after it chooses new pivots, as a restarted solver
- * does (a full factorization, the path a refactorization that comes out numerically singular
- * takes too). The factors' storage is reserved with the workspace, from the fill of the
- * ordering, so that step allocates nothing (new pivots would only if they filled more); nor
- * do the steps after it, failed steps (which keep the pivots) included, nor the first step of
- * a new solver restored from the checkpoint. Index 3 and the stabilized index 2. */
-static void no_sparse_allocation_after_a_checkpoint(void **state)
+/* New pivots on the sparse path: a restart (a checkpoint restored in its layout-2 form, which
+ * carries no pivots) makes the next step choose them, with a full factorization (the path a
+ * refactorization that comes out numerically singular takes too). The factors' storage is
+ * reserved with the workspace, from the fill of the ordering, so that step allocates nothing
+ * (new pivots would only if they filled more); nor do the steps after it, failed steps
+ * (which keep the pivots) included, nor the first step of a new solver restored from the
+ * checkpoint, in either layout. Index 3 and the stabilized index 2. */
+static void no_sparse_allocation_after_a_restart(void **state)
 {
     (void)state;
     for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
@@ -240,6 +241,10 @@ static void no_sparse_allocation_after_a_checkpoint(void **state)
         double *ckpt = malloc(len * sizeof *ckpt);
         assert_non_null(ckpt);
         assert_int_equal(ga_get_state(s, ckpt, len), GA_OK);
+        double *ckpt2 = malloc(len * sizeof *ckpt2);
+        assert_non_null(ckpt2);
+        const size_t len2 = ckpt_as_layout2(ckpt, ckpt2);
+        assert_int_equal(ga_set_state(s, ckpt2, len2), GA_OK);
         long long full_before = 0, full_after = 0;
         ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &full_before);
         allocations = 0;
@@ -257,24 +262,29 @@ static void no_sparse_allocation_after_a_checkpoint(void **state)
         }
         chain_force_fails = 0;
         armed = 0;
-        printf("  sparse, %s: %ld allocations in the step after a checkpoint (new pivots, %lld "
+        printf("  sparse, %s: %ld allocations in the step after a restart (new pivots, %lld "
                "factorizations), %ld in the 20 after it (4 of them failing)\n",
                formulation == GA_INDEX3 ? "index 3" : "index 2", first,
                full_after - full_before, allocations);
         assert_true(full_after > full_before);  /* the step did factorize */
         assert_int_equal(first, 0);
         assert_int_equal(allocations, 0);
-        /* a new solver restored from the checkpoint */
-        ga_solver *r = sparse_chain_solver(&c, chain_force, chain_jacobian, formulation);
-        assert_int_equal(ga_set_state(r, ckpt, len), GA_OK);
-        allocations = 0;
-        armed = 1;
-        assert_int_equal(ga_step(r, 1e-3), GA_OK);
-        armed = 0;
-        printf("  a new solver restored from it: %ld allocations in its first step\n",
-               allocations);
-        assert_int_equal(allocations, 0);
-        ga_free(r);
+        /* a new solver restored from the checkpoint, in either layout */
+        for (int layout = 2; layout <= 3; ++layout) {
+            ga_solver *r = sparse_chain_solver(&c, chain_force, chain_jacobian, formulation);
+            assert_int_equal(layout == 2 ? ga_set_state(r, ckpt2, len2)
+                                         : ga_set_state(r, ckpt, len),
+                             GA_OK);
+            allocations = 0;
+            armed = 1;
+            assert_int_equal(ga_step(r, 1e-3), GA_OK);
+            armed = 0;
+            printf("  a new solver restored from it (layout %d): %ld allocations in its first "
+                   "step\n", layout, allocations);
+            assert_int_equal(allocations, 0);
+            ga_free(r);
+        }
+        free(ckpt2);
         free(ckpt);
         ga_free(s);
     }
@@ -371,7 +381,7 @@ int main(void)
         cmocka_unit_test(no_allocation_in_step),
         cmocka_unit_test(no_allocation_in_failing_step),
         cmocka_unit_test(no_allocation_in_sparse_step),
-        cmocka_unit_test(no_sparse_allocation_after_a_checkpoint),
+        cmocka_unit_test(no_sparse_allocation_after_a_restart),
         cmocka_unit_test(no_allocation_with_dropped_constraints),
         cmocka_unit_test(no_allocation_with_any_dense_kernel),
         cmocka_unit_test(no_allocation_after_tangent_options_change),

@@ -383,9 +383,9 @@ static void run_sequence(int seq, long long *calls, long long *steps_ok, long lo
         }
         case 28: {
             size_t len = 0;
-            double buf[64];
+            double buf[512];
             assert_int_equal(ga_state_size(s, &len), GA_OK);
-            assert_true(len <= 64);
+            assert_true(len <= 512);
             call = "ga_get_state";
             changes = 0;
             st = ga_get_state(s, buf, len);

@@ -332,23 +332,24 @@ static void singular_matrix_mid_run_sparse(void **state)
         assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
         for (int i = 0; i < 5; ++i)
             assert_int_equal(ga_step(s, 1e-3), GA_OK);
-        double before[512], after[512];
+        double before[2048], after[2048], restart[2048];
         size_t len = 0;
         assert_int_equal(ga_state_size(s, &len), GA_OK);
-        assert_true(len <= 512);
+        assert_true(len <= 2048);
         assert_int_equal(ga_get_state(s, before, len), GA_OK);
         jacobian_vanishes = 1;
         assert_int_equal(ga_step(s, 1e-3), GA_ERR_SINGULAR);
         assert_non_null(strstr(ga_last_error(s), "is singular"));
         jacobian_vanishes = 0;
         assert_int_equal(ga_get_state(s, after, len), GA_OK);
-        assert_memory_equal(before, after, len * sizeof(double));
-        assert_int_equal(ga_set_state(r, before, len), GA_OK);
+        assert_true(ckpt_same_state(before, after));
+        /* the failed step dropped its matrix and pivots: it goes on as a restart */
+        assert_int_equal(ga_set_state(r, restart, ckpt_as_layout2(before, restart)), GA_OK);
         assert_int_equal(ga_step(s, 1e-3), GA_OK);
         assert_int_equal(ga_step(r, 1e-3), GA_OK);
         assert_int_equal(ga_get_state(s, after, len), GA_OK);
         assert_int_equal(ga_get_state(r, before, len), GA_OK);
-        assert_memory_equal(before, after, len * sizeof(double));
+        assert_true(ckpt_same_state(before, after));
         ga_free(s);
         ga_free(r);
     }

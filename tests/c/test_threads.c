@@ -15,7 +15,7 @@
 #include "helpers.h"
 #include "chain_solver.h"
 
-enum { THREADS = 4, LEN = 10 + 5 * 2 + 1 };
+enum { THREADS = 4, LEN = CKPT_PENDULUM };
 
 typedef struct job {
     pendulum p;

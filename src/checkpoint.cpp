@@ -1,0 +1,240 @@
+// Checkpoint and restart (ga_get_state, ga_set_state). Layout 3, in doubles:
+//   header   [magic, 3, n, m, t, h_last, h_next, err_prev, grew, sliver_span,
+//             matrix kept (0/1), its t, its h, t of its B, tangents (K + 2 C + 4 Z),
+//             theta_prev, refresh_steps_left, reuse_backoff, fd_tangents]
+//   state    q, v, qdd (n each), lambda (m), a, a_prev (n each)
+//   matrix   the iterate it was factorized at: q, v, qdd (n), lambda (m); q of its B (n)
+//   pivots   blocks of pivot_state_size(N) (backend.hpp) for S_ (N = n + m), S2_ (2n + 2m),
+//            P_ and O_ (n + m each)
+// Taking one only reads. Restoring rebuilds the kept matrix from the callbacks at the same
+// iterate and hands every sparse LU its pivots back, so the restored run repeats the run it
+// came from bit for bit (a kept matrix or pivots left out would make the next steps converge
+// to other round-off). Layout 2 (galpha 0.2: header up to grew, then the state) is read as a
+// restart: no kept matrix, pivots chosen afresh.
+#include "solver.hpp"
+
+#include <cmath>
+
+namespace ga {
+
+namespace {
+constexpr double kStateMagic = 26465.0;  // 0x6761, "ga"
+constexpr double kStateVersion = 3.0;
+constexpr std::size_t kHeader = 19;
+constexpr std::size_t kHeader2 = 9;  // layout 2
+
+bool is_flag(double x) { return x == 0.0 || x == 1.0; }
+bool is_count(double x, double max) { return x >= 0.0 && x <= max && x == std::floor(x); }
+
+struct Layout {
+    std::size_t matrix, pivots[4], end;  // offsets; pivots of S_, S2_, P_, O_
+};
+
+Layout layout(int n, int m)
+{
+    const std::size_t N = static_cast<std::size_t>(n), M = static_cast<std::size_t>(m);
+    Layout l;
+    l.matrix = kHeader + 5 * N + M;
+    l.pivots[0] = l.matrix + 4 * N + M;
+    l.pivots[1] = l.pivots[0] + pivot_state_size(n + m);
+    l.pivots[2] = l.pivots[1] + pivot_state_size(2 * n + 2 * m);
+    l.pivots[3] = l.pivots[2] + pivot_state_size(n + m);
+    l.end = l.pivots[3] + pivot_state_size(n + m);
+    return l;
+}
+}  // namespace
+
+std::size_t Solver::state_size() const { return layout(n_, m_).end; }
+
+void Solver::get_state(double *buf) const
+{
+    const Layout l = layout(n_, m_);
+    const State &s = accepted_;
+    const MatrixRecipe &r = recipe_;
+    std::fill(buf, buf + l.end, 0.0);
+    const double header[kHeader] = {kStateMagic,
+                                    kStateVersion,
+                                    static_cast<double>(n_),
+                                    static_cast<double>(m_),
+                                    s.t,
+                                    s.h_last,
+                                    control.h_next,
+                                    control.err_prev,
+                                    control.grew ? 1.0 : 0.0,
+                                    s.sliver_span,
+                                    jacobian_valid_ ? 1.0 : 0.0,
+                                    r.t,
+                                    r.h,
+                                    r.t_b,
+                                    (r.K ? 1.0 : 0.0) + (r.C ? 2.0 : 0.0) + (r.Z ? 4.0 : 0.0),
+                                    theta_prev_,
+                                    static_cast<double>(refresh_steps_left_),
+                                    static_cast<double>(reuse_backoff_),
+                                    fd_tangents_ ? 1.0 : 0.0};
+    std::copy(header, header + kHeader, buf);
+    double *p = buf + kHeader;
+    for (const Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev, &r.q, &r.v, &r.qdd,
+                         &r.lambda, &r.q_b}) {
+        Eigen::Map<Vec>(p, x->size()) = *x;
+        p += x->size();
+    }
+    S_.save_pivots(buf + l.pivots[0]);
+    S2_.save_pivots(buf + l.pivots[1]);
+    P_.save_pivots(buf + l.pivots[2]);
+    O_.save_pivots(buf + l.pivots[3]);
+}
+
+ga_status Solver::set_state(const double *buf, std::size_t len)
+{
+    const bool layout2 = len >= 2 && buf[0] == kStateMagic && buf[1] == 2.0;
+    const Layout l = layout(n_, m_);
+    const std::size_t expected =
+        layout2 ? kHeader2 + 5 * static_cast<std::size_t>(n_) + static_cast<std::size_t>(m_)
+                : l.end;
+    if (len != expected)
+        return diag.fail(GA_ERR_ARG, "checkpoint has %zu doubles, this solver needs %zu", len,
+                         l.end);
+    if (buf[0] != kStateMagic || (buf[1] != kStateVersion && !layout2))
+        return diag.fail(GA_ERR_ARG, "not a galpha checkpoint (magic %g, layout version %g)",
+                         buf[0], buf[1]);
+    if (buf[2] != n_ || buf[3] != m_)
+        return diag.fail(GA_ERR_ARG, "checkpoint is for n = %g, m = %g; this solver has n = %d, "
+                         "m = %d", buf[2], buf[3], n_, m_);
+    for (std::size_t k = 4; k < len; ++k)
+        if (!std::isfinite(buf[k]))
+            return diag.fail(GA_ERR_ARG, "checkpoint entry %zu is not finite", k);
+    // The step-size controller's entries as a solver writes them: h_last and h_next are 0 (no
+    // step yet, no proposal) or steps that move t (ga_step refuses others); err_prev is not
+    // negative; grew is a flag. Anything else was not written by galpha, and would fail later,
+    // far from here (h_last = 1e-320 multiplies a_n by 1e317 when it is rescaled for the next
+    // step; h_next = 1e-320 ends the next adaptive step below its minimum).
+    const double t = buf[4];
+    for (const int k : {5, 6}) {
+        const double h = buf[k];
+        if (h < 0.0 || (h > 0.0 && t + h == t && t - h == t))
+            return diag.fail(GA_ERR_ARG, "checkpoint entry %d (%s = %g) is not a step from "
+                             "t = %.17g", k, k == 5 ? "h_last" : "h_next", h, t);
+    }
+    if (buf[7] < 0.0 || !is_flag(buf[8]))
+        return diag.fail(GA_ERR_ARG, "checkpoint entries 7-8 (err_prev = %g, grew = %g) are "
+                         "not those of galpha's step-size control", buf[7], buf[8]);
+    const double sliver_span = layout2 ? 0.0 : buf[9];
+    if (sliver_span < 0.0 || sliver_span > buf[5] / kShortStepRatio)
+        return diag.fail(GA_ERR_ARG, "checkpoint entry 9 (sliver_span = %g) is not a span of "
+                         "short steps after steps of h_last = %g", sliver_span, buf[5]);
+    const bool kept = !layout2 && buf[10] == 1.0;
+    if (!layout2 && (!is_flag(buf[10]) || (kept && !(buf[12] > 0.0)) ||
+                     !is_count(buf[14], 7.0) || !(buf[15] == -1.0 || buf[15] >= 0.0) ||
+                     !is_count(buf[16], 32.0) || !is_count(buf[17], 32.0) ||
+                     !(buf[17] >= 1.0) || !is_flag(buf[18])))
+        return diag.fail(GA_ERR_ARG, "checkpoint entries 10-18 (the kept iteration matrix and "
+                         "its reuse) are not those a solver writes");
+    if (!model.ready())
+        return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
+    if (auto st = setup())
+        return st;
+    if (!layout2) {
+        // The projection and the output matrix take their pivots now, as in the solver they
+        // came from, where they existed (set up there by an adaptive step, or by output).
+        if (buf[l.pivots[2]] == 1.0)
+            setup_projection();
+        if (buf[l.pivots[3]] == 1.0)
+            setup_output();
+        if (!S_.pivots_loadable(buf + l.pivots[0]) || !S2_.pivots_loadable(buf + l.pivots[1]) ||
+            !P_.pivots_loadable(buf + l.pivots[2]) || !O_.pivots_loadable(buf + l.pivots[3]))
+            return diag.fail(GA_ERR_ARG, "checkpoint entries %zu-%zu (the pivots of the sparse "
+                             "factorizations) are not those a solver writes", l.pivots[0],
+                             l.end - 1);
+    }
+    if (redundancy == GA_REDUNDANT_DROP && m_ > 0) {
+        const Vec q = Eigen::Map<const Vec>(buf + (layout2 ? kHeader2 : kHeader), n_);
+        const std::vector<unsigned char> active_before = active_;
+        if (auto st = select_active_constraints(buf[4], q)) {
+            restore_active(active_before);
+            return st;
+        }
+    }
+    State &s = accepted_;
+    s.t = buf[4];
+    s.h_last = buf[5];
+    s.sliver_span = sliver_span;
+    control.h_next = buf[6];
+    control.err_prev = buf[7];
+    control.grew = buf[8] != 0.0;
+    const double *p = buf + (layout2 ? kHeader2 : kHeader);
+    for (Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev}) {
+        *x = Eigen::Map<const Vec>(p, x->size());
+        p += x->size();
+    }
+    invalidate_jacobian();
+    previous_valid_ = false;
+    ++state_id_;
+    // A checkpoint from before the first step (h_last = 0) still owes that step its corrected
+    // starting values, as the solver it was taken from does.
+    start_pending_ = s.h_last == 0.0;
+    initialized_ = true;
+    if (layout2) {
+        pivots_forgotten_ = true;
+        return GA_OK;
+    }
+
+    pivots_forgotten_ = false;
+    S_.load_pivots(buf + l.pivots[0]);
+    S2_.load_pivots(buf + l.pivots[1]);
+    P_.load_pivots(buf + l.pivots[2]);
+    O_.load_pivots(buf + l.pivots[3]);
+    if (kept) {
+        MatrixRecipe &r = recipe_;
+        r.t = buf[11];
+        r.h = buf[12];
+        r.t_b = buf[13];
+        const int tangents = static_cast<int>(buf[14]);
+        r.K = (tangents & 1) != 0;
+        r.C = (tangents & 2) != 0;
+        r.Z = (tangents & 4) != 0;
+        for (Vec *x : {&r.q, &r.v, &r.qdd, &r.lambda, &r.q_b}) {
+            *x = Eigen::Map<const Vec>(p, x->size());
+            p += x->size();
+        }
+        // A callback that fails now costs the restored run its bit-identity only: it goes on
+        // as after a restart (layout 2), with a fresh matrix and the reuse history forgotten.
+        if (rebuild_matrix() != GA_OK) {
+            invalidate_jacobian();
+            diag.clear();
+            return GA_OK;
+        }
+    }
+    theta_prev_ = jacobian_valid_ ? buf[15] : -1.0;
+    refresh_steps_left_ = static_cast<int>(buf[16]);
+    reuse_backoff_ = static_cast<int>(buf[17]);
+    fd_tangents_ = buf[18] != 0.0;
+    return GA_OK;
+}
+
+// The kept iteration matrix, evaluated and factorized as Newton did (Solver::newton).
+ga_status Solver::rebuild_matrix()
+{
+    const MatrixRecipe &r = recipe_;
+    State &x = trial_;  // scratch between steps
+    x.q = r.q;
+    x.v = r.v;
+    x.qdd = r.qdd;
+    x.lambda = r.lambda;
+    ga_status st = residual(r.t, x);
+    if (!st && formulation == GA_INDEX2_STABILIZED && m_ > 0) {
+        st = model.jacobian(r.t_b, r.q_b, B_);
+        b_t_ = r.t_b;
+        b_q_ = &r.q_b;
+    }
+    if (!st && r.K)
+        st = model.stiffness(r.t, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_);
+    if (!st && r.C)
+        st = model.damping(r.t, x.q, x.v, f_, C_);
+    if (!st && r.Z)
+        st = model.velocity_constraint_tangent(r.t, x.q, x.v, J_, Z_);
+    if (!st)
+        st = factorize(r.t, x, r.h, r.K, r.C, r.Z, 0);
+    return st;
+}
+
+}  // namespace ga
