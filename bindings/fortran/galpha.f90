@@ -3,9 +3,9 @@
 ! Two layers in one module:
 !  1. bind(C) interfaces to every function of galpha.h, under the C names (ga_create, ga_step,
 !     ...), with the status, counter and option constants;
-!  2. a thin Fortran layer: type(galpha_solver) with type-bound procedures that take
-!     assumed-shape arrays and check their sizes, and galpha_message / galpha_strerror that
-!     return Fortran strings.
+!  2. a thin Fortran layer over all of them: type(galpha_solver) with type-bound procedures
+!     that take assumed-shape arrays and check their sizes, and galpha_version /
+!     galpha_strerror that return Fortran strings.
 ! Callbacks are Fortran procedures with bind(C) and the interfaces ga_mass_fn, ... below
 ! (scalars by value, arrays as explicit-shape or assumed-size, `user` as type(c_ptr), value);
 ! matrices are column-major, which is Fortran's own order: M(n, n), Phi_q(m, n).
@@ -347,7 +347,7 @@ module galpha
        import :: c_int, c_ptr, c_double
        type(c_ptr), value :: s
        real(c_double), value :: t
-       real(c_double), intent(out) :: q(*), v(*), lambda(*)
+       real(c_double), intent(out), optional :: q(*), v(*), lambda(*)  ! absent: NULL
      end function ga_interpolate
      integer(c_int) function ga_interpolate_qdd(s, t, qdd) bind(C, name="ga_interpolate_qdd")
        import :: c_int, c_ptr, c_double
@@ -430,8 +430,33 @@ module galpha
      procedure :: get_lambda => solver_get_lambda
      procedure :: counter => solver_counter
      procedure :: message => solver_message
+     !> get_size(n, m): the sizes the C solver was created with
+     procedure :: get_size => solver_get_size
+     procedure :: set_params => solver_set_params
+     procedure :: get_params => solver_get_params
+     procedure :: set_tangent_mode => solver_set_tangent_mode
+     procedure :: set_scaling => solver_set_scaling
+     procedure :: set_jacobian_reuse => solver_set_jacobian_reuse
+     procedure :: set_predictor => solver_set_predictor
+     procedure :: set_rescale => solver_set_rescale
+     procedure :: set_corrected_start => solver_set_corrected_start
+     procedure :: set_init_mode => solver_set_init_mode
+     procedure :: set_step_limits => solver_set_step_limits
+     procedure :: set_initial_step => solver_set_initial_step
+     procedure :: step_adaptive => solver_step_adaptive
+     procedure :: get_a => solver_get_a
+     !> h_last(): the last step of Algorithm 1 (NaN if the call fails)
+     procedure :: h_last => solver_h_last
+     !> state_size(): doubles in a checkpoint (-1 if the call fails); get_state(buf) and
+     !> set_state(buf) take a buffer of exactly that size
+     procedure :: state_size => solver_state_size
+     procedure :: get_state => solver_get_state
+     procedure :: set_state => solver_set_state
+     procedure :: reset_counters => solver_reset_counters
+     !> get_info(key, value): GA_INFO_* of the last step
+     procedure :: get_info => solver_get_info
   end type galpha_solver
-  public :: galpha_strerror, galpha_version
+  public :: galpha_strerror, galpha_version, galpha_version_number
 
 contains
 
@@ -463,6 +488,10 @@ contains
     character(len=:), allocatable :: s
     s = c_to_f(ga_version())
   end function galpha_version
+
+  integer function galpha_version_number()
+    galpha_version_number = int(ga_version_number())
+  end function galpha_version_number
 
   integer(c_int) function solver_create(this, n, m) result(status)
     class(galpha_solver), intent(inout) :: this
@@ -657,17 +686,19 @@ contains
   integer(c_int) function solver_interpolate(this, t, q, v, lambda) result(status)
     class(galpha_solver), intent(inout) :: this
     real(c_double), intent(in) :: t
-    real(c_double), intent(out) :: q(:), v(:), lambda(:)
-    real(c_double) :: none(1)
-    if (size(q) < this%n .or. size(v) < this%n .or. size(lambda) < this%m) then
-       status = GA_ERR_ARG
-       return
+    real(c_double), intent(out), optional :: q(:), v(:), lambda(:)
+    status = GA_ERR_ARG
+    if (present(q)) then
+       if (size(q) < this%n) return
     end if
-    if (this%m > 0) then
-       status = ga_interpolate(this%handle, t, q, v, lambda)
-    else
-       status = ga_interpolate(this%handle, t, q, v, none)
+    if (present(v)) then
+       if (size(v) < this%n) return
     end if
+    if (present(lambda)) then
+       if (size(lambda) < this%m) return
+    end if
+    ! an absent argument reaches C as NULL (Fortran 2018, optional in bind(C) interfaces)
+    status = ga_interpolate(this%handle, t, q, v, lambda)
   end function solver_interpolate
 
   integer(c_int) function solver_interpolate_qdd(this, t, qdd) result(status)
@@ -746,5 +777,131 @@ contains
     character(len=:), allocatable :: s
     s = c_to_f(ga_last_error(this%handle))
   end function solver_message
+
+  integer(c_int) function solver_get_size(this, n, m) result(status)
+    class(galpha_solver), intent(in) :: this
+    integer, intent(out) :: n, m
+    integer(c_int) :: cn, cm
+    status = ga_get_size(this%handle, cn, cm)
+    n = int(cn)
+    m = int(cm)
+  end function solver_get_size
+
+  integer(c_int) function solver_set_params(this, alpha_m, alpha_f, beta, gamma) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: alpha_m, alpha_f, beta, gamma
+    status = ga_set_params(this%handle, alpha_m, alpha_f, beta, gamma)
+  end function solver_set_params
+
+  integer(c_int) function solver_get_params(this, alpha_m, alpha_f, beta, gamma) &
+       result(status)
+    class(galpha_solver), intent(in) :: this
+    real(c_double), intent(out) :: alpha_m, alpha_f, beta, gamma
+    status = ga_get_params(this%handle, alpha_m, alpha_f, beta, gamma)
+  end function solver_get_params
+
+  integer(c_int) function solver_set_tangent_mode(this, mode) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: mode
+    status = ga_set_tangent_mode(this%handle, mode)
+  end function solver_set_tangent_mode
+
+  integer(c_int) function solver_set_scaling(this, on) result(status)
+    class(galpha_solver), intent(inout) :: this
+    logical, intent(in) :: on
+    status = ga_set_scaling(this%handle, merge(1_c_int, 0_c_int, on))
+  end function solver_set_scaling
+
+  integer(c_int) function solver_set_jacobian_reuse(this, mode) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: mode
+    status = ga_set_jacobian_reuse(this%handle, mode)
+  end function solver_set_jacobian_reuse
+
+  integer(c_int) function solver_set_predictor(this, predictor) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: predictor
+    status = ga_set_predictor(this%handle, predictor)
+  end function solver_set_predictor
+
+  integer(c_int) function solver_set_rescale(this, on) result(status)
+    class(galpha_solver), intent(inout) :: this
+    logical, intent(in) :: on
+    status = ga_set_rescale(this%handle, merge(1_c_int, 0_c_int, on))
+  end function solver_set_rescale
+
+  integer(c_int) function solver_set_corrected_start(this, on) result(status)
+    class(galpha_solver), intent(inout) :: this
+    logical, intent(in) :: on
+    status = ga_set_corrected_start(this%handle, merge(1_c_int, 0_c_int, on))
+  end function solver_set_corrected_start
+
+  integer(c_int) function solver_set_init_mode(this, mode, init_tol) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: mode
+    real(c_double), intent(in) :: init_tol
+    status = ga_set_init_mode(this%handle, mode, init_tol)
+  end function solver_set_init_mode
+
+  integer(c_int) function solver_set_step_limits(this, h_min, h_max) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: h_min, h_max
+    status = ga_set_step_limits(this%handle, h_min, h_max)
+  end function solver_set_step_limits
+
+  integer(c_int) function solver_set_initial_step(this, h0) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: h0
+    status = ga_set_initial_step(this%handle, h0)
+  end function solver_set_initial_step
+
+  integer(c_int) function solver_step_adaptive(this, t_stop) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t_stop
+    status = ga_step_adaptive(this%handle, t_stop)
+  end function solver_step_adaptive
+
+  integer(c_int) function solver_get_a(this, a) result(status)
+    class(galpha_solver), intent(in) :: this
+    real(c_double), intent(out) :: a(:)
+    status = copy_out(this, ga_get_a, a, this%n)
+  end function solver_get_a
+
+  real(c_double) function solver_h_last(this) result(h)
+    class(galpha_solver), intent(in) :: this
+    if (ga_get_h_last(this%handle, h) /= GA_OK) h = ieee_nan()
+  end function solver_h_last
+
+  integer function solver_state_size(this) result(len)
+    class(galpha_solver), intent(in) :: this
+    integer(c_size_t) :: n
+    len = -1
+    if (ga_state_size(this%handle, n) == GA_OK) len = int(n)
+  end function solver_state_size
+
+  integer(c_int) function solver_get_state(this, buf) result(status)
+    class(galpha_solver), intent(in) :: this
+    real(c_double), intent(out) :: buf(:)
+    status = ga_get_state(this%handle, buf, int(size(buf), c_size_t))
+  end function solver_get_state
+
+  integer(c_int) function solver_set_state(this, buf) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: buf(:)
+    status = ga_set_state(this%handle, buf, int(size(buf), c_size_t))
+  end function solver_set_state
+
+  integer(c_int) function solver_reset_counters(this) result(status)
+    class(galpha_solver), intent(inout) :: this
+    status = ga_reset_counters(this%handle)
+  end function solver_reset_counters
+
+  integer(c_int) function solver_get_info(this, key, value) result(status)
+    class(galpha_solver), intent(in) :: this
+    integer(c_int), intent(in) :: key
+    real(c_double), intent(out) :: value
+    status = ga_get_info(this%handle, key, value)
+  end function solver_get_info
 
 end module galpha

@@ -172,6 +172,48 @@ def test_input_views_are_read_only():
             s.init(0.0, Q0, V0)
 
 
+def test_inputs_cannot_be_made_writeable():
+    def prying_mass(t, q, M):
+        q.flags.writeable = True
+
+    with galpha.Solver(2, 1, prying_mass, force, constraint, jacobian) as s:
+        with pytest.raises(ValueError, match="WRITEABLE"):
+            s.init(0.0, Q0, V0)
+
+
+def test_arrays_a_callback_keeps_stay_its_own():
+    """What a callback keeps of its arguments neither changes with later calls nor reaches
+    the library: a kept input keeps its values, a kept output written later (also after
+    close()) changes nothing in the run, which stays that of a solver whose callbacks keep
+    nothing."""
+    kept = []
+
+    def keeping_mass(t, q, M):
+        kept.append((q, q.copy(), M))
+        M[:] = np.eye(2)
+
+    def keeping_jacobian(t, q, J):
+        jacobian(t, q, J)
+        kept.append((q, q.copy(), J))
+
+    with galpha.Solver(2, 1, keeping_mass, force, constraint, keeping_jacobian) as a, \
+            pendulum() as b:
+        for s in (a, b):
+            s.init(0.0, Q0, V0)
+        for k in range(40):
+            for s in (a, b):
+                s.step(2e-3)
+            for q, q_then, out in kept:
+                out[...] = 1e300 * k  # written after the call returned
+        assert len(kept) > 40
+        for q, q_then, _ in kept:
+            assert np.array_equal(q, q_then)
+        assert np.array_equal(a.get_state(), b.get_state())
+    for q, q_then, out in kept:
+        out[...] = -1.0  # after close()
+        assert np.array_equal(q, q_then)
+
+
 def test_checkpoint_restart_is_bit_identical():
     with pendulum() as a, pendulum() as b:
         a.init(0.0, Q0, V0)
@@ -348,6 +390,12 @@ def test_fortran_module_declares_every_c_function():
     fortran = open(os.path.join(root, "bindings", "fortran", "galpha.f90")).read()
     bound = set(re.findall(r'bind\(C, name="(ga_\w+)"\)', fortran))
     assert declared - bound == set()
+    # ... and the Fortran layer wraps each of them: a type-bound procedure or a module
+    # function that calls it (ga_free through free, ga_get_t through t, ...)
+    layer = fortran[fortran.index("! ---- the Fortran layer"):]
+    called = set(re.findall(r"\b(ga_\w+)\(", layer))
+    called |= set(re.findall(r"copy_out\(this, (ga_\w+),", layer))
+    assert declared - called == set()
 
 
 def test_redundant_constraint_dropped():

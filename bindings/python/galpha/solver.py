@@ -3,10 +3,11 @@ numpy arrays.
 
 Callbacks fill their output array in place and return None (or 0) on success, a positive int
 for a recoverable failure (the step is rejected) or a negative int for a fatal one. Their
-array arguments are numpy views of the library's own buffers -- no copies -- so inputs must be
-treated as read-only (they are flagged so) and outputs must not be kept after the call.
-Matrices are seen in their natural shape (M: n x n, Phi_q: m x n); storage underneath is
-column-major, as in the C API.
+array arguments are their own: inputs are read-only copies (they cannot be made writeable),
+the output starts zeroed and is copied into the library's buffer when the callback returns
+successfully. Whatever a callback keeps of them stays valid and unchanged, also after
+close(). Matrices are seen in their natural shape (M: n x n, Phi_q: m x n), column-major
+(Fortran order) as in the C API.
 
 A Python exception raised inside a callback makes the step fail cleanly (the solver stays at
 its last accepted state) and is re-raised, with its traceback, from the call that stepped.
@@ -15,6 +16,7 @@ import ctypes
 import functools
 import signal
 import threading
+from ctypes import string_at
 
 import numpy as np
 
@@ -182,17 +184,25 @@ class Solver:
                       "jacobian": jacobian, "stiffness": stiffness, "damping": damping,
                       "constraint_accel": constraint_accel, "constraint_dt": constraint_dt}
 
-        # Trampolines: views of the library's buffers, every exception caught and stored.
-        # The return value counts by its sign, as in C: int() would pass 2**32 through the
-        # C int as 0 (success) and truncate -0.5 to 0; a value without a sign (NaN, a string)
-        # is an error of the callback.
-        def call(fn, *args):
+        # Trampolines. A callback gets its inputs as read-only copies and fills a zeroed array
+        # of its own, copied into the library's buffer when it returns: whatever it keeps of
+        # them stays valid and unchanged after the call (and after close()), and nothing it
+        # does reaches the library's memory outside the call. Every exception is caught and
+        # stored. The return value counts by its sign, as in C: int() would pass 2**32
+        # through the C int as 0 (success) and truncate -0.5 to 0; a value without a sign
+        # (NaN, a string) is an error of the callback.
+        def call(fn, out_address, out_shape, t, *inputs):
             if self._pending is not None or self._interrupted:
                 return -1
             self._in_callback += 1
             try:
-                rc = fn(*args)
+                # inputs over immutable bytes: read-only for good (writeable cannot be set)
+                args = [t] + [np.frombuffer(string_at(address, 8 * size) if size else b"")
+                              for address, size in inputs]
+                out = np.zeros(out_shape, order="F")
+                rc = fn(*args, out)
                 if rc is None or rc == 0:
+                    v(out_address, out_shape, True)[...] = out
                     return 0
                 if rc > 0:
                     return 1
@@ -207,25 +217,24 @@ class Solver:
                 self._in_callback -= 1
 
         self._cbs = [
-            _MASS(lambda t, q, M, u: call(mass, t, v(q, (n,)), v(M, shape("mass", (n, n)),
-                                                                True))),
-            _FORCE(lambda t, q, qd, f, u: call(force, t, v(q, (n,)), v(qd, (n,)),
-                                               v(f, (n,), True))) if force else None,
-            _CONSTRAINT(lambda t, q, p, u: call(constraint, t, v(q, (n,)),
-                                                v(p, (m,), True))) if m and constraint else None,
-            _CONSTRAINT(lambda t, q, J, u: call(jacobian, t, v(q, (n,)),
-                                                v(J, shape("jacobian", (m, n)), True)))
+            _MASS(lambda t, q, M, u: call(mass, M, shape("mass", (n, n)), t, (q, n))),
+            _FORCE(lambda t, q, qd, f, u: call(force, f, (n,), t, (q, n), (qd, n)))
+            if force else None,
+            _CONSTRAINT(lambda t, q, p, u: call(constraint, p, (m,), t, (q, n)))
+            if m and constraint else None,
+            _CONSTRAINT(lambda t, q, J, u: call(jacobian, J, shape("jacobian", (m, n)), t,
+                                                (q, n)))
             if m and jacobian else None,
             _STIFFNESS(lambda t, q, qd, a, lam, K, u: call(
-                stiffness, t, v(q, (n,)), v(qd, (n,)), v(a, (n,)), v(lam, (m,)),
-                v(K, shape("stiffness", (n, n)), True))) if stiffness else None,
-            _FORCE(lambda t, q, qd, C, u: call(damping, t, v(q, (n,)), v(qd, (n,)),
-                                               v(C, shape("damping", (n, n)), True)))
+                stiffness, K, shape("stiffness", (n, n)), t, (q, n), (qd, n), (a, n), (lam, m)))
+            if stiffness else None,
+            _FORCE(lambda t, q, qd, C, u: call(damping, C, shape("damping", (n, n)), t,
+                                               (q, n), (qd, n)))
             if damping else None,
-            _FORCE(lambda t, q, qd, o, u: call(constraint_accel, t, v(q, (n,)), v(qd, (n,)),
-                                               v(o, (m,), True))) if constraint_accel else None,
-            _CONSTRAINT(lambda t, q, o, u: call(constraint_dt, t, v(q, (n,)),
-                                                v(o, (m,), True))) if m and constraint_dt else None,
+            _FORCE(lambda t, q, qd, o, u: call(constraint_accel, o, (m,), t, (q, n), (qd, n)))
+            if constraint_accel else None,
+            _CONSTRAINT(lambda t, q, o, u: call(constraint_dt, o, (m,), t, (q, n)))
+            if m and constraint_dt else None,
         ]
         mc, fc, cc, jc, kc, dc, ac, tc = self._cbs
         self._check(_ffi.ga_set_callbacks(self._ptr, _cast(mc, _ffi.MASS_FN),

@@ -1,0 +1,176 @@
+! The Fortran layer (type(galpha_solver)) over the whole C API: each type-bound procedure
+! against what the C API or the analysis says. Stops with a nonzero code at the first failure.
+module layer_model
+  use, intrinsic :: iso_c_binding
+  implicit none
+  real(c_double), parameter :: g = 9.81d0
+contains
+  integer(c_int) function p_mass(t, q, M, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*)
+    real(c_double), intent(out) :: M(*)
+    type(c_ptr), value :: user
+    M(1:4) = [1.0d0, 0.0d0, 0.0d0, 1.0d0]
+    p_mass = 0
+  end function p_mass
+  integer(c_int) function p_force(t, q, v, f, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*)
+    real(c_double), intent(out) :: f(*)
+    type(c_ptr), value :: user
+    f(1:2) = [0.0d0, -g]
+    p_force = 0
+  end function p_force
+  integer(c_int) function p_constraint(t, q, phi, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*)
+    real(c_double), intent(out) :: phi(*)
+    type(c_ptr), value :: user
+    phi(1) = 0.5d0 * (q(1) * q(1) + q(2) * q(2) - 1.0d0)
+    p_constraint = 0
+  end function p_constraint
+  integer(c_int) function p_jacobian(t, q, J, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*)
+    real(c_double), intent(out) :: J(*)
+    type(c_ptr), value :: user
+    J(1:2) = q(1:2)
+    p_jacobian = 0
+  end function p_jacobian
+end module layer_model
+
+program test_layer
+  use galpha
+  use layer_model
+  implicit none
+  type(galpha_solver) :: s, r
+  real(c_double) :: q(2), v(2), a(2), lam(1), q2(2), v2(2), lam2(1), x, am, af, beta, gam
+  real(c_double), allocatable :: ckpt(:), back(:)
+  real(c_double), parameter :: rho = 0.8d0
+  integer :: n, m, i, nstate
+  character(len=32) :: text
+
+  n = galpha_version_number()
+  write (text, '(i0, ".", i0, ".", i0)') n / 10000, mod(n / 100, 100), mod(n, 100)
+  call expect(galpha_version() == trim(text), 'version string and number agree')
+  call expect(galpha_strerror(GA_ERR_ARG) /= galpha_strerror(GA_OK), 'strerror')
+
+  call ok(s%create(2, 1), 'create')
+  call ok(s%get_size(n, m), 'get_size')
+  call expect(n == 2 .and. m == 1, 'get_size values')
+  call ok(s%set_callbacks(p_mass, p_force, p_constraint, p_jacobian), 'set_callbacks')
+
+  ! parameters from rho_inf (Chung-Hulbert): alpha_m = (2 rho - 1)/(rho + 1), alpha_f =
+  ! rho/(rho + 1), gamma = 1/2 + alpha_f - alpha_m, beta = (gamma + 1/2)^2 / 4
+  call ok(s%set_rho_inf(rho), 'set_rho_inf')
+  call ok(s%get_params(am, af, beta, gam), 'get_params')
+  call expect(abs(am - (2 * rho - 1) / (rho + 1)) < 1d-15 .and. &
+              abs(af - rho / (rho + 1)) < 1d-15 .and. &
+              abs(gam - (0.5d0 + af - am)) < 1d-15 .and. &
+              abs(beta - 0.25d0 * (gam + 0.5d0)**2) < 1d-15, 'parameters of rho_inf')
+  call ok(s%set_params(am, af, beta, gam), 'set_params')
+  call expect(s%set_params(0.9d0, 0.1d0, beta, gam) == GA_ERR_ARG, 'set_params refuses')
+  call expect(len(s%message()) > 0, 'message after a refusal')
+
+  ! every option setter: accepts a valid value, refuses an invalid one
+  call ok(s%set_tangent_mode(GA_TANGENT_AUTO), 'set_tangent_mode')
+  call expect(s%set_tangent_mode(99_c_int) == GA_ERR_ARG, 'set_tangent_mode refuses')
+  call ok(s%set_scaling(.true.), 'set_scaling')
+  call ok(s%set_jacobian_reuse(GA_REUSE_AUTO), 'set_jacobian_reuse')
+  call expect(s%set_jacobian_reuse(99_c_int) == GA_ERR_ARG, 'set_jacobian_reuse refuses')
+  call ok(s%set_predictor(GA_PREDICTOR_EXTRAPOLATE), 'set_predictor')
+  call expect(s%set_predictor(99_c_int) == GA_ERR_ARG, 'set_predictor refuses')
+  call ok(s%set_rescale(.true.), 'set_rescale')
+  call ok(s%set_corrected_start(.true.), 'set_corrected_start')
+  call ok(s%set_init_mode(GA_INIT_PROJECT, 1d-10), 'set_init_mode')
+  call expect(s%set_init_mode(GA_INIT_PROJECT, -1d0) == GA_ERR_ARG, 'set_init_mode refuses')
+  call ok(s%set_tolerances(1d-6, 1d-6), 'set_tolerances')
+  call ok(s%set_step_limits(1d-10, 0.05d0), 'set_step_limits')
+  call expect(s%set_step_limits(0.1d0, 0.05d0) == GA_ERR_ARG, 'set_step_limits refuses')
+  call ok(s%set_initial_step(1d-3), 'set_initial_step')
+  call expect(s%set_initial_step(-1d0) == GA_ERR_ARG, 'set_initial_step refuses')
+
+  ! before ga_init: state queries fail with GA_ERR_STATE, h_last is NaN
+  call expect(s%get_a(a) == GA_ERR_STATE, 'get_a before init')
+  x = s%h_last()
+  call expect(x /= x, 'h_last before init is NaN')
+  nstate = s%state_size()
+  call expect(nstate > 0, 'state_size')
+  allocate (ckpt(nstate), back(nstate))
+  call expect(s%get_state(ckpt) == GA_ERR_STATE, 'get_state before init')
+
+  call ok(s%init(0.0d0, [sin(1.0d0), -cos(1.0d0)], [0.0d0, 0.0d0]), 'init')
+  call ok(s%get_a(a), 'get_a')
+  call expect(s%h_last() == 0.0d0, 'h_last after init')
+
+  ! adaptive steps to t = 1: they land on t_stop, respect h_max, keep |q| = 1
+  do while (s%t() < 1.0d0)
+     call ok(s%step_adaptive(1.0d0), 'step_adaptive')
+     call expect(s%h_last() <= 0.05d0, 'h_max')
+  end do
+  call expect(s%t() == 1.0d0, 'adaptive steps land on t_stop')
+  call ok(s%get_q(q), 'get_q')
+  call expect(abs(norm2(q) - 1.0d0) < 1d-10, 'constraint held')
+  call ok(s%get_info(GA_INFO_NEWTON_ITERS, x), 'get_info')
+  call expect(x >= 1.0d0, 'Newton iterations of the last step')
+  call ok(s%get_info(GA_INFO_H_NEXT, x), 'get_info h_next')
+  call expect(x > 0.0d0 .and. x <= 0.05d0, 'proposed next step')
+  call expect(s%get_info(99_c_int, x) == GA_ERR_ARG, 'get_info refuses an unknown key')
+  call expect(s%counter(GA_COUNT_STEPS) > 0, 'steps counted')
+  call ok(s%reset_counters(), 'reset_counters')
+  call expect(s%counter(GA_COUNT_STEPS) == 0, 'counters reset')
+
+  ! dense output: any output may be omitted, and what is asked for is the same
+  x = s%t() - 0.5d0 * s%h_last()
+  call ok(s%interpolate(x, q, v, lam), 'interpolate (all)')
+  call ok(s%interpolate(x, q=q2), 'interpolate (q only)')
+  call ok(s%interpolate(x, v=v2), 'interpolate (v only)')
+  call ok(s%interpolate(x, lambda=lam2), 'interpolate (lambda only)')
+  call expect(all(q == q2) .and. all(v == v2) .and. all(lam == lam2), 'interpolate parts')
+  call expect(s%interpolate(x, q=q2(1:1)) == GA_ERR_ARG, 'interpolate checks sizes')
+  call expect(s%interpolate(s%t() + 1.0d0, q=q2) == GA_ERR_ARG, 'interpolate outside the step')
+
+  ! checkpoint: a new solver restored from it repeats the run bit for bit
+  call ok(s%get_state(ckpt), 'get_state')
+  call expect(s%get_state(ckpt(1:nstate - 1)) == GA_ERR_ARG, 'get_state checks the length')
+  call ok(r%create(2, 1), 'create r')
+  call ok(r%set_callbacks(p_mass, p_force, p_constraint, p_jacobian), 'set_callbacks r')
+  call ok(r%set_rho_inf(rho), 'set_rho_inf r')
+  call ok(r%set_tolerances(1d-6, 1d-6), 'set_tolerances r')
+  call ok(r%set_step_limits(1d-10, 0.05d0), 'set_step_limits r')
+  call expect(r%set_state(ckpt(1:nstate - 1)) == GA_ERR_ARG, 'set_state checks the length')
+  call ok(r%set_state(ckpt), 'set_state')
+  do i = 1, 20
+     call ok(s%step_adaptive(2.0d0), 'step_adaptive s')
+     call ok(r%step_adaptive(2.0d0), 'step_adaptive r')
+  end do
+  call ok(s%get_state(ckpt), 'get_state s')
+  call ok(r%get_state(back), 'get_state r')
+  call expect(all(ckpt == back), 'restart is bit-identical')
+
+  call s%free()
+  call r%free()
+  x = s%h_last()
+  call expect(x /= x .and. s%state_size() == -1, 'freed solver')
+  print '(a)', 'test_layer: all checks passed'
+
+contains
+
+  subroutine ok(status, what)
+    integer(c_int), intent(in) :: status
+    character(*), intent(in) :: what
+    if (status /= GA_OK) then
+       print '(a)', what // ': ' // galpha_strerror(status)
+       error stop 1
+    end if
+  end subroutine ok
+
+  subroutine expect(cond, what)
+    logical, intent(in) :: cond
+    character(*), intent(in) :: what
+    if (.not. cond) then
+       print '(a)', 'FAILED: ' // what
+       error stop 1
+    end if
+  end subroutine expect
+end program test_layer
