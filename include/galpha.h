@@ -219,7 +219,7 @@ GA_API ga_status ga_step(ga_solver *s, double h);
  *  step, which norm. Every call that can change the solver (ga_init, ga_step, ga_set_*,
  *  ga_reset_counters) clears it when it starts; read-only calls (ga_get_*, ga_interpolate*)
  *  leave it when they succeed, so it can be read after inspecting the state, and replace it
- *  with their own when they fail (ga_get_info, ga_interpolate*, consistent output). "" when
+ *  with their own when they fail. "" when
  *  there is nothing to report. The string belongs to the solver. ga_last_error(NULL) returns a
  *  fixed message. */
 GA_API const char *ga_last_error(const ga_solver *s);
@@ -634,7 +634,8 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
  *  Layout 3 (treat it as opaque): a header [magic, layout version, n, m, t, h_last, h_next,
  *  err_prev, grew, sliver_span, then 9 entries on the kept iteration matrix and its reuse],
  *  the state q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n), the iterate the kept matrix was
- *  factorized at, and the pivots of the sparse factorizations (zeros on the dense path).
+ *  factorized at, the constraints in use (m flags), and the pivots of the sparse
+ *  factorizations (zeros on the dense path).
  *  h_next, err_prev, grew: the step-size controller; sliver_span: the time covered by slivers
  *  since the last step of Algorithm 1 (see ga_step); a_prev: the a of the step before, for
  *  the error estimate. ga_set_state rebuilds the kept matrix from the callbacks at that
@@ -642,9 +643,9 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
  *  fail there, the next step factorizes afresh instead, and the run continues as after a
  *  restart) and gives each sparse factorization its pivots back. A failed step drops the
  *  kept matrix, so the checkpoint taken after it has none. ga_set_state also reads layout 2
- *  (galpha 0.2), as a restart: a fresh iteration matrix, sparse pivots chosen afresh.
- *  With GA_REDUNDANT_DROP, ga_set_state selects the active constraints anew at the
- *  checkpoint's q. ga_set_state needs callbacks set, allocates like ga_init (when the solver
+ *  (galpha 0.2), as a restart: a fresh iteration matrix, sparse pivots chosen afresh, and
+ *  with GA_REDUNDANT_DROP the constraints in use selected anew at its q. ga_set_state needs
+ *  callbacks set, allocates like ga_init (when the solver
  *  was not initialized) and makes the solver initialized; dense output (ga_interpolate) is
  *  available again after the next step. */
 /**@{*/
@@ -655,9 +656,8 @@ GA_API ga_status ga_get_state(const ga_solver *s, double *buf, size_t len);
 /** Errors: GA_ERR_ARG (NULL, wrong length, magic, version or sizes, non-finite values, or
  *  step-size entries galpha never writes: h_last or h_next negative or too small to move t,
  *  err_prev negative, grew other than 0 or 1, sliver_span negative or over h_last / 100,
- *  entries 10-18 or the pivots not as a solver writes them), GA_ERR_STATE (callbacks not
- *  set),
- *  GA_ERR_NOMEM. */
+ *  entries 10-18 or the pivots not as a solver writes them, a constraint dropped while this
+ *  solver keeps every constraint), GA_ERR_STATE (callbacks not set), GA_ERR_NOMEM. */
 GA_API ga_status ga_set_state(ga_solver *s, const double *buf, size_t len);
 /**@}*/
 

@@ -79,15 +79,35 @@ ga_status guarded(ga_solver *s, Body &&body)
     return call(s, true, std::forward<Body>(body));
 }
 
-// Read-only calls: the same refusal from callbacks; they cannot throw and keep the message.
+// A read-only call that failed says why in ga_last_error, instead of leaving an earlier
+// failure's message there to mislead; unless another call holds the solver (then that call
+// owns the message).
+void explain(const ga_solver *s, ga_status st, const char *name, const char *bad_argument)
+{
+    auto *w = const_cast<ga_solver *>(s);
+    bool idle = false;
+    if (!w->busy.compare_exchange_strong(idle, true))
+        return;
+    if (st == GA_ERR_STATE)
+        w->core.diag.fail(st, "%s before ga_init or ga_set_state", name);
+    else
+        w->core.diag.fail(st, "%s: %s", name, bad_argument);
+    w->busy = false;
+}
+
+// Read-only calls: the same refusal from callbacks; they cannot throw, keep the message when
+// they succeed and replace it when they fail (GA_ERR_ARG: `bad_argument` says which).
 template <class Body>
-ga_status reading(const ga_solver *s, Body &&body)
+ga_status reading(const ga_solver *s, const char *name, const char *bad_argument, Body &&body)
 {
     if (!s)
         return GA_ERR_ARG;
     if (s->busy)
         return GA_ERR_STATE;
-    return body(s->core);
+    const ga_status st = body(s->core);
+    if (st != GA_OK)
+        explain(s, st, name, bad_argument);
+    return st;
 }
 
 // Calls that read the solver but may evaluate callbacks (consistent output): a success keeps
@@ -204,7 +224,7 @@ GA_API void ga_free(ga_solver *s)
 
 GA_API ga_status ga_get_size(const ga_solver *s, int *n, int *m)
 {
-    return reading(s, [&](const ga::Solver &c) {
+    return reading(s, "ga_get_size", "n or m is NULL", [&](const ga::Solver &c) {
         if (!n || !m)
             return GA_ERR_ARG;
         *n = c.n();
@@ -295,7 +315,7 @@ GA_API ga_status ga_set_params(ga_solver *s, double alpha_m, double alpha_f, dou
 GA_API ga_status ga_get_params(const ga_solver *s, double *alpha_m, double *alpha_f,
                                double *beta, double *gamma)
 {
-    return reading(s, [&](const ga::Solver &c) {
+    return reading(s, "ga_get_params", "no argument can fail", [&](const ga::Solver &c) {
         if (alpha_m)
             *alpha_m = c.params.alpha_m;
         if (alpha_f)
@@ -437,7 +457,8 @@ GA_API ga_status ga_set_redundant_constraints(ga_solver *s, int mode)
 
 GA_API ga_status ga_get_active_constraints(const ga_solver *s, int *active)
 {
-    return reading(s, [&](const ga::Solver &c) {
+    return reading(s, "ga_get_active_constraints", "active is NULL",
+                   [&](const ga::Solver &c) {
         if (!active)
             return GA_ERR_ARG;
         if (!c.initialized())
@@ -616,7 +637,7 @@ GA_API ga_status ga_step(ga_solver *s, double h)
 
 GA_API ga_status ga_get_t(const ga_solver *s, double *t)
 {
-    return reading(s, [&](const ga::Solver &c) {
+    return reading(s, "ga_get_t", "t is NULL", [&](const ga::Solver &c) {
         if (!t)
             return GA_ERR_ARG;
         if (!c.initialized())
@@ -628,7 +649,7 @@ GA_API ga_status ga_get_t(const ga_solver *s, double *t)
 
 GA_API ga_status ga_get_h_last(const ga_solver *s, double *h)
 {
-    return reading(s, [&](const ga::Solver &c) {
+    return reading(s, "ga_get_h_last", "h is NULL", [&](const ga::Solver &c) {
         if (!h)
             return GA_ERR_ARG;
         if (!c.initialized())
@@ -640,21 +661,23 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h)
 
 GA_API ga_status ga_get_q(const ga_solver *s, double *q)
 {
-    return reading(s, [&](const ga::Solver &c) { return copy_out(c, c.state().q, q); });
+    return reading(s, "ga_get_q", "q is NULL",
+                   [&](const ga::Solver &c) { return copy_out(c, c.state().q, q); });
 }
 
 GA_API ga_status ga_get_v(const ga_solver *s, double *v)
 {
-    return reading(s, [&](const ga::Solver &c) { return copy_out(c, c.state().v, v); });
+    return reading(s, "ga_get_v", "v is NULL",
+                   [&](const ga::Solver &c) { return copy_out(c, c.state().v, v); });
 }
 
 GA_API ga_status ga_get_qdd(const ga_solver *s, double *qdd)
 {
     return computing(s, [&](ga::Solver &c) {
         if (!qdd)
-            return GA_ERR_ARG;
+            return c.diag.fail(GA_ERR_ARG, "ga_get_qdd: qdd is NULL");
         if (!c.initialized())
-            return GA_ERR_STATE;
+            return c.diag.fail(GA_ERR_STATE, "ga_get_qdd before ga_init or ga_set_state");
         return c.output_state(qdd, nullptr);
     });
 }
@@ -665,9 +688,9 @@ GA_API ga_status ga_get_lambda(const ga_solver *s, double *lambda)
         if (c.m() == 0 && c.initialized())
             return GA_OK;  // nothing to copy; lambda may be NULL
         if (!lambda)
-            return GA_ERR_ARG;
+            return c.diag.fail(GA_ERR_ARG, "ga_get_lambda: lambda is NULL");
         if (!c.initialized())
-            return GA_ERR_STATE;
+            return c.diag.fail(GA_ERR_STATE, "ga_get_lambda before ga_init or ga_set_state");
         return c.output_state(nullptr, lambda);
     });
 }
@@ -686,12 +709,13 @@ GA_API ga_status ga_set_output(ga_solver *s, int mode)
 
 GA_API ga_status ga_get_a(const ga_solver *s, double *a)
 {
-    return reading(s, [&](const ga::Solver &c) { return copy_out(c, c.state().a, a); });
+    return reading(s, "ga_get_a", "a is NULL",
+                   [&](const ga::Solver &c) { return copy_out(c, c.state().a, a); });
 }
 
 GA_API ga_status ga_state_size(const ga_solver *s, size_t *len)
 {
-    return reading(s, [&](const ga::Solver &c) {
+    return reading(s, "ga_state_size", "len is NULL", [&](const ga::Solver &c) {
         if (!len)
             return GA_ERR_ARG;
         *len = c.state_size();
@@ -701,7 +725,8 @@ GA_API ga_status ga_state_size(const ga_solver *s, size_t *len)
 
 GA_API ga_status ga_get_state(const ga_solver *s, double *buf, size_t len)
 {
-    return reading(s, [&](const ga::Solver &c) {
+    return reading(s, "ga_get_state", "buf is NULL or shorter than ga_state_size",
+                   [&](const ga::Solver &c) {
         if (!buf || len < c.state_size())
             return GA_ERR_ARG;
         if (!c.initialized())
@@ -722,7 +747,8 @@ GA_API ga_status ga_set_state(ga_solver *s, const double *buf, size_t len)
 
 GA_API ga_status ga_get_counter(const ga_solver *s, int key, long long *value)
 {
-    return reading(s, [&](const ga::Solver &c) {
+    return reading(s, "ga_get_counter", "value is NULL or the key is unknown",
+                   [&](const ga::Solver &c) {
         if (!value || key < 0 || key >= GA_COUNTER_COUNT)
             return GA_ERR_ARG;
         *value = c.counters[key];

@@ -4,6 +4,7 @@
 //             theta_prev, refresh_steps_left, reuse_backoff, fd_tangents]
 //   state    q, v, qdd (n each), lambda (m), a, a_prev (n each)
 //   matrix   the iterate it was factorized at: q, v, qdd (n), lambda (m); q of its B (n)
+//   active   the constraints in use (m flags; all 1 unless GA_REDUNDANT_DROP dropped some)
 //   pivots   blocks of pivot_state_size(N) (backend.hpp) for S_ (N = n + m), S2_ (2n + 2m),
 //            P_ and O_ (n + m each)
 // Taking one only reads. Restoring rebuilds the kept matrix from the callbacks at the same
@@ -27,7 +28,7 @@ bool is_flag(double x) { return x == 0.0 || x == 1.0; }
 bool is_count(double x, double max) { return x >= 0.0 && x <= max && x == std::floor(x); }
 
 struct Layout {
-    std::size_t matrix, pivots[4], end;  // offsets; pivots of S_, S2_, P_, O_
+    std::size_t matrix, active, pivots[4], end;  // offsets; pivots of S_, S2_, P_, O_
 };
 
 Layout layout(int n, int m)
@@ -35,7 +36,8 @@ Layout layout(int n, int m)
     const std::size_t N = static_cast<std::size_t>(n), M = static_cast<std::size_t>(m);
     Layout l;
     l.matrix = kHeader + 5 * N + M;
-    l.pivots[0] = l.matrix + 4 * N + M;
+    l.active = l.matrix + 4 * N + M;
+    l.pivots[0] = l.active + M;
     l.pivots[1] = l.pivots[0] + pivot_state_size(n + m);
     l.pivots[2] = l.pivots[1] + pivot_state_size(2 * n + 2 * m);
     l.pivots[3] = l.pivots[2] + pivot_state_size(n + m);
@@ -67,7 +69,8 @@ void Solver::get_state(double *buf) const
                                     r.h,
                                     r.t_b,
                                     (r.K ? 1.0 : 0.0) + (r.C ? 2.0 : 0.0) + (r.Z ? 4.0 : 0.0),
-                                    theta_prev_,
+                                    // without a matrix the rate is stale and unused
+                                    jacobian_valid_ ? theta_prev_ : -1.0,
                                     static_cast<double>(refresh_steps_left_),
                                     static_cast<double>(reuse_backoff_),
                                     fd_tangents_ ? 1.0 : 0.0};
@@ -78,6 +81,8 @@ void Solver::get_state(double *buf) const
         Eigen::Map<Vec>(p, x->size()) = *x;
         p += x->size();
     }
+    for (int i = 0; i < m_; ++i)
+        buf[l.active + i] = constraint_active(i) ? 1.0 : 0.0;
     S_.save_pivots(buf + l.pivots[0]);
     S2_.save_pivots(buf + l.pivots[1]);
     P_.save_pivots(buf + l.pivots[2]);
@@ -129,6 +134,18 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
                      !(buf[17] >= 1.0) || !is_flag(buf[18])))
         return diag.fail(GA_ERR_ARG, "checkpoint entries 10-18 (the kept iteration matrix and "
                          "its reuse) are not those a solver writes");
+    // The constraints in use: as the checkpoint says (layout 2, which does not say, selects
+    // them anew at its q). Dropped ones need a solver that drops them.
+    for (int i = 0; i < m_ && !layout2; ++i) {
+        const double in_use = buf[l.active + i];
+        if (!is_flag(in_use))
+            return diag.fail(GA_ERR_ARG, "checkpoint entry %zu (constraint %d in use: %g) is "
+                             "neither 0 nor 1", l.active + i, i, in_use);
+        if (in_use == 0.0 && redundancy != GA_REDUNDANT_DROP)
+            return diag.fail(GA_ERR_ARG, "the checkpoint dropped constraint %d as redundant; "
+                             "this solver keeps every constraint (GA_REDUNDANT_DROP drops them)",
+                             i);
+    }
     if (!model.ready())
         return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
     if (auto st = setup())
@@ -147,11 +164,22 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
                              l.end - 1);
     }
     if (redundancy == GA_REDUNDANT_DROP && m_ > 0) {
-        const Vec q = Eigen::Map<const Vec>(buf + (layout2 ? kHeader2 : kHeader), n_);
-        const std::vector<unsigned char> active_before = active_;
-        if (auto st = select_active_constraints(buf[4], q)) {
-            restore_active(active_before);
-            return st;
+        if (layout2) {
+            const Vec q = Eigen::Map<const Vec>(buf + kHeader2, n_);
+            const std::vector<unsigned char> active_before = active_;
+            if (auto st = select_active_constraints(buf[4], q)) {
+                restore_active(active_before);
+                return st;
+            }
+        } else {
+            bool changed = false;  // in place: the linear algebra holds active_'s address
+            for (int i = 0; i < m_; ++i) {
+                const unsigned char in_use = buf[l.active + i] != 0.0;
+                changed = changed || active_[i] != in_use;
+                active_[i] = in_use;
+            }
+            if (changed)
+                invalidate_jacobian();
         }
     }
     State &s = accepted_;

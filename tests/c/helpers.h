@@ -14,7 +14,7 @@
 /* Checkpoint layout 3 (src/checkpoint.cpp), as far as tests look into it: 19 header entries
  * (entry 9: the span of slivers), then q, v, qdd, lambda, a, a_prev; then what rebuilds the
  * kept matrix (4n + m + n) and four pivot blocks. The pendulum's takes 85 doubles. */
-enum { CKPT_HEADER = 19, CKPT_PENDULUM = 85 };
+enum { CKPT_HEADER = 19, CKPT_PENDULUM = 86 };
 
 /* The layout-2 checkpoint (galpha 0.2) of the same state: header entries 0-8 with version 2,
  * then the state; its length. */

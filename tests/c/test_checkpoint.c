@@ -128,7 +128,7 @@ static void sparse_restart(int formulation, int adaptive, int sliver_first)
     size_t len = 0;
     assert_int_equal(ga_state_size(s[0], &len), GA_OK);
     /* 19 + 9n + 2m, and pivot blocks of 4 + 2N for N = n + m (three) and 2n + 2m */
-    assert_int_equal(len, 35 + 19 * (size_t)n + 12 * 2 * (size_t)c.links);
+    assert_int_equal(len, 35 + 19 * (size_t)n + 13 * 2 * (size_t)c.links);
     double *ckpt = malloc(3 * len * sizeof(double)), *a = ckpt + len, *b = a + len;
     assert_non_null(ckpt);
     assert_int_equal(ga_get_state(s[0], ckpt, len), GA_OK);

@@ -241,21 +241,38 @@ static void null_pointers_are_refused(void **state)
     assert_int_equal(ga_set_rho_inf(NULL, 0.5), GA_ERR_ARG);
     assert_int_equal(ga_get_t(NULL, &d), GA_ERR_ARG);
     assert_int_equal(ga_set_pattern_csc(NULL, GA_MATRIX_MASS, NULL, NULL), GA_ERR_ARG);
+    /* each read that fails says which call and which argument, in place of the message an
+     * earlier failure left (issue 17) */
+    assert_int_equal(ga_step(x->s, -1.0), GA_ERR_ARG);
     assert_int_equal(ga_get_t(x->s, NULL), GA_ERR_ARG);
+    expect_message(x->s, "ga_get_t: t is NULL");
     assert_int_equal(ga_get_q(x->s, NULL), GA_ERR_ARG);
+    expect_message(x->s, "ga_get_q: q is NULL");
     assert_int_equal(ga_get_v(x->s, NULL), GA_ERR_ARG);
+    expect_message(x->s, "ga_get_v: v is NULL");
     assert_int_equal(ga_get_qdd(x->s, NULL), GA_ERR_ARG);
+    expect_message(x->s, "ga_get_qdd: qdd is NULL");
     assert_int_equal(ga_get_lambda(x->s, NULL), GA_ERR_ARG);
+    expect_message(x->s, "ga_get_lambda: lambda is NULL");
     assert_int_equal(ga_get_a(x->s, NULL), GA_ERR_ARG);
+    expect_message(x->s, "ga_get_a: a is NULL");
     assert_int_equal(ga_get_h_last(x->s, NULL), GA_ERR_ARG);
+    expect_message(x->s, "ga_get_h_last: h is NULL");
     assert_int_equal(ga_get_counter(x->s, GA_COUNT_STEPS, NULL), GA_ERR_ARG);
+    expect_message(x->s, "ga_get_counter: value is NULL or the key is unknown");
     assert_int_equal(ga_get_counter(x->s, 99, &c), GA_ERR_ARG);
     assert_int_equal(ga_get_counter(x->s, -1, &c), GA_ERR_ARG);
+    assert_int_equal(ga_get_active_constraints(x->s, NULL), GA_ERR_ARG);
+    expect_message(x->s, "ga_get_active_constraints: active is NULL");
     assert_int_equal(ga_get_size(x->s, NULL, &m), GA_ERR_ARG);
+    expect_message(x->s, "ga_get_size: n or m is NULL");
     assert_int_equal(ga_get_size(x->s, &n, &m), GA_OK);
+    expect_message(x->s, "ga_get_size: n or m is NULL"); /* a read that succeeds keeps it */
     assert_int_equal(ga_state_size(x->s, NULL), GA_ERR_ARG);
+    expect_message(x->s, "ga_state_size: len is NULL");
     assert_int_equal(ga_state_size(x->s, &len), GA_OK);
     assert_int_equal(ga_get_state(x->s, NULL, len), GA_ERR_ARG);
+    expect_message(x->s, "ga_get_state: buf is NULL or shorter than ga_state_size");
     assert_int_equal(ga_set_state(x->s, NULL, len), GA_ERR_ARG);
     assert_int_equal(ga_init(x->s, 0.0, NULL, &d), GA_ERR_ARG);
     assert_string_equal(ga_last_error(NULL), "NULL solver");
@@ -287,8 +304,15 @@ static void calls_out_of_order_are_refused(void **state)
     assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_STATE);
     expect_message(s, "before ga_set_callbacks");
     assert_int_equal(ga_get_t(s, &t), GA_ERR_STATE);
+    expect_message(s, "ga_get_t before ga_init or ga_set_state");
     assert_int_equal(ga_get_q(s, q), GA_ERR_STATE);
+    expect_message(s, "ga_get_q before ga_init");
+    assert_int_equal(ga_get_qdd(s, q), GA_ERR_STATE);
+    expect_message(s, "ga_get_qdd before ga_init");
+    assert_int_equal(ga_get_lambda(s, q), GA_ERR_STATE);
+    expect_message(s, "ga_get_lambda before ga_init");
     assert_int_equal(ga_get_state(s, buf, STATE_MAX), GA_ERR_STATE);
+    expect_message(s, "ga_get_state before ga_init");
     buf[0] = 26465.0; /* a well-formed checkpoint still needs callbacks */
     buf[1] = 2.0;
     buf[2] = 2.0;
@@ -525,9 +549,19 @@ static void bad_checkpoints_are_refused(void **state)
         assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
         expect_message(x->s, "entries 10-18");
     }
-    /* the pivot blocks (from entry 39 for the pendulum): flags and sizes as written */
-    const double bad_pivots[][2] = {{39, 0.5}, {40, -1.0}, {40, 2.5}, {41, 2.0}, {42, 0.5},
-                                    {49, 3.0}, {65, 0.5}, {75, 0.5}};
+    /* the constraints in use (entry 39 for the pendulum): flags; a dropped one only for a
+     * solver that drops them */
+    memcpy(buf, before, len * sizeof(double));
+    assert_true(before[39] == 1.0);
+    buf[39] = 0.5;
+    assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
+    expect_message(x->s, "neither 0 nor 1");
+    buf[39] = 0.0;
+    assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
+    expect_message(x->s, "dropped constraint 0");
+    /* the pivot blocks (from entry 40 for the pendulum): flags and sizes as written */
+    const double bad_pivots[][2] = {{40, 0.5}, {41, -1.0}, {41, 2.5}, {42, 2.0}, {43, 0.5},
+                                    {50, 3.0}, {66, 0.5}, {76, 0.5}};
     for (size_t k = 0; k < sizeof bad_pivots / sizeof bad_pivots[0]; ++k) {
         memcpy(buf, before, len * sizeof(double));
         buf[(int)bad_pivots[k][0]] = bad_pivots[k][1];

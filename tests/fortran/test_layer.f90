@@ -150,6 +150,7 @@ program test_layer
 
   call s%free()
   call r%free()
+  deallocate (ckpt, back)  ! (a main program's allocatables are never freed on their own)
   x = s%h_last()
   call expect(x /= x .and. s%state_size() == -1, 'freed solver')
   print '(a)', 'test_layer: all checks passed'

@@ -1,0 +1,521 @@
+/* Random sequences of C API calls, shared by tests/c/test_api_sequences.c (choices from a
+ * seeded generator) and the libFuzzer harness tests/fuzz/fuzz_api.c (choices from the fuzzer's
+ * bytes); see test_api_sequences.c for what they make and what must hold. The includer
+ * defines SEQ_FAIL(fmt, ...) (report and stop) and SEQ_REQUIRE(cond). */
+#ifndef GALPHA_TESTS_API_SEQUENCE_H
+#define GALPHA_TESTS_API_SEQUENCE_H
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <galpha.h>
+
+enum { N = 4, MAX_OPS = 64, STATE_MAX = 1 + 4 * N + 3, CKPT_MAX = 512 };
+
+typedef enum fault_kind { NONE, RETURN_RETRY, RETURN_FATAL, WRITE_NAN, WRITE_INF, WRITE_HUGE,
+                          REENTER, FAULT_KINDS } fault_kind;
+enum { MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS, ACCEL, DT, CALLBACKS };
+
+typedef struct model {
+    uint64_t rng;
+    const uint8_t *data;   /* fuzzing: the choices come from these bytes (rng unused) */
+    size_t size, pos;
+    int exhausted;         /* the bytes ran out: the sequence ends after this call */
+    int m;                 /* 2, 3 (redundant) or 0 */
+    fault_kind fault;      /* armed failure */
+    int fault_callback;    /* which callback fails */
+    long calls, fault_at;  /* it fails from its fault_at-th call on */
+    ga_solver *s;
+    int impure;            /* a callback returned success with other values than usual */
+    int reentry_allowed;   /* a callback's ga_step on its own solver returned other than STATE */
+    int sparse_M, sparse_J, sparse_K; /* patterns declared: the callbacks write values only */
+} model;
+
+static uint64_t next(model *md)
+{
+    if (md->data) {
+        uint64_t x = 0;
+        for (int k = 0; k < 2; ++k, ++md->pos)
+            x = x << 8 | (md->pos < md->size ? md->data[md->pos] : 0);
+        md->exhausted |= md->pos >= md->size;
+        /* two bytes per choice, spread over 64 bits so that uniform() is not always ~0 */
+        return x * 0x9E3779B97F4A7C15ull;
+    }
+    md->rng ^= md->rng << 13;
+    md->rng ^= md->rng >> 7;
+    md->rng ^= md->rng << 17;
+    return md->rng;
+}
+static int pick(model *md, int k) { return (int)((next(md) >> 32) % (uint64_t)k); }
+static double uniform(model *md) { return (double)(next(md) >> 11) * 0x1.0p-53; }
+
+static int misbehave(model *md, int callback, double *out, int len)
+{
+    if (md->fault == NONE || md->fault_callback != callback || ++md->calls < md->fault_at)
+        return 0;
+    switch (md->fault) {
+    case RETURN_RETRY: return 1;
+    case RETURN_FATAL: return -1;
+    case WRITE_NAN: out[pick(md, len)] = NAN; return 0;
+    case WRITE_INF: out[pick(md, len)] = -INFINITY; return 0;
+    case WRITE_HUGE: out[pick(md, len)] = 1e300; md->impure = 1; return 0;
+    case REENTER:
+        if (ga_step(md->s, 1e-3) != GA_ERR_STATE)
+            md->reentry_allowed = 1;
+        return 0;
+    default: return 0;
+    }
+}
+
+static int mass(double t, const double *q, double *M, void *user)
+{
+    model *md = user;
+    (void)t, (void)q;
+    if (md->sparse_M) {  /* the diagonal */
+        for (int i = 0; i < N; ++i)
+            M[i] = 1.0;
+        return misbehave(md, MASS, M, N);
+    }
+    memset(M, 0, sizeof(double) * N * N);
+    for (int i = 0; i < N; ++i)
+        M[i + i * N] = 1.0;
+    return misbehave(md, MASS, M, N * N);
+}
+static int force(double t, const double *q, const double *v, double *f, void *user)
+{
+    (void)t, (void)q, (void)v;
+    for (int i = 0; i < N; ++i)
+        f[i] = i % 2 ? -9.81 : 0.0;
+    return misbehave(user, FORCE, f, N);
+}
+static int constraint(double t, const double *q, double *phi, void *user)
+{
+    model *md = user;
+    (void)t;
+    phi[0] = 0.5 * (q[0] * q[0] + q[1] * q[1] - 1.0);
+    phi[1] = 0.5 * ((q[2] - q[0]) * (q[2] - q[0]) + (q[3] - q[1]) * (q[3] - q[1]) - 1.0);
+    if (md->m == 3)
+        phi[2] = phi[0];
+    return misbehave(md, CONSTRAINT, phi, md->m);
+}
+static int jacobian(double t, const double *q, double *J, void *user)
+{
+    model *md = user;
+    const int m = md->m;
+    (void)t;
+    if (md->sparse_J) {  /* in the order of J_ROWS, J_COLS */
+        const double values[] = {q[0], q[1], q[0] - q[2], q[1] - q[3], q[2] - q[0], q[3] - q[1],
+                                 q[0], q[1]};
+        const int nnz = m == 3 ? 8 : 6;
+        memcpy(J, values, sizeof(double) * (size_t)nnz);
+        return misbehave(md, JACOBIAN, J, nnz);
+    }
+    memset(J, 0, sizeof(double) * (size_t)(m * N));
+    J[0] = q[0], J[m] = q[1];
+    J[1] = q[0] - q[2], J[1 + m] = q[1] - q[3], J[1 + 2 * m] = q[2] - q[0],
+    J[1 + 3 * m] = q[3] - q[1];
+    if (m == 3)
+        J[2] = q[0], J[2 + m] = q[1];
+    return misbehave(md, JACOBIAN, J, m * N);
+}
+/* K_t = d(Phi_q^T lambda)/dq (M constant, f constant) */
+static int stiffness(double t, const double *q, const double *v, const double *qdd,
+                     const double *lambda, double *K, void *user)
+{
+    model *md = user;
+    (void)t, (void)q, (void)v, (void)qdd;
+    if (md->sparse_K) {  /* in the order of K_ROWS, K_COLS */
+        const double l0 = md->m ? lambda[0] + (md->m == 3 ? lambda[2] : 0.0) : 0.0,
+                     l1 = md->m ? lambda[1] : 0.0;
+        const double values[] = {l0 + l1, l0 + l1, l1, l1, -l1, -l1, -l1, -l1};
+        memcpy(K, values, sizeof values);
+        return misbehave(md, STIFFNESS, K, 8);
+    }
+    memset(K, 0, sizeof(double) * N * N);
+    if (md->m > 0) {
+        const double l0 = lambda[0] + (md->m == 3 ? lambda[2] : 0.0), l1 = lambda[1];
+        K[0] = K[1 + N] = l0 + l1;
+        K[2 + 2 * N] = K[3 + 3 * N] = l1;
+        K[2 * N] = K[2] = K[1 + 3 * N] = K[3 + N] = -l1;
+    }
+    return misbehave(md, STIFFNESS, K, N * N);
+}
+static int accel(double t, const double *q, const double *v, double *out, void *user)
+{
+    model *md = user;
+    (void)t, (void)q;
+    out[0] = v[0] * v[0] + v[1] * v[1];
+    out[1] = (v[2] - v[0]) * (v[2] - v[0]) + (v[3] - v[1]) * (v[3] - v[1]);
+    if (md->m == 3)
+        out[2] = out[0];
+    return misbehave(md, ACCEL, out, md->m);
+}
+static int time_derivative(double t, const double *q, double *phi_t, void *user)
+{
+    model *md = user;
+    (void)t, (void)q;
+    for (int i = 0; i < md->m; ++i)
+        phi_t[i] = 0.0;
+    return misbehave(md, DT, phi_t, md->m);
+}
+
+/* The patterns the callbacks above write when declared; and ones ga_set_pattern must refuse. */
+static const int M_DIAG[] = {0, 1, 2, 3}, M_COLPTR[] = {0, 1, 2, 3, 4};
+static const int J_ROWS[] = {0, 0, 1, 1, 1, 1, 2, 2}, J_COLS[] = {0, 1, 0, 1, 2, 3, 0, 1};
+static const int K_ROWS[] = {0, 1, 2, 3, 0, 2, 1, 3}, K_COLS[] = {0, 1, 2, 3, 2, 0, 3, 1};
+
+static ga_status declare_pattern(model *md, ga_solver *s, int *must_fail)
+{
+    static const int bad_rows[] = {0, 5, -1, 2}, bad_cols[] = {0, 1, 2, 4};
+    const int k = pick(md, 9);
+    *must_fail = k >= 5;
+    switch (k) {
+    case 0: {
+        const ga_status st = ga_set_pattern(s, GA_MATRIX_MASS, N, M_DIAG, M_DIAG);
+        md->sparse_M |= st == GA_OK;
+        return st;
+    }
+    case 1: {
+        const ga_status st = ga_set_pattern_csc(s, GA_MATRIX_MASS, M_COLPTR, M_DIAG);
+        md->sparse_M |= st == GA_OK;
+        return st;
+    }
+    case 2: {
+        const ga_status st =
+            ga_set_pattern(s, GA_MATRIX_JACOBIAN, md->m == 3 ? 8 : 6, J_ROWS, J_COLS);
+        md->sparse_J |= st == GA_OK;
+        return st;
+    }
+    case 3: {
+        const ga_status st = ga_set_pattern(s, GA_MATRIX_STIFFNESS, 8, K_ROWS, K_COLS);
+        md->sparse_K |= st == GA_OK;
+        return st;
+    }
+    case 4: return ga_set_pattern(s, GA_MATRIX_DAMPING, 0, NULL, NULL);
+    /* each of these must be refused: an index out of range, NULL arrays with entries, an
+     * unknown matrix, a negative count, a decreasing colptr */
+    case 5: return ga_set_pattern(s, pick(md, 4), 4, bad_rows, bad_cols);
+    case 6: return ga_set_pattern(s, pick(md, 4), 3, NULL, M_DIAG);
+    case 7: return ga_set_pattern(s, 4 + pick(md, 3), 4, M_DIAG, M_DIAG);
+    default: {
+        static const int decreasing[] = {0, 2, 1, 3, 4};
+        return pick(md, 2) ? ga_set_pattern(s, GA_MATRIX_MASS, -1, M_DIAG, M_DIAG)
+                           : ga_set_pattern_csc(s, GA_MATRIX_MASS, decreasing, M_DIAG);
+    }
+    }
+}
+
+static double edge_value(model *md)
+{
+    static const double values[] = {0.0, -1.0, 1.0, 0.5, 1e-3, 1e-12, 1e300, -1e300, 1e-320,
+                                    2.0, 0.9, 0.7, 1e-6, 1e-10, 10.0};
+    const int k = pick(md, 18);
+    return k < 15 ? values[k] : k == 15 ? NAN : k == 16 ? INFINITY : uniform(md);
+}
+static double step_size(model *md)
+{
+    static const double values[] = {1e-3, 1e-2, 1e-4, 0.1, 1.0, 1e-8, 1e-15, 0.0, -1e-3, 1e3,
+                                    5e-3, NAN, INFINITY};
+    return values[pick(md, 13)];
+}
+
+/* t, q, v, qdd, a, lambda; 0 before ga_init */
+static int snapshot(ga_solver *s, int m, double *x)
+{
+    if (ga_get_t(s, x) != GA_OK)
+        return 0;
+    SEQ_REQUIRE(ga_get_q(s, x + 1) == GA_OK);
+    SEQ_REQUIRE(ga_get_v(s, x + 1 + N) == GA_OK);
+    SEQ_REQUIRE(ga_get_qdd(s, x + 1 + 2 * N) == GA_OK);
+    SEQ_REQUIRE(ga_get_a(s, x + 1 + 3 * N) == GA_OK);
+    SEQ_REQUIRE(ga_get_lambda(s, m ? x + 1 + 4 * N : NULL) == GA_OK);
+    return 1 + 4 * N + m;
+}
+
+static void check(ga_solver *s, ga_status st, int changes_solver, const char *call, int seq)
+{
+    if (st > GA_OK || st < GA_ERR_STEP_SIZE)
+        SEQ_FAIL("sequence %d: %s returned %d, not a ga_status", seq, call, st);
+    if (st != GA_OK && changes_solver && ga_last_error(s)[0] == '\0')
+        SEQ_FAIL("sequence %d: %s failed (%s) without a message", seq, call, ga_strerror(st));
+    /* a failed read names itself: its message, not one an earlier failure left */
+    if (st != GA_OK && !changes_solver && strncmp(call, "ga_get_", 7) == 0 &&
+        !strstr(ga_last_error(s), call))
+        SEQ_FAIL("sequence %d: %s failed (%s) with the message '%s'", seq, call,
+                 ga_strerror(st), ga_last_error(s));
+}
+
+/* A failed step must leave the state as it was. */
+static void check_transaction(ga_solver *s, int m, ga_status st, const double *before, int len,
+                              const char *call, int seq)
+{
+    double after[STATE_MAX];
+    if (st == GA_OK || len == 0)
+        return;
+    SEQ_REQUIRE(snapshot(s, m, after) == len);
+    if (memcmp(before, after, sizeof(double) * (size_t)len) != 0)
+        SEQ_FAIL("sequence %d: %s failed (%s: %s) but changed the state", seq, call,
+                 ga_strerror(st), ga_last_error(s));
+}
+
+typedef struct seq_stats {
+    long long calls, steps_ok, sparse_ok, twin_steps_ok;
+} seq_stats;
+
+/* The restart twin: a few steps from a checkpoint, then the checkpoint restored in the same
+ * solver and the same steps again must give the same statuses and the same checkpoint, bit
+ * for bit (callbacks do not fail meanwhile: the failures armed count their calls). */
+static int restart_twin(model *md, ga_solver *s, const double *ckpt, size_t len, int seq)
+{
+    enum { TWIN_STEPS = 4 };
+    const fault_kind fault = md->fault;
+    double h[TWIN_STEPS], end[2][CKPT_MAX];
+    int adaptive[TWIN_STEPS];
+    ga_status st[2][TWIN_STEPS];
+    const int k = 1 + pick(md, TWIN_STEPS);
+    for (int i = 0; i < k; ++i) {
+        h[i] = step_size(md);
+        adaptive[i] = pick(md, 2);
+    }
+    md->fault = NONE;
+#ifdef SEQ_TRACE
+    fprintf(stderr, "  twin on %s, sparse M %d J %d K %d\n", ga_linear_solver_name(s),
+            md->sparse_M, md->sparse_J, md->sparse_K);
+#endif
+    for (int run = 0; run < 2; ++run) {
+        if (run == 1 && ga_set_state(s, ckpt, len) != GA_OK)
+            SEQ_FAIL("sequence %d: a solver refused its own checkpoint: %s", seq,
+                     ga_last_error(s));
+        for (int i = 0; i < k; ++i) {
+            double t = 0.0;
+            ga_get_t(s, &t);
+            st[run][i] = adaptive[i] ? ga_step_adaptive(s, t + h[i]) : ga_step(s, h[i]);
+#ifdef SEQ_TRACE
+            fprintf(stderr, "  twin run %d step %d: %s\n", run, i, ga_last_error(s));
+#endif
+        }
+        SEQ_REQUIRE(ga_get_state(s, end[run], len) == GA_OK);
+    }
+    md->fault = fault;
+#ifdef SEQ_TRACE
+    for (int i = 0; i < k; ++i)
+        fprintf(stderr, "  twin step %d: h = %g adaptive %d: %d / %d\n", i, h[i], adaptive[i],
+                st[0][i], st[1][i]);
+    for (size_t i = 0; i < len; ++i)
+        if (memcmp(&end[0][i], &end[1][i], sizeof(double)) != 0)
+            fprintf(stderr, "  entry %zu: %.17g / %.17g\n", i, end[0][i], end[1][i]);
+#endif
+    if (memcmp(st[0], st[1], sizeof st[0][0] * (size_t)k) != 0 ||
+        memcmp(end[0], end[1], sizeof(double) * len) != 0)
+        SEQ_FAIL("sequence %d: %d steps from a restored checkpoint differ from the same steps "
+                 "after it was taken", seq, k);
+    int accepted = 0;
+    for (int i = 0; i < k; ++i)
+        accepted += st[0][i] == GA_OK;
+    return accepted;
+}
+
+
+/* One sequence: its choices from `data` (fuzzing; the sequence ends with the bytes) or from a
+ * generator seeded by `seq`. */
+static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *stats)
+{
+    model md = {0};
+    md.rng = 0x9E3779B97F4A7C15ull * (uint64_t)(seq + 1);
+    md.data = data;
+    md.size = size;
+    for (int k = 0; k < 4 && !data; ++k)
+        next(&md);
+    const int kinds[] = {2, 3, 0};
+    md.m = kinds[pick(&md, 3)];
+    ga_solver *s = NULL;
+    SEQ_REQUIRE(ga_create(N, md.m, &s) == GA_OK);
+#ifdef SEQ_TRACE
+    fprintf(stderr, "m = %d\n", md.m);
+#endif
+    md.s = s;
+    /* snapshots read the state: the step's qdd and lambda, no callbacks */
+    SEQ_REQUIRE(ga_set_output(s, GA_OUTPUT_STEP) == GA_OK);
+    SEQ_REQUIRE(ga_set_callbacks(s, mass, force, constraint, jacobian, &md) == GA_OK);
+    if (pick(&md, 3) == 0) {  /* a third of the runs on the sparse path */
+        md.sparse_M = 1;
+        SEQ_REQUIRE(ga_set_pattern(s, GA_MATRIX_MASS, N, M_DIAG, M_DIAG) == GA_OK);
+        if (md.m > 0) {
+            md.sparse_J = 1;
+            SEQ_REQUIRE(
+                ga_set_pattern(s, GA_MATRIX_JACOBIAN, md.m == 3 ? 8 : 6, J_ROWS, J_COLS) == GA_OK);
+        }
+        if (pick(&md, 2)) {
+            md.sparse_K = 1;
+            SEQ_REQUIRE(ga_set_pattern(s, GA_MATRIX_STIFFNESS, 8, K_ROWS, K_COLS) == GA_OK);
+        }
+        SEQ_REQUIRE(ga_set_linear_solver(s, GA_LINEAR_SPARSE) == GA_OK);
+    }
+    const int ops = data ? MAX_OPS : 5 + pick(&md, MAX_OPS - 5);
+    for (int op = 0; op < ops && !md.exhausted; ++op) {
+        if (pick(&md, 6) == 0) {  /* arm a failure (or disarm: NONE) */
+            md.fault = (fault_kind)pick(&md, FAULT_KINDS);
+            md.fault_callback = pick(&md, CALLBACKS);
+            md.calls = 0;
+            md.fault_at = 1 + pick(&md, 30);
+        }
+        double before[STATE_MAX];
+        ga_status st = GA_OK;
+        int changes = 1;
+        const char *call = "";
+        switch (pick(&md, 36)) {
+        case 0: call = "ga_set_rho_inf"; st = ga_set_rho_inf(s, edge_value(&md)); break;
+        case 1: {
+            const double am = edge_value(&md), af = edge_value(&md), b = edge_value(&md);
+            call = "ga_set_params";
+            st = ga_set_params(s, am, af, b, edge_value(&md));
+            break;
+        }
+        case 2: call = "ga_set_newton"; st = ga_set_newton(s, edge_value(&md), pick(&md, 30) - 2); break;
+        case 3: call = "ga_set_tangents"; st = ga_set_tangents(s, pick(&md, 2) ? stiffness : NULL, NULL); break;
+        case 4: call = "ga_set_tangent_mode"; st = ga_set_tangent_mode(s, pick(&md, 5) - 1); break;
+        case 5: call = "ga_set_scaling"; st = ga_set_scaling(s, pick(&md, 3)); break;
+        case 6: call = "ga_set_jacobian_reuse"; st = ga_set_jacobian_reuse(s, pick(&md, 3)); break;
+        case 7: call = "ga_set_constant_mass"; st = ga_set_constant_mass(s, pick(&md, 3)); break;
+        case 8: call = "ga_set_predictor"; st = ga_set_predictor(s, pick(&md, 4)); break;
+        case 9: call = "ga_set_linear_solver"; st = ga_set_linear_solver(s, pick(&md, 7) - 1); break;
+        case 10: call = "ga_set_formulation"; st = ga_set_formulation(s, pick(&md, 3)); break;
+        case 11: call = "ga_set_redundant_constraints"; st = ga_set_redundant_constraints(s, pick(&md, 3)); break;
+        case 12: call = "ga_set_rescale"; st = ga_set_rescale(s, pick(&md, 3)); break;
+        case 13: call = "ga_set_corrected_start"; st = ga_set_corrected_start(s, pick(&md, 3)); break;
+        case 14: {
+            const double rtol = edge_value(&md);
+            call = "ga_set_tolerances";
+            st = ga_set_tolerances(s, rtol, edge_value(&md));
+            break;
+        }
+        case 15: {
+            const double h_min = pick(&md, 2) ? 0.0 : edge_value(&md);
+            call = "ga_set_step_limits";
+            st = ga_set_step_limits(s, h_min, edge_value(&md));
+            break;
+        }
+        case 16: call = "ga_set_initial_step"; st = ga_set_initial_step(s, edge_value(&md)); break;
+        case 17: call = "ga_set_constraint_accel"; st = ga_set_constraint_accel(s, pick(&md, 2) ? accel : NULL); break;
+        case 18: call = "ga_set_constraint_dt"; st = ga_set_constraint_dt(s, pick(&md, 2) ? time_derivative : NULL); break;
+        case 19: {
+            const int mode = pick(&md, 3);
+            call = "ga_set_init_mode";
+            st = ga_set_init_mode(s, mode, edge_value(&md));
+            break;
+        }
+        case 20: case 21: case 34: case 35: {
+            const double angle = 0.3 + uniform(&md);
+            double q0[N] = {sin(angle), -cos(angle), sin(angle) + 1.0, -cos(angle)}, v0[N] = {0};
+            if (pick(&md, 4) == 0)
+                q0[pick(&md, N)] += edge_value(&md);
+            if (pick(&md, 4) == 0)
+                v0[pick(&md, N)] += edge_value(&md);
+            const double t0 = pick(&md, 5) == 0 ? edge_value(&md) : 0.0;
+            call = "ga_init";
+            st = ga_init(s, t0, q0, v0);
+            break;
+        }
+        case 22: case 23: case 24: case 25: {
+            const int len = snapshot(s, md.m, before);
+            call = "ga_step";
+            st = ga_step(s, step_size(&md));
+            check_transaction(s, md.m, st, before, len, call, seq);
+            stats->steps_ok += st == GA_OK;
+            stats->sparse_ok += st == GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
+            break;
+        }
+        case 26: {
+            double t = 0.0;
+            const int len = snapshot(s, md.m, before);
+            ga_get_t(s, &t);
+            const double t_stop = pick(&md, 4) ? t + step_size(&md) : edge_value(&md);
+            call = "ga_step_adaptive";
+            st = ga_step_adaptive(s, t_stop);
+            check_transaction(s, md.m, st, before, len, call, seq);
+            stats->steps_ok += st == GA_OK;
+            stats->sparse_ok += st == GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
+            break;
+        }
+        case 27: {
+            double t = 0.0, q[N], v[N], lambda[3];
+            ga_get_t(s, &t);
+            call = "ga_interpolate";
+            changes = 0;
+            st = ga_interpolate(s, t - 1e-4 * uniform(&md), q, v, md.m ? lambda : NULL);
+            break;
+        }
+        case 28: {
+            size_t len = 0;
+            double buf[CKPT_MAX];
+            SEQ_REQUIRE(ga_state_size(s, &len) == GA_OK);
+            SEQ_REQUIRE(len <= CKPT_MAX);
+            call = "ga_get_state";
+            changes = 0;
+            st = ga_get_state(s, buf, len);
+            if (st == GA_OK) {
+                check(s, st, changes, call, seq);
+                /* (values a solver keeps, such as a constant mass matrix, are evaluated
+                 * again after a restore: the twins agree when the callbacks are functions) */
+                if (pick(&md, 2) == 0 && !md.impure)
+                    stats->twin_steps_ok += restart_twin(&md, s, buf, len, seq);
+                if (pick(&md, 3) == 0)
+                    buf[pick(&md, (int)len)] = edge_value(&md);
+                call = "ga_set_state";
+                changes = 1;
+                st = ga_set_state(s, buf, len - (size_t)(pick(&md, 5) == 0));
+            }
+            break;
+        }
+        case 29: {
+            long long value;
+            call = "ga_get_counter";
+            changes = 0;
+            st = ga_get_counter(s, pick(&md, 16) - 1, &value);
+            if (pick(&md, 3) == 0) {
+                check(s, st, changes, call, seq);
+                call = "ga_reset_counters";
+                changes = 1;
+                st = ga_reset_counters(s);
+            }
+            break;
+        }
+        case 31: case 32: {
+            int must_fail = 0;
+            call = "ga_set_pattern";
+            st = declare_pattern(&md, s, &must_fail);
+            if (must_fail && st == GA_OK)
+                SEQ_FAIL("sequence %d: an invalid pattern was accepted", seq);
+            break;
+        }
+        case 30: {
+            double value;
+            call = "ga_get_info";
+            changes = 0;
+            st = ga_get_info(s, pick(&md, 7) - 1, &value);
+            break;
+        }
+        default: {
+            int active[3];
+            call = "ga_get_active_constraints";
+            changes = 0;
+            st = ga_get_active_constraints(s, active);
+            break;
+        }
+        }
+        check(s, st, changes, call, seq);
+#ifdef SEQ_TRACE
+        fprintf(stderr, "%s: %d %s\n", call, st, st ? ga_last_error(s) : "");
+#endif
+        ++stats->calls;
+    }
+    if (md.reentry_allowed)
+        SEQ_FAIL("sequence %d: a callback's ga_step on its own solver was not refused", seq);
+    ga_free(s);
+}
+
+#endif
