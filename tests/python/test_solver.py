@@ -163,22 +163,47 @@ def test_status_maps_to_exception_classes():
     s.close()  # idempotent
 
 
-def test_input_views_are_read_only():
+@pytest.mark.parametrize("zero_copy", [False, True])
+def test_inputs_are_read_only(zero_copy):
     def sneaky_mass(t, q, M):
         q[0] = 0.0
 
-    with galpha.Solver(2, 1, sneaky_mass, force, constraint, jacobian) as s:
+    with galpha.Solver(2, 1, sneaky_mass, force, constraint, jacobian,
+                       zero_copy=zero_copy) as s:
         with pytest.raises(ValueError, match="read-only"):
             s.init(0.0, Q0, V0)
 
 
-def test_inputs_cannot_be_made_writeable():
+def test_views_of_the_library_cannot_be_made_writeable():
     def prying_mass(t, q, M):
         q.flags.writeable = True
 
-    with galpha.Solver(2, 1, prying_mass, force, constraint, jacobian) as s:
+    with galpha.Solver(2, 1, prying_mass, force, constraint, jacobian, zero_copy=True) as s:
         with pytest.raises(ValueError, match="WRITEABLE"):
             s.init(0.0, Q0, V0)
+
+
+def test_writing_into_a_copied_input_changes_nothing():
+    def prying_mass(t, q, M):
+        q.flags.writeable = True  # its own copy: allowed, and harmless
+        q[:] = 1e300
+        mass(t, q, M)
+
+    with galpha.Solver(2, 1, prying_mass, force, constraint, jacobian) as a, pendulum() as b:
+        for s in (a, b):
+            s.init(0.0, Q0, V0)
+            for _ in range(20):
+                s.step(2e-3)
+        assert np.array_equal(a.get_state(), b.get_state())
+
+
+def test_zero_copy_runs_the_same_numbers():
+    with pendulum(zero_copy=True) as a, pendulum() as b:
+        for s in (a, b):
+            s.init(0.0, Q0, V0)
+            for _ in range(50):
+                s.step_adaptive(1.0)
+        assert np.array_equal(a.get_state(), b.get_state())
 
 
 def test_arrays_a_callback_keeps_stay_its_own():

@@ -3,10 +3,10 @@ numpy arrays.
 
 Callbacks fill their output array in place and return None (or 0) on success, a positive int
 for a recoverable failure (the step is rejected) or a negative int for a fatal one. Their
-array arguments are their own: inputs are read-only copies (they cannot be made writeable),
-the output starts zeroed and is copied into the library's buffer when the callback returns
-successfully. Whatever a callback keeps of them stays valid and unchanged, also after
-close(). Matrices are seen in their natural shape (M: n x n, Phi_q: m x n), column-major
+array arguments are their own: inputs are read-only copies, the output starts zeroed and is
+copied into the library's buffer when the callback returns successfully. Whatever a callback
+keeps of them stays valid and unchanged, also after close() (Solver(zero_copy=True) trades
+this for speed: views of the library's buffers, valid during the call only). Matrices are seen in their natural shape (M: n x n, Phi_q: m x n), column-major
 (Fortran order) as in the C API.
 
 A Python exception raised inside a callback makes the step fail cleanly (the solver stays at
@@ -16,7 +16,6 @@ import ctypes
 import functools
 import signal
 import threading
-from ctypes import string_at
 
 import numpy as np
 
@@ -42,29 +41,51 @@ _PATTERN_MATRICES = {"mass": _ffi.GA_MATRIX_MASS, "jacobian": _ffi.GA_MATRIX_JAC
 
 
 
+_MAIN_THREAD = threading.main_thread().ident
+_sigint_handler_tried = False
+_running = None  # the solver whose call into C runs in the main thread now
+
+
+def _on_sigint(signum, frame):
+    """galpha's SIGINT handler: during a call into C it only flags the solver (see
+    _InterruptsDeferred); otherwise it is Python's own (KeyboardInterrupt)."""
+    if _running is not None:
+        _running._interrupted = True
+    else:
+        signal.default_int_handler(signum, frame)
+
+
 class _InterruptsDeferred:
     """Ctrl-C during a call into C: a KeyboardInterrupt raised inside a ctypes callback, before
     its try, was swallowed, and the library read an undefined return value (29-39 % of
     interrupts were lost). In the main thread, while such a call runs, SIGINT only sets a flag:
     the next callback returns a fatal failure (the step fails and leaves the state as it was),
-    and KeyboardInterrupt is raised when the call returns."""
+    and KeyboardInterrupt is raised when the call returns. The handler is installed once, at
+    the first call, if SIGINT still has Python's default handler then (swapping it at every
+    call cost more than a pendulum step with Python callbacks); a handler of the program's
+    own is left alone."""
 
     def __init__(self, solver):
         self.solver = solver
-        self.previous = None
+        self.main = False
+        self.outer = None
 
     def __enter__(self):
-        if (threading.current_thread() is threading.main_thread()
-                and signal.getsignal(signal.SIGINT) is signal.default_int_handler):
-            self.previous = signal.signal(signal.SIGINT, self._flag)
+        global _running, _sigint_handler_tried
+        self.main = threading.get_ident() == _MAIN_THREAD
+        if self.main:
+            if not _sigint_handler_tried:
+                _sigint_handler_tried = True
+                if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+                    signal.signal(signal.SIGINT, _on_sigint)
+            self.outer = _running
+            _running = self.solver
         return self
 
-    def _flag(self, signum, frame):
-        self.solver._interrupted = True
-
     def __exit__(self, *exc):
-        if self.previous is not None:
-            signal.signal(signal.SIGINT, self.previous)
+        global _running
+        if self.main:
+            _running = self.outer
             if self.solver._interrupted:
                 self.solver._interrupted = False
                 raise KeyboardInterrupt
@@ -119,6 +140,11 @@ class Solver:
         gamma)), ga_set_newton((tol, max_iter)), ga_set_tolerances((rtol, atol)),
         ga_set_step_limits((h_min, h_max)), ga_set_formulation(galpha.GA_INDEX2_STABILIZED),
         ...).
+    zero_copy : bool
+        False (default): callbacks get copies of their inputs and an array of their own to
+        fill, so what they keep stays valid and unchanged after the call. True: views of the
+        library's buffers instead, faster (see docs/performance.md), valid only during the
+        call (inputs read-only; nothing may be kept, written or read after the call returns).
 
     Use as a context manager, or call close(); the handle is also freed by the garbage
     collector.
@@ -130,7 +156,8 @@ class Solver:
                  params=None, newton=None, tangent_mode=None, scaling=None, predictor=None,
                  init_mode=None, formulation=None, redundant=None, tolerances=None, reuse=None,
                  constant_mass=None, linear_solver=None, rescale=None, corrected_start=None,
-                 step_limits=None, initial_step=None, output=None, patterns=None):
+                 step_limits=None, initial_step=None, output=None, patterns=None,
+                 zero_copy=False):
         self._ptr = None
         self._lock = threading.RLock()  # see _serialized
         self._pending = None          # exception raised inside a callback
@@ -184,52 +211,61 @@ class Solver:
                       "jacobian": jacobian, "stiffness": stiffness, "damping": damping,
                       "constraint_accel": constraint_accel, "constraint_dt": constraint_dt}
 
-        # Trampolines. A callback gets its inputs as read-only copies and fills a zeroed array
-        # of its own, copied into the library's buffer when it returns: whatever it keeps of
-        # them stays valid and unchanged after the call (and after close()), and nothing it
-        # does reaches the library's memory outside the call. Every exception is caught and
-        # stored. The return value counts by its sign, as in C: int() would pass 2**32
-        # through the C int as 0 (success) and truncate -0.5 to 0; a value without a sign
-        # (NaN, a string) is an error of the callback.
+        # Trampolines. By default a callback gets its inputs as read-only copies and fills a
+        # zeroed array of its own, copied into the library's buffer when it returns: whatever
+        # it keeps of them stays valid and unchanged after the call (and after close()), and
+        # nothing it does reaches the library's memory outside the call. zero_copy=True hands
+        # it views of the library's buffers instead, valid during the call only. Every
+        # exception is caught and stored. The return value counts by its sign, as in C: int()
+        # would pass 2**32 through the C int as 0 (success) and truncate -0.5 to 0; a value
+        # without a sign (NaN, a string) is an error of the callback.
+        def status(fn, rc):
+            if rc is None or rc == 0:
+                return 0
+            if rc > 0:
+                return 1
+            if rc < 0:
+                return -1
+            raise TypeError("callback %s returned %r: expected None or an int"
+                            % (getattr(fn, "__name__", "?"), rc))
+
+        def copied(address, size):
+            a = v(address, (size,)).copy()
+            a.flags.writeable = False
+            return a
+
         def call(fn, out_address, out_shape, t, *inputs):
             if self._pending is not None or self._interrupted:
                 return -1
             self._in_callback += 1
             try:
-                # inputs over immutable bytes: read-only for good (writeable cannot be set)
-                args = [t] + [np.frombuffer(string_at(address, 8 * size) if size else b"")
-                              for address, size in inputs]
+                if zero_copy:
+                    return status(fn, fn(t, *[v(a, (k,)) for a, k in inputs],
+                                         v(out_address, out_shape, True)))
                 out = np.zeros(out_shape, order="F")
-                rc = fn(*args, out)
-                if rc is None or rc == 0:
+                rc = status(fn, fn(t, *[copied(a, k) for a, k in inputs], out))
+                if rc == 0:
                     v(out_address, out_shape, True)[...] = out
-                    return 0
-                if rc > 0:
-                    return 1
-                if rc < 0:
-                    return -1
-                raise TypeError("callback %s returned %r: expected None or an int"
-                                % (getattr(fn, "__name__", "?"), rc))
+                return rc
             except BaseException as e:  # re-raised by the call that stepped
                 self._pending = e
                 return -1
             finally:
                 self._in_callback -= 1
 
+        sM, sJ = shape("mass", (n, n)), shape("jacobian", (m, n))
+        sK, sC = shape("stiffness", (n, n)), shape("damping", (n, n))
         self._cbs = [
-            _MASS(lambda t, q, M, u: call(mass, M, shape("mass", (n, n)), t, (q, n))),
+            _MASS(lambda t, q, M, u: call(mass, M, sM, t, (q, n))),
             _FORCE(lambda t, q, qd, f, u: call(force, f, (n,), t, (q, n), (qd, n)))
             if force else None,
             _CONSTRAINT(lambda t, q, p, u: call(constraint, p, (m,), t, (q, n)))
             if m and constraint else None,
-            _CONSTRAINT(lambda t, q, J, u: call(jacobian, J, shape("jacobian", (m, n)), t,
-                                                (q, n)))
+            _CONSTRAINT(lambda t, q, J, u: call(jacobian, J, sJ, t, (q, n)))
             if m and jacobian else None,
             _STIFFNESS(lambda t, q, qd, a, lam, K, u: call(
-                stiffness, K, shape("stiffness", (n, n)), t, (q, n), (qd, n), (a, n), (lam, m)))
-            if stiffness else None,
-            _FORCE(lambda t, q, qd, C, u: call(damping, C, shape("damping", (n, n)), t,
-                                               (q, n), (qd, n)))
+                stiffness, K, sK, t, (q, n), (qd, n), (a, n), (lam, m))) if stiffness else None,
+            _FORCE(lambda t, q, qd, C, u: call(damping, C, sC, t, (q, n), (qd, n)))
             if damping else None,
             _FORCE(lambda t, q, qd, o, u: call(constraint_accel, o, (m,), t, (q, n), (qd, n)))
             if constraint_accel else None,
@@ -287,7 +323,9 @@ class Solver:
         if arr is None:
             size = int(np.prod(shape))
             buf = (ctypes.c_double * max(size, 1)).from_address(address)
-            flat = np.ctypeslib.as_array(buf)[:size]
+            # an input over a read-only memoryview: its writeable flag cannot be set
+            flat = (np.ctypeslib.as_array(buf) if writeable else
+                    np.frombuffer(memoryview(buf).toreadonly(), dtype=np.float64))[:size]
             # column-major storage seen with its natural (rows, cols) shape
             arr = flat.reshape(shape[::-1]).T if len(shape) == 2 else flat
             arr.flags.writeable = writeable
