@@ -14,7 +14,11 @@
 
 #include <galpha.h>
 
-enum { N = 4, MAX_OPS = 64, STATE_MAX = 1 + 4 * N + 3, CKPT_MAX = 512 };
+/* The model: a planar chain of L = 1 to 3 links in Cartesian coordinates (n = 2 L, the point
+ * masses at the links' ends), m = L constraints |p_k - p_(k-1)|^2 = 1 (p_(-1) = 0), or L + 1
+ * with the first stated twice (redundant), or none (free particles). */
+enum { MAX_LINKS = 3, NMAX = 2 * MAX_LINKS, MMAX = MAX_LINKS + 1, MAX_OPS = 64,
+       STATE_MAX = 1 + 4 * NMAX + MMAX, CKPT_MAX = 1024 };
 
 typedef enum fault_kind { NONE, RETURN_RETRY, RETURN_FATAL, WRITE_NAN, WRITE_INF, WRITE_HUGE,
                           REENTER, FAULT_KINDS } fault_kind;
@@ -25,7 +29,7 @@ typedef struct model {
     const uint8_t *data;   /* fuzzing: the choices come from these bytes (rng unused) */
     size_t size, pos;
     int exhausted;         /* the bytes ran out: the sequence ends after this call */
-    int m;                 /* 2, 3 (redundant) or 0 */
+    int links, n, m;       /* m = links, links + 1 (redundant) or 0 */
     fault_kind fault;      /* armed failure */
     int fault_callback;    /* which callback fails */
     long calls, fault_at;  /* it fails from its fault_at-th call on */
@@ -33,6 +37,10 @@ typedef struct model {
     int impure;            /* a callback returned success with other values than usual */
     int reentry_allowed;   /* a callback's ga_step on its own solver returned other than STATE */
     int sparse_M, sparse_J, sparse_K; /* patterns declared: the callbacks write values only */
+    /* the patterns the callbacks write when declared */
+    int m_diag[NMAX], m_colptr[NMAX + 1];
+    int j_rows[4 * MMAX], j_cols[4 * MMAX], j_nnz;
+    int k_rows[3 * NMAX], k_cols[3 * NMAX], k_nnz;
 } model;
 
 static uint64_t next(model *md)
@@ -71,35 +79,74 @@ static int misbehave(model *md, int callback, double *out, int len)
     }
 }
 
+/* The chain's sizes and patterns: Phi_q row k has the entries of p_(k-1) (k > 0) and p_k;
+ * K_t = sum_k lambda_k Phi_k'' has the diagonal and the couplings of neighbouring points. */
+static void model_shape(model *md, int links, int m)
+{
+    md->links = links;
+    md->n = 2 * links;
+    md->m = m;
+    for (int i = 0; i < md->n; ++i)
+        md->m_diag[i] = md->m_colptr[i] = i;
+    md->m_colptr[md->n] = md->n;
+    int nnz = 0;
+    for (int k = 0; k < m; ++k) {
+        const int link = k < links ? k : 0;  /* the redundant row repeats row 0 */
+        for (int c = link > 0 ? 2 * link - 2 : 2 * link; c < 2 * link + 2; ++c)
+            md->j_rows[nnz] = k, md->j_cols[nnz++] = c;
+    }
+    md->j_nnz = nnz;
+    nnz = 0;
+    for (int i = 0; i < md->n; ++i)
+        md->k_rows[nnz] = i, md->k_cols[nnz++] = i;
+    for (int k = 1; k < links; ++k)
+        for (int d = 0; d < 2; ++d) {
+            md->k_rows[nnz] = 2 * k - 2 + d, md->k_cols[nnz++] = 2 * k + d;
+            md->k_rows[nnz] = 2 * k + d, md->k_cols[nnz++] = 2 * k - 2 + d;
+        }
+    md->k_nnz = nnz;
+}
+
+/* p_k - p_(k-1) of the link of constraint k (the redundant one: link 0), in x */
+static void link_vector(const model *md, int k, const double *x, double d[2])
+{
+    const int link = k < md->links ? k : 0;
+    d[0] = x[2 * link] - (link > 0 ? x[2 * link - 2] : 0.0);
+    d[1] = x[2 * link + 1] - (link > 0 ? x[2 * link - 1] : 0.0);
+}
+
 static int mass(double t, const double *q, double *M, void *user)
 {
     model *md = user;
+    const int n = md->n;
     (void)t, (void)q;
     if (md->sparse_M) {  /* the diagonal */
-        for (int i = 0; i < N; ++i)
+        for (int i = 0; i < n; ++i)
             M[i] = 1.0;
-        return misbehave(md, MASS, M, N);
+        return misbehave(md, MASS, M, n);
     }
-    memset(M, 0, sizeof(double) * N * N);
-    for (int i = 0; i < N; ++i)
-        M[i + i * N] = 1.0;
-    return misbehave(md, MASS, M, N * N);
+    memset(M, 0, sizeof(double) * (size_t)(n * n));
+    for (int i = 0; i < n; ++i)
+        M[i + i * n] = 1.0;
+    return misbehave(md, MASS, M, n * n);
 }
 static int force(double t, const double *q, const double *v, double *f, void *user)
 {
+    model *md = user;
     (void)t, (void)q, (void)v;
-    for (int i = 0; i < N; ++i)
+    for (int i = 0; i < md->n; ++i)
         f[i] = i % 2 ? -9.81 : 0.0;
-    return misbehave(user, FORCE, f, N);
+    return misbehave(md, FORCE, f, md->n);
 }
 static int constraint(double t, const double *q, double *phi, void *user)
 {
     model *md = user;
     (void)t;
-    phi[0] = 0.5 * (q[0] * q[0] + q[1] * q[1] - 1.0);
-    phi[1] = 0.5 * ((q[2] - q[0]) * (q[2] - q[0]) + (q[3] - q[1]) * (q[3] - q[1]) - 1.0);
-    if (md->m == 3)
-        phi[2] = phi[0];
+    for (int k = 0; k < md->m; ++k) {
+        double d[2];
+        link_vector(md, k, q, d);
+        phi[k] = 0.5 * (d[0] * d[0] + d[1] * d[1] - 1.0);
+    }
     return misbehave(md, CONSTRAINT, phi, md->m);
 }
 static int jacobian(double t, const double *q, double *J, void *user)
@@ -107,51 +154,67 @@ static int jacobian(double t, const double *q, double *J, void *user)
     model *md = user;
     const int m = md->m;
     (void)t;
-    if (md->sparse_J) {  /* in the order of J_ROWS, J_COLS */
-        const double values[] = {q[0], q[1], q[0] - q[2], q[1] - q[3], q[2] - q[0], q[3] - q[1],
-                                 q[0], q[1]};
-        const int nnz = m == 3 ? 8 : 6;
-        memcpy(J, values, sizeof(double) * (size_t)nnz);
-        return misbehave(md, JACOBIAN, J, nnz);
+    if (!md->sparse_J)
+        memset(J, 0, sizeof(double) * (size_t)(m * md->n));
+    int e = 0;
+    for (int k = 0; k < m; ++k) {
+        double d[2];
+        link_vector(md, k, q, d);
+        const int link = k < md->links ? k : 0;
+        const double values[4] = {-d[0], -d[1], d[0], d[1]};
+        for (int c = link > 0 ? 0 : 2; c < 4; ++c) {  /* in the order of j_rows, j_cols */
+            const int col = 2 * link - 2 + c;
+            if (md->sparse_J)
+                J[e++] = values[c];
+            else
+                J[k + col * m] = values[c];
+        }
     }
-    memset(J, 0, sizeof(double) * (size_t)(m * N));
-    J[0] = q[0], J[m] = q[1];
-    J[1] = q[0] - q[2], J[1 + m] = q[1] - q[3], J[1 + 2 * m] = q[2] - q[0],
-    J[1 + 3 * m] = q[3] - q[1];
-    if (m == 3)
-        J[2] = q[0], J[2 + m] = q[1];
-    return misbehave(md, JACOBIAN, J, m * N);
+    return misbehave(md, JACOBIAN, J, md->sparse_J ? md->j_nnz : m * md->n);
 }
 /* K_t = d(Phi_q^T lambda)/dq (M constant, f constant) */
 static int stiffness(double t, const double *q, const double *v, const double *qdd,
                      const double *lambda, double *K, void *user)
 {
     model *md = user;
+    const int n = md->n, links = md->links;
     (void)t, (void)q, (void)v, (void)qdd;
-    if (md->sparse_K) {  /* in the order of K_ROWS, K_COLS */
-        const double l0 = md->m ? lambda[0] + (md->m == 3 ? lambda[2] : 0.0) : 0.0,
-                     l1 = md->m ? lambda[1] : 0.0;
-        const double values[] = {l0 + l1, l0 + l1, l1, l1, -l1, -l1, -l1, -l1};
-        memcpy(K, values, sizeof values);
-        return misbehave(md, STIFFNESS, K, 8);
+    /* lambda_k on the link of constraint k: + on both its points' diagonals, - between them */
+    double on_link[MAX_LINKS] = {0.0};
+    for (int k = 0; k < md->m; ++k)
+        on_link[k < links ? k : 0] += lambda[k];
+    double diag[NMAX] = {0.0};
+    for (int p = 0; p < links; ++p)
+        diag[2 * p] = diag[2 * p + 1] = md->m ? on_link[p] + (p + 1 < links ? on_link[p + 1] : 0.0)
+                                              : 0.0;
+    if (md->sparse_K) {  /* in the order of k_rows, k_cols */
+        int e = 0;
+        for (int i = 0; i < n; ++i)
+            K[e++] = diag[i];
+        for (int k = 1; k < links; ++k)
+            for (int d = 0; d < 4; ++d)
+                K[e++] = md->m ? -on_link[k] : 0.0;
+        return misbehave(md, STIFFNESS, K, md->k_nnz);
     }
-    memset(K, 0, sizeof(double) * N * N);
-    if (md->m > 0) {
-        const double l0 = lambda[0] + (md->m == 3 ? lambda[2] : 0.0), l1 = lambda[1];
-        K[0] = K[1 + N] = l0 + l1;
-        K[2 + 2 * N] = K[3 + 3 * N] = l1;
-        K[2 * N] = K[2] = K[1 + 3 * N] = K[3 + N] = -l1;
-    }
-    return misbehave(md, STIFFNESS, K, N * N);
+    memset(K, 0, sizeof(double) * (size_t)(n * n));
+    for (int i = 0; i < n; ++i)
+        K[i + i * n] = diag[i];
+    for (int k = 1; k < links && md->m; ++k)
+        for (int d = 0; d < 2; ++d) {
+            const int a = 2 * k - 2 + d, b = 2 * k + d;
+            K[a + b * n] = K[b + a * n] = -on_link[k];
+        }
+    return misbehave(md, STIFFNESS, K, n * n);
 }
 static int accel(double t, const double *q, const double *v, double *out, void *user)
 {
     model *md = user;
     (void)t, (void)q;
-    out[0] = v[0] * v[0] + v[1] * v[1];
-    out[1] = (v[2] - v[0]) * (v[2] - v[0]) + (v[3] - v[1]) * (v[3] - v[1]);
-    if (md->m == 3)
-        out[2] = out[0];
+    for (int k = 0; k < md->m; ++k) {  /* Phi_qq(v, v) = |v_k - v_(k-1)|^2 */
+        double d[2];
+        link_vector(md, k, v, d);
+        out[k] = d[0] * d[0] + d[1] * d[1];
+    }
     return misbehave(md, ACCEL, out, md->m);
 }
 static int time_derivative(double t, const double *q, double *phi_t, void *user)
@@ -163,11 +226,7 @@ static int time_derivative(double t, const double *q, double *phi_t, void *user)
     return misbehave(md, DT, phi_t, md->m);
 }
 
-/* The patterns the callbacks above write when declared; and ones ga_set_pattern must refuse. */
-static const int M_DIAG[] = {0, 1, 2, 3}, M_COLPTR[] = {0, 1, 2, 3, 4};
-static const int J_ROWS[] = {0, 0, 1, 1, 1, 1, 2, 2}, J_COLS[] = {0, 1, 0, 1, 2, 3, 0, 1};
-static const int K_ROWS[] = {0, 1, 2, 3, 0, 2, 1, 3}, K_COLS[] = {0, 1, 2, 3, 2, 0, 3, 1};
-
+/* A pattern declaration: the model's own, or one ga_set_pattern must refuse. */
 static ga_status declare_pattern(model *md, ga_solver *s, int *must_fail)
 {
     static const int bad_rows[] = {0, 5, -1, 2}, bad_cols[] = {0, 1, 2, 4};
@@ -175,23 +234,24 @@ static ga_status declare_pattern(model *md, ga_solver *s, int *must_fail)
     *must_fail = k >= 5;
     switch (k) {
     case 0: {
-        const ga_status st = ga_set_pattern(s, GA_MATRIX_MASS, N, M_DIAG, M_DIAG);
+        const ga_status st = ga_set_pattern(s, GA_MATRIX_MASS, md->n, md->m_diag, md->m_diag);
         md->sparse_M |= st == GA_OK;
         return st;
     }
     case 1: {
-        const ga_status st = ga_set_pattern_csc(s, GA_MATRIX_MASS, M_COLPTR, M_DIAG);
+        const ga_status st = ga_set_pattern_csc(s, GA_MATRIX_MASS, md->m_colptr, md->m_diag);
         md->sparse_M |= st == GA_OK;
         return st;
     }
     case 2: {
         const ga_status st =
-            ga_set_pattern(s, GA_MATRIX_JACOBIAN, md->m == 3 ? 8 : 6, J_ROWS, J_COLS);
+            ga_set_pattern(s, GA_MATRIX_JACOBIAN, md->j_nnz, md->j_rows, md->j_cols);
         md->sparse_J |= st == GA_OK;
         return st;
     }
     case 3: {
-        const ga_status st = ga_set_pattern(s, GA_MATRIX_STIFFNESS, 8, K_ROWS, K_COLS);
+        const ga_status st =
+            ga_set_pattern(s, GA_MATRIX_STIFFNESS, md->k_nnz, md->k_rows, md->k_cols);
         md->sparse_K |= st == GA_OK;
         return st;
     }
@@ -199,12 +259,12 @@ static ga_status declare_pattern(model *md, ga_solver *s, int *must_fail)
     /* each of these must be refused: an index out of range, NULL arrays with entries, an
      * unknown matrix, a negative count, a decreasing colptr */
     case 5: return ga_set_pattern(s, pick(md, 4), 4, bad_rows, bad_cols);
-    case 6: return ga_set_pattern(s, pick(md, 4), 3, NULL, M_DIAG);
-    case 7: return ga_set_pattern(s, 4 + pick(md, 3), 4, M_DIAG, M_DIAG);
+    case 6: return ga_set_pattern(s, pick(md, 4), 3, NULL, md->m_diag);
+    case 7: return ga_set_pattern(s, 4 + pick(md, 3), 2, md->m_diag, md->m_diag);
     default: {
-        static const int decreasing[] = {0, 2, 1, 3, 4};
-        return pick(md, 2) ? ga_set_pattern(s, GA_MATRIX_MASS, -1, M_DIAG, M_DIAG)
-                           : ga_set_pattern_csc(s, GA_MATRIX_MASS, decreasing, M_DIAG);
+        static const int decreasing[] = {0, 2, 1, 3, 4, 5, 6};
+        return pick(md, 2) ? ga_set_pattern(s, GA_MATRIX_MASS, -1, md->m_diag, md->m_diag)
+                           : ga_set_pattern_csc(s, GA_MATRIX_MASS, decreasing, md->m_diag);
     }
     }
 }
@@ -224,16 +284,17 @@ static double step_size(model *md)
 }
 
 /* t, q, v, qdd, a, lambda; 0 before ga_init */
-static int snapshot(ga_solver *s, int m, double *x)
+static int snapshot(const model *md, ga_solver *s, double *x)
 {
+    const int n = md->n;
     if (ga_get_t(s, x) != GA_OK)
         return 0;
     SEQ_REQUIRE(ga_get_q(s, x + 1) == GA_OK);
-    SEQ_REQUIRE(ga_get_v(s, x + 1 + N) == GA_OK);
-    SEQ_REQUIRE(ga_get_qdd(s, x + 1 + 2 * N) == GA_OK);
-    SEQ_REQUIRE(ga_get_a(s, x + 1 + 3 * N) == GA_OK);
-    SEQ_REQUIRE(ga_get_lambda(s, m ? x + 1 + 4 * N : NULL) == GA_OK);
-    return 1 + 4 * N + m;
+    SEQ_REQUIRE(ga_get_v(s, x + 1 + n) == GA_OK);
+    SEQ_REQUIRE(ga_get_qdd(s, x + 1 + 2 * n) == GA_OK);
+    SEQ_REQUIRE(ga_get_a(s, x + 1 + 3 * n) == GA_OK);
+    SEQ_REQUIRE(ga_get_lambda(s, md->m ? x + 1 + 4 * n : NULL) == GA_OK);
+    return 1 + 4 * n + md->m;
 }
 
 static void check(ga_solver *s, ga_status st, int changes_solver, const char *call, int seq)
@@ -250,13 +311,13 @@ static void check(ga_solver *s, ga_status st, int changes_solver, const char *ca
 }
 
 /* A failed step must leave the state as it was. */
-static void check_transaction(ga_solver *s, int m, ga_status st, const double *before, int len,
-                              const char *call, int seq)
+static void check_transaction(const model *md, ga_solver *s, ga_status st,
+                              const double *before, int len, const char *call, int seq)
 {
     double after[STATE_MAX];
     if (st == GA_OK || len == 0)
         return;
-    SEQ_REQUIRE(snapshot(s, m, after) == len);
+    SEQ_REQUIRE(snapshot(md, s, after) == len);
     if (memcmp(before, after, sizeof(double) * (size_t)len) != 0)
         SEQ_FAIL("sequence %d: %s failed (%s: %s) but changed the state", seq, call,
                  ga_strerror(st), ga_last_error(s));
@@ -330,12 +391,13 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
     md.size = size;
     for (int k = 0; k < 4 && !data; ++k)
         next(&md);
-    const int kinds[] = {2, 3, 0};
-    md.m = kinds[pick(&md, 3)];
+    const int links = 1 + pick(&md, MAX_LINKS);
+    const int kinds[] = {links, links + 1, 0};
+    model_shape(&md, links, kinds[pick(&md, 3)]);
     ga_solver *s = NULL;
-    SEQ_REQUIRE(ga_create(N, md.m, &s) == GA_OK);
+    SEQ_REQUIRE(ga_create(md.n, md.m, &s) == GA_OK);
 #ifdef SEQ_TRACE
-    fprintf(stderr, "m = %d\n", md.m);
+    fprintf(stderr, "n = %d, m = %d\n", md.n, md.m);
 #endif
     md.s = s;
     /* snapshots read the state: the step's qdd and lambda, no callbacks */
@@ -343,15 +405,16 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
     SEQ_REQUIRE(ga_set_callbacks(s, mass, force, constraint, jacobian, &md) == GA_OK);
     if (pick(&md, 3) == 0) {  /* a third of the runs on the sparse path */
         md.sparse_M = 1;
-        SEQ_REQUIRE(ga_set_pattern(s, GA_MATRIX_MASS, N, M_DIAG, M_DIAG) == GA_OK);
+        SEQ_REQUIRE(ga_set_pattern(s, GA_MATRIX_MASS, md.n, md.m_diag, md.m_diag) == GA_OK);
         if (md.m > 0) {
             md.sparse_J = 1;
-            SEQ_REQUIRE(
-                ga_set_pattern(s, GA_MATRIX_JACOBIAN, md.m == 3 ? 8 : 6, J_ROWS, J_COLS) == GA_OK);
+            SEQ_REQUIRE(ga_set_pattern(s, GA_MATRIX_JACOBIAN, md.j_nnz, md.j_rows, md.j_cols) ==
+                        GA_OK);
         }
         if (pick(&md, 2)) {
             md.sparse_K = 1;
-            SEQ_REQUIRE(ga_set_pattern(s, GA_MATRIX_STIFFNESS, 8, K_ROWS, K_COLS) == GA_OK);
+            SEQ_REQUIRE(ga_set_pattern(s, GA_MATRIX_STIFFNESS, md.k_nnz, md.k_rows,
+                                       md.k_cols) == GA_OK);
         }
         SEQ_REQUIRE(ga_set_linear_solver(s, GA_LINEAR_SPARSE) == GA_OK);
     }
@@ -410,39 +473,44 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         }
         case 20: case 21: case 34: case 35: {
             const double angle = 0.3 + uniform(&md);
-            double q0[N] = {sin(angle), -cos(angle), sin(angle) + 1.0, -cos(angle)}, v0[N] = {0};
+            /* the first link at `angle` from the downward vertical, the others horizontal */
+            double q0[NMAX], v0[NMAX] = {0};
+            for (int k = 0; k < md.links; ++k) {
+                q0[2 * k] = sin(angle) + k;
+                q0[2 * k + 1] = -cos(angle);
+            }
             if (pick(&md, 4) == 0)
-                q0[pick(&md, N)] += edge_value(&md);
+                q0[pick(&md, md.n)] += edge_value(&md);
             if (pick(&md, 4) == 0)
-                v0[pick(&md, N)] += edge_value(&md);
+                v0[pick(&md, md.n)] += edge_value(&md);
             const double t0 = pick(&md, 5) == 0 ? edge_value(&md) : 0.0;
             call = "ga_init";
             st = ga_init(s, t0, q0, v0);
             break;
         }
         case 22: case 23: case 24: case 25: {
-            const int len = snapshot(s, md.m, before);
+            const int len = snapshot(&md, s, before);
             call = "ga_step";
             st = ga_step(s, step_size(&md));
-            check_transaction(s, md.m, st, before, len, call, seq);
+            check_transaction(&md, s, st, before, len, call, seq);
             stats->steps_ok += st == GA_OK;
             stats->sparse_ok += st == GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
             break;
         }
         case 26: {
             double t = 0.0;
-            const int len = snapshot(s, md.m, before);
+            const int len = snapshot(&md, s, before);
             ga_get_t(s, &t);
             const double t_stop = pick(&md, 4) ? t + step_size(&md) : edge_value(&md);
             call = "ga_step_adaptive";
             st = ga_step_adaptive(s, t_stop);
-            check_transaction(s, md.m, st, before, len, call, seq);
+            check_transaction(&md, s, st, before, len, call, seq);
             stats->steps_ok += st == GA_OK;
             stats->sparse_ok += st == GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
             break;
         }
         case 27: {
-            double t = 0.0, q[N], v[N], lambda[3];
+            double t = 0.0, q[NMAX], v[NMAX], lambda[MMAX];
             ga_get_t(s, &t);
             call = "ga_interpolate";
             changes = 0;
@@ -500,7 +568,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             break;
         }
         default: {
-            int active[3];
+            int active[MMAX];
             call = "ga_get_active_constraints";
             changes = 0;
             st = ga_get_active_constraints(s, active);

@@ -11,8 +11,9 @@
  *   - a callback's call of ga_step on its own solver is refused with GA_ERR_STATE;
  *   - a checkpoint restored in the solver it came from repeats the steps taken after it, bit
  *     for bit (the restart twin).
- * Models: a double pendulum in Cartesian coordinates (4 coordinates, 2 constraints), the same
- * with its first constraint stated twice (3, one redundant), and two free particles (none);
+ * Models: planar chains of 1 to 3 links in Cartesian coordinates (n = 2, 4 or 6; a constraint
+ * per link), the same with the first constraint stated twice (one redundant), and free
+ * particles (none);
  * a third of the runs declare sparsity patterns and take the sparse path, and pattern
  * declarations (valid ones, and invalid ones that must be refused) come at random too.
  * ga_advance is left out: it runs as many steps as its interval needs, which at the step
@@ -49,6 +50,74 @@ static void random_call_sequences_keep_the_contract(void **state)
     assert_true(stats.twin_steps_ok > SEQUENCES / 100);
 }
 
+/* The sequences' model is exact: for every chain length, with and without the redundant
+ * constraint, dense and in its patterns, Phi_q, K_t = d(Phi_q^T lambda)/dq and Phi_qq(v, v)
+ * agree with central differences of Phi and of Phi_q. */
+static void model_derivatives_agree_with_differences(void **state)
+{
+    (void)state;
+    const double eps = 1e-6;
+    for (int links = 1; links <= MAX_LINKS; ++links)
+        for (int redundant = 0; redundant < 2; ++redundant)
+            for (int sparse = 0; sparse < 2; ++sparse) {
+                model md = {0};
+                model_shape(&md, links, links + redundant);
+                md.sparse_J = md.sparse_K = sparse;
+                const int n = md.n, m = md.m;
+                double q[NMAX], v[NMAX], lambda[MMAX], J[MMAX * NMAX], K[NMAX * NMAX];
+                double Jd[MMAX * NMAX] = {0}, Kd[NMAX * NMAX] = {0}, out[MMAX];
+                for (int i = 0; i < n; ++i)
+                    q[i] = 0.3 * i + 0.1 * (i % 2), v[i] = 0.7 - 0.2 * i;
+                for (int k = 0; k < m; ++k)
+                    lambda[k] = 1.0 + k;
+                assert_int_equal(jacobian(0.0, q, J, &md), 0);
+                assert_int_equal(stiffness(0.0, q, v, v, lambda, K, &md), 0);
+                if (sparse) { /* scatter the values into dense matrices */
+                    for (int e = 0; e < md.j_nnz; ++e)
+                        Jd[md.j_rows[e] + md.j_cols[e] * m] = J[e];
+                    for (int e = 0; e < md.k_nnz; ++e)
+                        Kd[md.k_rows[e] + md.k_cols[e] * n] = K[e];
+                } else {
+                    memcpy(Jd, J, sizeof(double) * (size_t)(m * n));
+                    memcpy(Kd, K, sizeof(double) * (size_t)(n * n));
+                }
+                md.sparse_J = 0; /* differences of the dense Phi_q */
+                for (int j = 0; j < n; ++j) {
+                    double qp[NMAX], qm[NMAX], pp[MMAX], pm[MMAX];
+                    double Jp[MMAX * NMAX], Jm[MMAX * NMAX];
+                    memcpy(qp, q, sizeof qp);
+                    memcpy(qm, q, sizeof qm);
+                    qp[j] += eps;
+                    qm[j] -= eps;
+                    constraint(0.0, qp, pp, &md);
+                    constraint(0.0, qm, pm, &md);
+                    jacobian(0.0, qp, Jp, &md);
+                    jacobian(0.0, qm, Jm, &md);
+                    for (int k = 0; k < m; ++k)
+                        assert_true(fabs((pp[k] - pm[k]) / (2 * eps) - Jd[k + j * m]) < 1e-8);
+                    for (int i = 0; i < n; ++i) { /* column j of d(J^T lambda)/dq, row i */
+                        double d = 0.0;
+                        for (int k = 0; k < m; ++k)
+                            d += (Jp[k + i * m] - Jm[k + i * m]) / (2 * eps) * lambda[k];
+                        assert_true(fabs(d - Kd[i + j * n]) < 1e-8);
+                    }
+                }
+                /* Phi_qq(v, v) = d/ds (Phi_q(q + s v) v) at s = 0 */
+                double qp[NMAX], qm[NMAX], Jp[MMAX * NMAX], Jm[MMAX * NMAX];
+                for (int i = 0; i < n; ++i)
+                    qp[i] = q[i] + eps * v[i], qm[i] = q[i] - eps * v[i];
+                jacobian(0.0, qp, Jp, &md);
+                jacobian(0.0, qm, Jm, &md);
+                assert_int_equal(accel(0.0, q, v, out, &md), 0);
+                for (int k = 0; k < m; ++k) {
+                    double d = 0.0;
+                    for (int i = 0; i < n; ++i)
+                        d += (Jp[k + i * m] - Jm[k + i * m]) / (2 * eps) * v[i];
+                    assert_true(fabs(d - out[k]) < 1e-8);
+                }
+            }
+}
+
 /* The inputs on which the fuzzer (tests/fuzz/fuzz_api.c) once found a defect, replayed. */
 static void fuzzer_findings_stay_fixed(void **state)
 {
@@ -78,6 +147,7 @@ static void fuzzer_findings_stay_fixed(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(model_derivatives_agree_with_differences),
         cmocka_unit_test(random_call_sequences_keep_the_contract),
         cmocka_unit_test(fuzzer_findings_stay_fixed),
     };
