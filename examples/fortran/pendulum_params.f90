@@ -1,60 +1,7 @@
-! Model parameters through `user`: one set of callbacks, two pendulums of lengths 1 and 4 m.
-! Each solver gets the address of its own parameter record (a bind(C) derived type); the
-! callbacks turn it back into a Fortran pointer. The quarter period is located on the dense
-! output (interpolate with q only) and compared with the small-amplitude series
-! T/4 = (pi/2) sqrt(L/g) (1 + theta0^2/16 + 11 theta0^4/3072).
-module params_model
-  use, intrinsic :: iso_c_binding
-  implicit none
-  type, bind(C) :: pendulum_params
-     real(c_double) :: mass, length, gravity
-  end type pendulum_params
-contains
-  function params(user) result(p)
-    type(c_ptr), value :: user
-    type(pendulum_params), pointer :: p
-    call c_f_pointer(user, p)
-  end function params
-
-  integer(c_int) function p_mass(t, q, M, user) bind(C)
-    real(c_double), value :: t
-    real(c_double), intent(in) :: q(*)
-    real(c_double), intent(out) :: M(*)
-    type(c_ptr), value :: user
-    type(pendulum_params), pointer :: p
-    p => params(user)
-    M(1:4) = [p%mass, 0.0d0, 0.0d0, p%mass]
-    p_mass = 0
-  end function p_mass
-  integer(c_int) function p_force(t, q, v, f, user) bind(C)
-    real(c_double), value :: t
-    real(c_double), intent(in) :: q(*), v(*)
-    real(c_double), intent(out) :: f(*)
-    type(c_ptr), value :: user
-    type(pendulum_params), pointer :: p
-    p => params(user)
-    f(1:2) = [0.0d0, -p%mass * p%gravity]
-    p_force = 0
-  end function p_force
-  integer(c_int) function p_constraint(t, q, phi, user) bind(C)
-    real(c_double), value :: t
-    real(c_double), intent(in) :: q(*)
-    real(c_double), intent(out) :: phi(*)
-    type(c_ptr), value :: user
-    type(pendulum_params), pointer :: p
-    p => params(user)
-    phi(1) = 0.5d0 * (q(1) * q(1) + q(2) * q(2) - p%length * p%length)
-    p_constraint = 0
-  end function p_constraint
-  integer(c_int) function p_jacobian(t, q, J, user) bind(C)
-    real(c_double), value :: t
-    real(c_double), intent(in) :: q(*)
-    real(c_double), intent(out) :: J(*)
-    type(c_ptr), value :: user
-    J(1:2) = q(1:2)
-    p_jacobian = 0
-  end function p_jacobian
-end module params_model
+! Model parameters through `user`: one set of callbacks (params_model.f90), two pendulums of
+! lengths 1 and 4 m, each solver with the address of its own parameter record. The quarter
+! period is located on the dense output (interpolate with q only) and compared with the
+! small-amplitude series T/4 = (pi/2) sqrt(L/g) (1 + theta0^2/16 + 11 theta0^4/3072).
 
 program pendulum_params_demo
   use galpha

@@ -1,48 +1,12 @@
 ! The Fortran layer (type(galpha_solver)) over the whole C API: each type-bound procedure
-! against what the C API or the analysis says. Stops with a nonzero code at the first failure.
-module layer_model
-  use, intrinsic :: iso_c_binding
-  implicit none
-  real(c_double), parameter :: g = 9.81d0
-contains
-  integer(c_int) function p_mass(t, q, M, user) bind(C)
-    real(c_double), value :: t
-    real(c_double), intent(in) :: q(*)
-    real(c_double), intent(out) :: M(*)
-    type(c_ptr), value :: user
-    M(1:4) = [1.0d0, 0.0d0, 0.0d0, 1.0d0]
-    p_mass = 0
-  end function p_mass
-  integer(c_int) function p_force(t, q, v, f, user) bind(C)
-    real(c_double), value :: t
-    real(c_double), intent(in) :: q(*), v(*)
-    real(c_double), intent(out) :: f(*)
-    type(c_ptr), value :: user
-    f(1:2) = [0.0d0, -g]
-    p_force = 0
-  end function p_force
-  integer(c_int) function p_constraint(t, q, phi, user) bind(C)
-    real(c_double), value :: t
-    real(c_double), intent(in) :: q(*)
-    real(c_double), intent(out) :: phi(*)
-    type(c_ptr), value :: user
-    phi(1) = 0.5d0 * (q(1) * q(1) + q(2) * q(2) - 1.0d0)
-    p_constraint = 0
-  end function p_constraint
-  integer(c_int) function p_jacobian(t, q, J, user) bind(C)
-    real(c_double), value :: t
-    real(c_double), intent(in) :: q(*)
-    real(c_double), intent(out) :: J(*)
-    type(c_ptr), value :: user
-    J(1:2) = q(1:2)
-    p_jacobian = 0
-  end function p_jacobian
-end module layer_model
+! against what the C API or the analysis says, on the unit pendulum of params_model.f90 (its
+! parameters through `user`). Stops with a nonzero code at the first failure.
 
 program test_layer
   use galpha
-  use layer_model
+  use params_model
   implicit none
+  type(pendulum_params), target :: unit = pendulum_params(1.0d0, 1.0d0, 9.81d0)
   type(galpha_solver) :: s, r
   real(c_double) :: q(2), v(2), a(2), lam(1), q2(2), v2(2), lam2(1), x, am, af, beta, gam
   real(c_double), allocatable :: ckpt(:), back(:)
@@ -58,7 +22,8 @@ program test_layer
   call ok(s%create(2, 1), 'create')
   call ok(s%get_size(n, m), 'get_size')
   call expect(n == 2 .and. m == 1, 'get_size values')
-  call ok(s%set_callbacks(p_mass, p_force, p_constraint, p_jacobian), 'set_callbacks')
+  call ok(s%set_callbacks(p_mass, p_force, p_constraint, p_jacobian, c_loc(unit)), &
+          'set_callbacks')
 
   ! parameters from rho_inf (Chung-Hulbert): alpha_m = (2 rho - 1)/(rho + 1), alpha_f =
   ! rho/(rho + 1), gamma = 1/2 + alpha_f - alpha_m, beta = (gamma + 1/2)^2 / 4
@@ -134,7 +99,8 @@ program test_layer
   call ok(s%get_state(ckpt), 'get_state')
   call expect(s%get_state(ckpt(1:nstate - 1)) == GA_ERR_ARG, 'get_state checks the length')
   call ok(r%create(2, 1), 'create r')
-  call ok(r%set_callbacks(p_mass, p_force, p_constraint, p_jacobian), 'set_callbacks r')
+  call ok(r%set_callbacks(p_mass, p_force, p_constraint, p_jacobian, c_loc(unit)), &
+          'set_callbacks r')
   call ok(r%set_rho_inf(rho), 'set_rho_inf r')
   call ok(r%set_tolerances(1d-6, 1d-6), 'set_tolerances r')
   call ok(r%set_step_limits(1d-10, 0.05d0), 'set_step_limits r')
