@@ -65,6 +65,9 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
 {
     invalidate_jacobian();
     jacobian_valid_ = false;
+    // A restart (after a jump in q or v) is a new solver with the same options and patterns:
+    // no pivots from the run before, so that it repeats what a new solver does, bit for bit.
+    forget_pivots();
     State &x = trial_;
     x.t = t0;
     x.h_last = 0.0;

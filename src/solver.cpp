@@ -307,6 +307,15 @@ ga_status Solver::step(double h)
     return GA_OK;
 }
 
+void Solver::forget_pivots()
+{
+    S_.forget_pivots();
+    S2_.forget_pivots();
+    P_.forget_pivots();
+    O_.forget_pivots();
+    pivots_forgotten_ = false;
+}
+
 void Solver::commit(bool land_on, double t_land)
 {
     accepted_.swap(trial_);    // the new step becomes the state ...
@@ -324,13 +333,8 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
 {
     if (formulation == GA_INDEX2_STABILIZED && !S2_.ready())
         return diag.fail(GA_ERR_INTERNAL, "the stabilized index-2 system was not set up");
-    if (pivots_forgotten_) {  // after a checkpoint: pivots as a restarted solver picks them
-        S_.forget_pivots();
-        S2_.forget_pivots();
-        P_.forget_pivots();
-        O_.forget_pivots();
-        pivots_forgotten_ = false;
-    }
+    if (pivots_forgotten_)  // after a layout-2 checkpoint: pivots as a new solver picks them
+        forget_pivots();
     const State &s = accepted_;
     const double short_limit = s.h_last / kShortStepRatio;
     const bool short_step = s.h_last > 0.0 && h < short_limit;

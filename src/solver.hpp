@@ -223,6 +223,7 @@ private:
     mutable bool fd_tangents_ = false;
     // A checkpoint of layout 2 was restored: the next step forgets the pivots (set_state).
     bool pivots_forgotten_ = false;
+    void forget_pivots();  // of every sparse LU: the next factorizations choose them afresh
     // What rebuilds the kept iteration matrix bit for bit (checkpoint): the time, iterate and
     // h it was factorized at, the tangents it holds and, in index 2, the q_n of B = Phi_q(q_n).
     struct MatrixRecipe {

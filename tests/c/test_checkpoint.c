@@ -345,6 +345,60 @@ static void failed_rebuild_restores_as_a_restart(void **state)
     ga_free(r);
 }
 
+/* The restart after a jump (an impact law, a switched force): ga_init on a running solver, at
+ * a new state, continues exactly as a new solver with the same options started there does,
+ * dense and sparse, index 3 and 2, fixed and adaptive steps (nothing of the run before is
+ * kept: not the step-size history, the kept matrix, nor the sparse pivots). */
+static void restart_after_a_jump_is_a_new_solver(void **state)
+{
+    (void)state;
+    chain c = chain_make(20);
+    enum { NQ = 3 * 20 };
+    double q[NQ], v[NQ];
+    chain_initial(&c, q, v);
+    for (int config = 0; config < 8; ++config) {
+        const int sparse = config & 1, formulation = config & 2 ? GA_INDEX2_STABILIZED : GA_INDEX3;
+        const int adaptive = (config & 4) != 0;
+        ga_solver *s[2];
+        for (int i = 0; i < 2; ++i) {
+            s[i] = chain_solver(&c, 1);
+            assert_int_equal(ga_set_linear_solver(s[i], sparse ? GA_LINEAR_SPARSE
+                                                               : GA_LINEAR_DENSE),
+                             GA_OK);
+            assert_int_equal(ga_set_formulation(s[i], formulation), GA_OK);
+            assert_int_equal(ga_set_tolerances(s[i], 1e-5, 1e-7), GA_OK);
+        }
+        assert_int_equal(ga_init(s[0], 0.0, q, v), GA_OK);
+        for (int k = 0; k < 20; ++k)
+            assert_int_equal(adaptive ? ga_step_adaptive(s[0], 100.0) : ga_step(s[0], 3e-3),
+                             GA_OK);
+        /* the jump: velocities reversed and halved, one position nudged off the constraints */
+        double t, qj[NQ], vj[NQ];
+        assert_int_equal(ga_get_t(s[0], &t), GA_OK);
+        assert_int_equal(ga_get_q(s[0], qj), GA_OK);
+        assert_int_equal(ga_get_v(s[0], vj), GA_OK);
+        for (int i = 0; i < NQ; ++i)
+            vj[i] *= -0.5;
+        qj[4] += 1e-3;
+        for (int i = 0; i < 2; ++i)
+            assert_int_equal(ga_init(s[i], t, qj, vj), GA_OK);
+        for (int k = 0; k < 20; ++k)
+            for (int i = 0; i < 2; ++i)
+                assert_int_equal(adaptive ? ga_step_adaptive(s[i], 100.0) : ga_step(s[i], 3e-3),
+                                 GA_OK);
+        size_t len = 0;
+        assert_int_equal(ga_state_size(s[0], &len), GA_OK);
+        double *a = malloc(2 * len * sizeof(double)), *b = a + len;
+        assert_non_null(a);
+        assert_int_equal(ga_get_state(s[0], a, len), GA_OK);
+        assert_int_equal(ga_get_state(s[1], b, len), GA_OK);
+        assert_memory_equal(a, b, len * sizeof(double));
+        free(a);
+        for (int i = 0; i < 2; ++i)
+            ga_free(s[i]);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -355,6 +409,7 @@ int main(void)
         cmocka_unit_test(restart_between_slivers_is_bit_identical),
         cmocka_unit_test(taking_checkpoints_changes_nothing),
         cmocka_unit_test(failed_rebuild_restores_as_a_restart),
+        cmocka_unit_test(restart_after_a_jump_is_a_new_solver),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
