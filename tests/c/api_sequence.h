@@ -1,7 +1,8 @@
 /* Random sequences of C API calls, shared by tests/c/test_api_sequences.c (choices from a
  * seeded generator) and the libFuzzer harness tests/fuzz/fuzz_api.c (choices from the fuzzer's
  * bytes); see test_api_sequences.c for what they make and what must hold. The includer
- * defines SEQ_FAIL(fmt, ...) (report and stop) and SEQ_REQUIRE(cond). */
+ * defines SEQ_FAIL(fmt, ...) (report and stop) and SEQ_REQUIRE(cond), and SEQ_TRACE to have
+ * every call and the restart twins printed to stderr (to read what a fuzzer finding does). */
 #ifndef GALPHA_TESTS_API_SEQUENCE_H
 #define GALPHA_TESTS_API_SEQUENCE_H
 

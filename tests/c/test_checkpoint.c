@@ -21,11 +21,8 @@ static pendulum P = {1.0, 1.0, 9.81};
 
 static ga_solver *make(void)
 {
-    ga_solver *s = NULL;
-    assert_int_equal(ga_create(2, 1, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
-                                      pendulum_jacobian, &P),
-                     GA_OK);
+    ga_solver *s = pendulum_new_solver(&P, 0);
+    assert_non_null(s);
     assert_int_equal(ga_set_rho_inf(s, 0.7), GA_OK);
     return s;
 }

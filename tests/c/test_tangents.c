@@ -16,6 +16,7 @@
 #include <cmocka.h>
 #include <galpha.h>
 
+#include "helpers.h"
 #include "scenes/andrews.h"
 #include "scenes/chain.h"
 #include "scenes/pendulum.h"
@@ -154,12 +155,9 @@ static void differences_count_their_residuals(void **state)
     (void)state;
     pendulum p = {1.0, 1.0, 9.81};
     double q[2], v[2];
-    ga_solver *s = NULL;
     pendulum_state(&p, 1.0, 0.5, q, v);
-    assert_int_equal(ga_create(2, 1, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
-                                      pendulum_jacobian, &p),
-                     GA_OK);
+    ga_solver *s = pendulum_new_solver(&p, 0);
+    assert_non_null(s);
     assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     for (int i = 0; i < 10; ++i)

@@ -39,12 +39,9 @@ static void one_solver_in_two_threads_is_refused_not_shared(void **state)
     (void)state;
     pendulum p = {1.0, 1.0, 9.81};
     double q[2], v[2];
-    ga_solver *s = NULL;
     pendulum_state(&p, 1.0, 0.5, q, v);
-    assert_int_equal(ga_create(2, 1, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
-                                      pendulum_jacobian, &p),
-                     GA_OK);
+    ga_solver *s = pendulum_new_solver(&p, 0);
+    assert_non_null(s);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     shared sh[2] = {{s, 0, 0, 0}, {s, 0, 0, 0}};
     pthread_t th[2];
