@@ -118,7 +118,10 @@ typedef enum ga_status {
                                      could not be, projected onto them */
     GA_ERR_INTERNAL = -10,      /**< unexpected internal error, including a C++ exception thrown
                                      by a user callback written in C++ */
-    GA_ERR_STEP_SIZE = -11      /**< adaptive mode: the step size fell below its minimum */
+    GA_ERR_STEP_SIZE = -11,     /**< adaptive mode: the step size fell below its minimum */
+    GA_EVENT = 1                /**< not an error: ga_step, ga_step_adaptive or ga_advance stopped
+                                     at a terminal event (or with its event log full); see
+                                     ga_set_events */
 } ga_status;
 
 /** Fixed English name of a status (a ::ga_status value), e.g. "invalid argument"; "unknown
@@ -153,6 +156,10 @@ typedef int (*ga_damping_fn)(double t, const double *q, const double *v, double 
  *  d^2/dt^2 Phi(q(t), t) - Phi_q q'': length m. Optional (finite differences otherwise). */
 typedef int (*ga_constraint_accel_fn)(double t, const double *q, const double *v, double *out,
                                       void *user);
+/** Event functions g_k(t, q, v, lambda), k = 0 .. count-1, written to g (length count; see
+ *  ga_set_events). lambda (length m) is NULL unless ga_set_events asked for multipliers. */
+typedef int (*ga_event_fn)(double t, const double *q, const double *v, const double *lambda,
+                           double *g, void *user);
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */
@@ -546,6 +553,62 @@ GA_API ga_status ga_interpolate_qdd(const ga_solver *s, double t, double *qdd);
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */
+/** @name Events
+ *  Event functions g_k(t, q, v, lambda) whose sign changes are located inside accepted steps on
+ *  the dense output, never by taking steps again (with Jacobian reuse a re-taken step need not
+ *  reproduce a sign change): after each accepted step g is evaluated at its end, and where a
+ *  watched sign change shows, the earliest root is found by the Illinois secant method
+ *  safeguarded by bisection, to within 100 u (|t| + |h|) after it (u the unit round-off; the
+ *  tolerance of SUNDIALS IDA), then the rest of the step is searched from there, so that
+ *  roots of several functions in one step are found in time order. A function exactly zero
+ *  where a search starts does not fire there. docs/algorithms.md sec. 12. */
+/**@{*/
+typedef enum ga_event_direction {
+    GA_EVENT_BOTH = 0,    /**< any sign change */
+    GA_EVENT_RISING = 1,  /**< from below zero to zero or above */
+    GA_EVENT_FALLING = -1 /**< from above zero to zero or below */
+} ga_event_direction;
+
+/** Entries of the event log of one stepping call. */
+#define GA_EVENT_LOG 64
+
+/** Watch `count` event functions (0 removes them), evaluated by `fn` with the user pointer of
+ *  ga_set_callbacks. direction[k] is a ::ga_event_direction (NULL: all GA_EVENT_BOTH).
+ *  terminal[k] nonzero (NULL: all terminal): ga_step, ga_step_adaptive and ga_advance stop
+ *  after locating it and return GA_EVENT; zero: the event is logged and the run goes on.
+ *  with_multipliers nonzero: fn receives lambda as ga_get_lambda and ga_interpolate give it
+ *  (by default from the acceleration-level equations at the interpolated q, v, so that the
+ *  time where a multiplier vanishes converges at the method's order; one saddle-point solve
+ *  per step and per evaluation inside a step); zero: lambda is NULL and a step costs one call
+ *  of fn more than without events.
+ *  After GA_EVENT the solver stands at the end of the step in which the event lies (ga_get_t):
+ *  ga_get_event gives its time t_e, ga_interpolate(t_e) and ga_interpolate_qdd the state
+ *  there. The next stepping call first searches the rest of that step, then goes on; to change
+ *  q, v at the event (an impact, a switched force), restart with ga_init(t_e, q, v), which
+ *  keeps every option and these events. The search starts afresh from the current state at
+ *  the next stepping call after ga_init, ga_set_state or this call.
+ *  A failed event callback (or a NaN in g) fails the step that called it, which is undone like
+ *  any failed step; a failed ga_step or ga_step_adaptive leaves the search where it was, so
+ *  that a retry finds the same events. Allocates (count + n + m doubles and the log); may be
+ *  called before or after ga_init. Errors: GA_ERR_ARG (count < 0, fn NULL with count > 0, a
+ *  direction not -1, 0 or 1), GA_ERR_STATE, GA_ERR_NOMEM. */
+GA_API ga_status ga_set_events(ga_solver *s, int count, ga_event_fn fn, const int *direction,
+                               const int *terminal, int with_multipliers);
+
+/** Events logged by the last ga_step, ga_step_adaptive or ga_advance (each starts an empty
+ *  log; ga_advance keeps those of the steps it accepted before a failure). A call stops with
+ *  GA_EVENT when its log is full, as at a terminal event: nothing is lost. Errors: GA_ERR_ARG,
+ *  GA_ERR_STATE (from a callback). */
+GA_API ga_status ga_get_event_count(const ga_solver *s, int *count);
+
+/** Entry i (0 <= i < count) of that log, in time order: the located time t, the function
+ *  `index` and its `direction` (+1 rising, -1 falling). Functions that cross at one located
+ *  time are logged one after the other with the same t. Any output pointer may be NULL.
+ *  Errors: GA_ERR_ARG (i out of range), GA_ERR_STATE (from a callback). */
+GA_API ga_status ga_get_event(const ga_solver *s, int i, double *t, int *index, int *direction);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
 /** @name Consistent start */
 /**@{*/
 /** Optional callback for the constraint acceleration term (finite differences of Phi_q and Phi
@@ -690,11 +753,12 @@ typedef enum ga_counter {
     GA_COUNT_REJECTED_STEPS = 12, /**< adaptive mode: steps rejected by the error test (steps
                                       whose Newton iteration or callbacks failed count in
                                       GA_COUNT_FAILED_STEPS) */
-    GA_COUNT_CONSTRAINT_DT_EVALS = 13 /**< Phi_t evaluations (callback, or finite differences:
+    GA_COUNT_CONSTRAINT_DT_EVALS = 13, /**< Phi_t evaluations (callback, or finite differences:
                                       their constraint calls count in
                                       GA_COUNT_CONSTRAINT_EVALS too) */
+    GA_COUNT_EVENT_EVALS = 14    /**< event function callback calls (ga_set_events) */
 } ga_counter;
-#define GA_COUNTER_COUNT 14
+#define GA_COUNTER_COUNT 15
 
 /** Value of the counter `key` (a ::ga_counter). Errors: GA_ERR_ARG (NULL or unknown key),
  *  GA_ERR_STATE. */

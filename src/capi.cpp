@@ -187,6 +187,7 @@ GA_API const char *ga_strerror(int status)
     case GA_ERR_INCONSISTENT: return "inconsistent initial values";
     case GA_ERR_INTERNAL: return "internal error";
     case GA_ERR_STEP_SIZE: return "step size below its minimum";
+    case GA_EVENT: return "stopped at an event";
     }
     return "unknown status";
 }
@@ -556,6 +557,52 @@ GA_API ga_status ga_advance(ga_solver *s, double t_out)
         if (!std::isfinite(t_out))
             return c.diag.fail(GA_ERR_ARG, "t_out = %g is not finite", t_out);
         return c.advance(t_out);
+    });
+}
+
+GA_API ga_status ga_set_events(ga_solver *s, int count, ga_event_fn fn, const int *direction,
+                               const int *terminal, int with_multipliers)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (count < 0)
+            return c.diag.fail(GA_ERR_ARG, "ga_set_events: count = %d is negative", count);
+        if (count > 0 && !fn)
+            return c.diag.fail(GA_ERR_ARG, "ga_set_events: %d functions but fn is NULL", count);
+        for (int k = 0; direction && k < count; ++k)
+            if (direction[k] < -1 || direction[k] > 1)
+                return c.diag.fail(GA_ERR_ARG,
+                                   "ga_set_events: direction[%d] = %d is not -1, 0 or 1", k,
+                                   direction[k]);
+        c.events().configure(count, fn, direction, terminal, with_multipliers != 0, c.n(),
+                             c.m());
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_get_event_count(const ga_solver *s, int *count)
+{
+    return reading(s, "ga_get_event_count", "count is NULL", [&](const ga::Solver &c) {
+        if (!count)
+            return GA_ERR_ARG;
+        *count = c.events().logged();
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_get_event(const ga_solver *s, int i, double *t, int *index, int *direction)
+{
+    return reading(s, "ga_get_event", "i is not an entry of the event log",
+                   [&](const ga::Solver &c) {
+        if (i < 0 || i >= c.events().logged())
+            return GA_ERR_ARG;
+        const ga::EventSet::Entry &e = c.events().entry(i);
+        if (t)
+            *t = e.t;
+        if (index)
+            *index = e.index;
+        if (direction)
+            *direction = e.direction;
+        return GA_OK;
     });
 }
 

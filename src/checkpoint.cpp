@@ -196,6 +196,7 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
     }
     invalidate_jacobian();
     previous_valid_ = false;
+    events_.restart();
     ++state_id_;
     // A checkpoint from before the first step (h_last = 0) still owes that step its corrected
     // starting values, as the solver it was taken from does.

@@ -84,7 +84,7 @@ double Solver::error_norm(double h)
     return std::sqrt(sum / (2.0 * n_));
 }
 
-ga_status Solver::step_adaptive(double t_stop)
+ga_status Solver::adaptive_step(double t_stop)
 {
     // In index 3 every change of h starts a transient in qdd and lambda whose recursion has
     // the double root -alpha_f/(1 - alpha_f) (docs/algorithms.md sec. 1.4, 6.2): -rho_inf, so at
@@ -211,9 +211,25 @@ ga_status Solver::advance(double t_out)
 {
     if (t_out < accepted_.t)
         return diag.fail(GA_ERR_ARG, "t_out = %.17g is before t = %.17g", t_out, accepted_.t);
-    while (accepted_.t < t_out)
-        if (auto st = step_adaptive(t_out))
+    if (!events_.active()) {
+        while (accepted_.t < t_out)
+            if (auto st = adaptive_step(t_out))
+                return st;
+        return GA_OK;
+    }
+    events_.clear_log();
+    events_.save();
+    if (auto st = resume_events()) {
+        if (st < 0)
+            events_.restore();
+        return st;
+    }
+    // each step is undone alone: those accepted before a failure stay, with their events
+    while (accepted_.t < t_out) {
+        events_.save();
+        if (auto st = step_with_events(true, t_out))
             return st;
+    }
     return GA_OK;
 }
 

@@ -1,5 +1,7 @@
 #include "events.hpp"
 
+#include "solver.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -87,6 +89,187 @@ int EventLocator::locate(double t0, const double *g0, double t1, const double *g
     for (int k = 0; k < K; ++k)
         fired[k] = crossing(lo_[k], hi_[k], direction[k]);
     return 1;
+}
+
+void EventSet::configure(int count, ga_event_fn fn, const int *direction, const int *terminal,
+                         bool with_lambda, int n, int m)
+{
+    // everything is allocated before anything changes: a failure leaves the old set
+    std::vector<int> dir(count), term(count), fired(count);
+    std::vector<double> lo(count), hi(count), slo(count), shi(count);
+    std::vector<double> qs(count ? n : 0), vs(count ? n : 0), ls(count && with_lambda ? m : 0);
+    // a whole root fits into an empty log, however many functions cross at it
+    std::vector<Entry> log(count ? std::max(count, GA_EVENT_LOG) : 0);
+    EventLocator locator_new;
+    locator_new.setup(count);
+    for (int k = 0; k < count; ++k) {
+        dir[k] = direction ? direction[k] : GA_EVENT_BOTH;
+        term[k] = terminal ? (terminal[k] != 0) : 1;
+    }
+    fn_ = count ? fn : nullptr;
+    with_lambda_ = count && with_lambda;
+    direction_.swap(dir);
+    terminal_.swap(term);
+    this->fired.swap(fired);
+    g_lo.swap(lo);
+    g_hi.swap(hi);
+    saved_g_lo_.swap(slo);
+    saved_g_hi_.swap(shi);
+    q.swap(qs);
+    v.swap(vs);
+    lambda.swap(ls);
+    log_.swap(log);
+    locator = std::move(locator_new);
+    log_count_ = 0;
+    started = false;
+}
+
+void EventSet::save()
+{
+    saved_started_ = started;
+    saved_t_lo_ = t_lo;
+    saved_t_hi_ = t_hi;
+    saved_log_count_ = log_count_;
+    std::copy(g_lo.begin(), g_lo.end(), saved_g_lo_.begin());
+    std::copy(g_hi.begin(), g_hi.end(), saved_g_hi_.begin());
+}
+
+void EventSet::restore()
+{
+    started = saved_started_;
+    t_lo = saved_t_lo_;
+    t_hi = saved_t_hi_;
+    log_count_ = saved_log_count_;
+    std::copy(saved_g_lo_.begin(), saved_g_lo_.end(), g_lo.begin());
+    std::copy(saved_g_hi_.begin(), saved_g_hi_.end(), g_hi.begin());
+}
+
+// g at t: at the end of the last step from the accepted state, inside it from the dense
+// output, with lambda (if asked for) as ga_get_lambda and ga_interpolate give it.
+ga_status Solver::event_values(double t, double *g)
+{
+    EventSet &e = events_;
+    double *lambda = e.with_lambda() ? e.lambda.data() : nullptr;
+    const double *q = accepted_.q.data(), *v = accepted_.v.data();
+    if (t == accepted_.t) {
+        if (lambda)
+            if (auto st = output_state(nullptr, lambda))
+                return st;
+    } else {
+        if (auto st = interpolate(t, e.q.data(), e.v.data(), nullptr, lambda))
+            return st;
+        q = e.q.data();
+        v = e.v.data();
+    }
+    return model.event_functions(e.fn(), t, q, v, lambda, g, e.count());
+}
+
+// The rest (t_lo, t_hi] of the last step: what fires there is logged in time order. GA_EVENT
+// at a terminal event or a full log, the search left just after the root (or, if the next
+// root's entries do not fit, before it) for the next call.
+ga_status Solver::search_events()
+{
+    EventSet &e = events_;
+    const auto evaluate = [](double t, double *g, void *self) {
+        return static_cast<int>(static_cast<Solver *>(self)->event_values(t, g));
+    };
+    while (e.t_lo < e.t_hi) {
+        double t_root = 0.0;
+        const int found = e.locator.locate(e.t_lo, e.g_lo.data(), e.t_hi, e.g_hi.data(),
+                                           e.direction(), evaluate, this, &t_root,
+                                           e.fired.data());
+        if (found < 0)
+            return static_cast<ga_status>(found);
+        if (found == 0)
+            break;
+        const int crossing = static_cast<int>(
+            std::count_if(e.fired.begin(), e.fired.end(), [](int f) { return f != 0; }));
+        if (e.logged() + crossing > e.capacity())
+            return GA_EVENT;
+        bool stop = false;
+        for (int k = 0; k < e.count(); ++k) {
+            if (e.fired[k]) {
+                e.log(t_root, k, e.fired[k]);
+                stop = stop || e.terminal(k);
+            }
+        }
+        e.t_lo = t_root;
+        std::copy(e.locator.root_values(), e.locator.root_values() + e.count(), e.g_lo.begin());
+        if (stop || e.log_full())
+            return GA_EVENT;
+    }
+    e.t_lo = e.t_hi;
+    std::copy(e.g_hi.begin(), e.g_hi.end(), e.g_lo.begin());
+    return GA_OK;
+}
+
+// At the start of a stepping call: g at the current state if the search starts afresh, else
+// the rest of the last step, which a call that stopped at an event left.
+ga_status Solver::resume_events()
+{
+    EventSet &e = events_;
+    if (e.started)
+        return search_events();
+    if (auto st = event_values(accepted_.t, e.g_lo.data()))
+        return st;
+    e.t_lo = e.t_hi = accepted_.t;
+    e.started = true;
+    return GA_OK;
+}
+
+// After a step was accepted: g at its end, and the search over it.
+ga_status Solver::events_after_step()
+{
+    EventSet &e = events_;
+    if (auto st = event_values(accepted_.t, e.g_hi.data()))
+        return st;
+    e.t_hi = accepted_.t;
+    return search_events();
+}
+
+// The caller saved the search (events_.save()) where a failure must put it back.
+ga_status Solver::step_with_events(bool adaptive, double h_or_t_stop)
+{
+    const StepUndo undo = undo_point();
+    if (auto st = adaptive ? adaptive_step(h_or_t_stop) : take_step(h_or_t_stop)) {
+        events_.restore();
+        return st;
+    }
+    const ga_status st = events_after_step();
+    if (st < 0) {
+        undo_step(undo);
+        events_.restore();
+    }
+    return st;
+}
+
+// ga_step and ga_step_adaptive: first the rest of the step a call stopped in, then one step.
+ga_status Solver::step(double h)
+{
+    if (!events_.active())
+        return take_step(h);
+    events_.clear_log();
+    events_.save();
+    if (auto st = resume_events()) {
+        if (st < 0)
+            events_.restore();
+        return st;
+    }
+    return step_with_events(false, h);
+}
+
+ga_status Solver::step_adaptive(double t_stop)
+{
+    if (!events_.active())
+        return adaptive_step(t_stop);
+    events_.clear_log();
+    events_.save();
+    if (auto st = resume_events()) {
+        if (st < 0)
+            events_.restore();
+        return st;
+    }
+    return step_with_events(true, t_stop);
 }
 
 }  // namespace ga

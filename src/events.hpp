@@ -6,6 +6,8 @@
 
 #include <vector>
 
+#include "galpha.h"
+
 namespace ga {
 
 class EventLocator {
@@ -28,10 +30,68 @@ public:
                Evaluate g, void *context, double *t_root, int *fired);
 
     int last_evaluations() const { return evaluations_; }
+    // g at the *t_root of the last locate() that found one.
+    const double *root_values() const { return hi_.data(); }
 
 private:
     std::vector<double> lo_, hi_, mid_;
     int evaluations_ = 0;
+};
+
+// The event functions a solver watches (ga_set_events), where their search stands, and the
+// log of one stepping call. The search covers the accepted steps one after the other: [t_lo,
+// t_hi] is the part of the last step not yet searched (empty once it is done), g_lo and g_hi
+// the values at its ends.
+class EventSet {
+public:
+    struct Entry {
+        double t;
+        int index, direction;
+    };
+
+    // Allocates everything the search needs (count 0: no events); throws std::bad_alloc.
+    void configure(int count, ga_event_fn fn, const int *direction, const int *terminal,
+                   bool with_lambda, int n, int m);
+    int count() const { return static_cast<int>(direction_.size()); }
+    bool active() const { return count() > 0; }
+    ga_event_fn fn() const { return fn_; }
+    bool with_lambda() const { return with_lambda_; }
+    const int *direction() const { return direction_.data(); }
+    bool terminal(int k) const { return terminal_[k] != 0; }
+
+    // The search starts again from the state at the next stepping call.
+    void restart() { started = false; }
+
+    // A stepping call starts with an empty log; save() keeps where the search stands (and the
+    // log's length) so that restore() can put it back when a step fails.
+    void clear_log() { log_count_ = 0; }
+    void save();
+    void restore();
+
+    int capacity() const { return static_cast<int>(log_.size()); }
+    bool log_full() const { return log_count_ == capacity(); }
+    void log(double t, int index, int direction) { log_[log_count_++] = {t, index, direction}; }
+    int logged() const { return log_count_; }
+    const Entry &entry(int i) const { return log_[i]; }
+
+    bool started = false;  // g_lo holds g at t_lo
+    double t_lo = 0.0, t_hi = 0.0;
+    std::vector<double> g_lo, g_hi;
+    std::vector<double> q, v, lambda;  // the interpolated state g is evaluated at
+    EventLocator locator;
+    std::vector<int> fired;
+
+private:
+    ga_event_fn fn_ = nullptr;
+    bool with_lambda_ = false;
+    std::vector<int> direction_, terminal_;
+    std::vector<Entry> log_;
+    int log_count_ = 0;
+    // what save() kept
+    bool saved_started_ = false;
+    double saved_t_lo_ = 0.0, saved_t_hi_ = 0.0;
+    int saved_log_count_ = 0;
+    std::vector<double> saved_g_lo_, saved_g_hi_;
 };
 
 }  // namespace ga

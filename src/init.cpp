@@ -98,6 +98,7 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
     ++state_id_;
     initialized_ = true;
     previous_valid_ = false;
+    events_.restart();
     start_pending_ = true;  // corrected starting values need the h of the first step
     control.h_next = 0.0;
     control.err_prev = 0.0;  // no accepted step: no base for the predictive controller

@@ -93,6 +93,9 @@ public:
     // Phi_t: the callback, or extrapolated central differences in t (exactly zero for
     // time-independent constraints).
     ga_status constraint_dt(double t, const Vec &q, Vec &out);
+    // The event functions of ga_set_events: `count` values into g (lambda may be null).
+    ga_status event_functions(ga_event_fn fn, double t, const double *q, const double *v,
+                              const double *lambda, double *g, int count);
 
     // r^q = M qdd - f + Phi_q^T lambda: the residual of eq. (1), not weighted.
     static void dynamics_residual(const ModelMatrix &M, const Vec &qdd, const Vec &f,

@@ -284,7 +284,7 @@ double Solver::newton_tolerance(bool adaptive) const
     return adaptive ? kFractionOfLocal * control.rtol * control.calibration() : kFixedStep;
 }
 
-ga_status Solver::step(double h)
+ga_status Solver::take_step(double h)
 {
     // Every exit that is not a commit counts as a failed step, exceptions included.
     struct FailedStepCounter {
@@ -314,6 +314,20 @@ void Solver::forget_pivots()
     P_.forget_pivots();
     O_.forget_pivots();
     pivots_forgotten_ = false;
+}
+
+void Solver::undo_step(const StepUndo &u)
+{
+    previous_.swap(trial_);  // commit's swaps, backwards
+    accepted_.swap(trial_);
+    previous_valid_ = u.previous_valid;
+    start_pending_ = u.start_pending;
+    control = u.control;
+    ++state_id_;  // no output computed for the undone state is taken for this one
+    output_for_ = -1;
+    count(counters, GA_COUNT_STEPS, -1);
+    count(counters, GA_COUNT_FAILED_STEPS);
+    invalidate_jacobian();
 }
 
 void Solver::commit(bool land_on, double t_land)

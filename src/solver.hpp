@@ -6,6 +6,7 @@
 #include <cstddef>
 
 #include "diagnostics.hpp"
+#include "events.hpp"
 #include "linear/index2_matrix.hpp"
 #include "linear/iteration_matrix.hpp"
 #include "model.hpp"
@@ -94,6 +95,7 @@ public:
     const State &state() const { return accepted_; }
 
     ga_status init(double t0, const double *q0, const double *v0);  // init.cpp
+    // One step of size h; with events (events.cpp) GA_EVENT when a terminal one fired in it.
     ga_status step(double h);
     // Adaptive mode (control.cpp): one controlled step, not beyond t_stop (landing on it
     // exactly if it is reached); or steps until t_out exactly.
@@ -107,6 +109,10 @@ public:
     // Allocates the workspace of consistent output if the solver's workspace exists and it
     // does not yet; throws std::bad_alloc.
     void setup_output();
+
+    // Events (events.cpp): the functions watched, where their search stands, the last log.
+    EventSet &events() { return events_; }
+    const EventSet &events() const { return events_; }
 
     // Anything that changes the iteration matrix (options, callbacks) calls this.
     void invalidate_jacobian() const
@@ -159,6 +165,25 @@ private:
     // restart (sliver_step).
     static constexpr double kShortStepRatio = 100.0;
     ga_status newton(double h, double tol, bool refresh, bool &converged, bool &used_stale);
+    ga_status take_step(double h);               // ga_step's step, without events
+    ga_status adaptive_step(double t_stop);      // control.cpp: ga_step_adaptive's, likewise
+    // What a step changes besides the states, so that a step whose event search fails after
+    // its commit can be undone.
+    struct StepUndo {
+        bool previous_valid, start_pending;
+        Control control;
+    };
+    StepUndo undo_point() const { return {previous_valid_, start_pending_, control}; }
+    void undo_step(const StepUndo &u);
+    // events.cpp
+    ga_status event_values(double t, double *g);
+    ga_status search_events();
+    ga_status resume_events();
+    ga_status events_after_step();
+    // A step (take_step(h), or adaptive_step(t_stop) if adaptive) with the event search
+    // after it; a failure of either leaves the solver as it was and the search as the
+    // caller saved it.
+    ga_status step_with_events(bool adaptive, double h_or_t_stop);
     ga_status residual(double t, const State &x);
     ga_status factorize(double t, const State &x, double h, bool tangents_K, bool tangents_C,
                         bool tangent_Z, int iter);
@@ -253,6 +278,8 @@ private:
     IterationMatrix P_;  // [I Phi_q^T; Phi_q 0]: tangent projection of error estimates
     Index2Matrix S2_;
     ConvergenceTest convergence_;
+
+    EventSet events_;
 };
 
 }  // namespace ga
