@@ -20,7 +20,8 @@ module galpha
   integer(c_int), parameter, public :: GA_OK = 0, GA_ERR_ARG = -1, GA_ERR_STATE = -2, &
        GA_ERR_NOMEM = -3, GA_ERR_CALLBACK = -4, GA_ERR_CALLBACK_RETRY = -5, &
        GA_ERR_NONFINITE = -6, GA_ERR_SINGULAR = -7, GA_ERR_NEWTON = -8, &
-       GA_ERR_INCONSISTENT = -9, GA_ERR_INTERNAL = -10, GA_ERR_STEP_SIZE = -11
+       GA_ERR_INCONSISTENT = -9, GA_ERR_INTERNAL = -10, GA_ERR_STEP_SIZE = -11, &
+       GA_EVENT = 1
   ! ---- options ----------------------------------------------------------------------------
   integer(c_int), parameter, public :: GA_TANGENT_AUTO = 0, GA_TANGENT_FD = 1, &
        GA_TANGENT_NEGLECT = 2
@@ -36,12 +37,14 @@ module galpha
   integer(c_int), parameter, public :: GA_REDUNDANT_REFUSE = 0, GA_REDUNDANT_DROP = 1
   integer(c_int), parameter, public :: GA_INIT_PROJECT = 0, GA_INIT_REFUSE = 1
   integer(c_int), parameter, public :: GA_OUTPUT_CONSISTENT = 0, GA_OUTPUT_STEP = 1
+  integer(c_int), parameter, public :: GA_EVENT_BOTH = 0, GA_EVENT_RISING = 1, &
+       GA_EVENT_FALLING = -1, GA_EVENT_LOG = 64
   integer(c_int), parameter, public :: GA_COUNT_STEPS = 0, GA_COUNT_FAILED_STEPS = 1, &
        GA_COUNT_NEWTON_ITERS = 2, GA_COUNT_FACTORIZATIONS = 3, GA_COUNT_RESIDUALS = 4, &
        GA_COUNT_MASS_EVALS = 5, GA_COUNT_FORCE_EVALS = 6, GA_COUNT_CONSTRAINT_EVALS = 7, &
        GA_COUNT_JACOBIAN_EVALS = 8, GA_COUNT_STIFFNESS_EVALS = 9, &
        GA_COUNT_DAMPING_EVALS = 10, GA_COUNT_ACCEL_EVALS = 11, GA_COUNT_REJECTED_STEPS = 12, &
-       GA_COUNT_CONSTRAINT_DT_EVALS = 13
+       GA_COUNT_CONSTRAINT_DT_EVALS = 13, GA_COUNT_EVENT_EVALS = 14
   integer(c_int), parameter, public :: GA_INFO_RCOND = 0, GA_INFO_NEWTON_ITERS = 1, &
        GA_INFO_NEWTON_RATIO = 2, GA_INFO_ERROR_ESTIMATE = 3, GA_INFO_H_NEXT = 4
 
@@ -75,8 +78,16 @@ module galpha
        real(c_double), intent(out) :: K(*)
        type(c_ptr), value :: user
      end function ga_stiffness_fn
+     ! lambda is NULL unless the events were set with multipliers: not to be touched then
+     integer(c_int) function ga_event_fn(t, q, v, lambda, g, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*), v(*), lambda(*)
+       real(c_double), intent(out) :: g(*)
+       type(c_ptr), value :: user
+     end function ga_event_fn
   end interface
-  public :: ga_mass_fn, ga_force_fn, ga_constraint_fn, ga_stiffness_fn
+  public :: ga_mass_fn, ga_force_fn, ga_constraint_fn, ga_stiffness_fn, ga_event_fn
 
   ! ---- the C API, one to one ----------------------------------------------------------------
   interface
@@ -360,6 +371,28 @@ module galpha
        type(c_ptr), value :: s
        integer(c_int), value :: mode
      end function ga_set_output
+     integer(c_int) function ga_set_events(s, count, fn, direction, terminal, with_multipliers) &
+          bind(C, name="ga_set_events")
+       import :: c_int, c_ptr, c_funptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: count
+       type(c_funptr), value :: fn
+       integer(c_int), intent(in), optional :: direction(*), terminal(*)  ! absent: NULL
+       integer(c_int), value :: with_multipliers
+     end function ga_set_events
+     integer(c_int) function ga_get_event_count(s, count) bind(C, name="ga_get_event_count")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), intent(out) :: count
+     end function ga_get_event_count
+     integer(c_int) function ga_get_event(s, i, t, index, direction) &
+          bind(C, name="ga_get_event")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       integer(c_int), value :: i
+       real(c_double), intent(out), optional :: t  ! absent: NULL
+       integer(c_int), intent(out), optional :: index, direction
+     end function ga_get_event
      function c_strlen(p) bind(C, name="strlen")
        import :: c_ptr, c_size_t
        type(c_ptr), value :: p
@@ -378,7 +411,8 @@ module galpha
        ga_linear_solver_name, ga_set_formulation, ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
-       ga_interpolate, ga_interpolate_qdd, ga_set_output
+       ga_interpolate, ga_interpolate_qdd, ga_set_output, ga_set_events, ga_get_event_count, &
+       ga_get_event
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
@@ -455,6 +489,15 @@ module galpha
      procedure :: reset_counters => solver_reset_counters
      !> get_info(key, value): GA_INFO_* of the last step
      procedure :: get_info => solver_get_info
+     !> set_events(fn, direction, terminal, with_multipliers): size(direction) event functions
+     !> (GA_EVENT_BOTH, _RISING or _FALLING each), terminal(k) true: step, step_adaptive and
+     !> advance stop there with GA_EVENT; fn fills g(1:size(direction)). set_events(fn,
+     !> [integer(c_int) ::]) removes them
+     procedure :: set_events => solver_set_events
+     !> event_count(): events logged by the last stepping call (-1 if the call fails);
+     !> get_event(i, t, index, direction): the i-th (1-based), index 1-based as well
+     procedure :: event_count => solver_event_count
+     procedure :: get_event => solver_get_event
   end type galpha_solver
   public :: galpha_strerror, galpha_version, galpha_version_number
 
@@ -551,6 +594,44 @@ contains
     if (present(damping)) d = c_funloc(damping)
     status = ga_set_tangents(this%handle, k, d)
   end function solver_set_tangents
+
+  integer(c_int) function solver_set_events(this, fn, direction, terminal, with_multipliers) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    procedure(ga_event_fn) :: fn
+    integer(c_int), intent(in) :: direction(:)
+    logical, intent(in), optional :: terminal(:), with_multipliers
+    integer(c_int) :: flags(max(size(direction), 1)), lam
+    status = GA_ERR_ARG
+    lam = 0
+    if (present(with_multipliers)) then
+       if (with_multipliers) lam = 1
+    end if
+    if (present(terminal)) then
+       if (size(terminal) /= size(direction)) return
+       flags = 0
+       where (terminal) flags(1:size(terminal)) = 1
+       status = ga_set_events(this%handle, size(direction, kind=c_int), c_funloc(fn), &
+            direction, flags, lam)
+    else
+       status = ga_set_events(this%handle, size(direction, kind=c_int), c_funloc(fn), &
+            direction, with_multipliers=lam)
+    end if
+  end function solver_set_events
+
+  integer(c_int) function solver_event_count(this) result(count)
+    class(galpha_solver), intent(in) :: this
+    if (ga_get_event_count(this%handle, count) /= GA_OK) count = -1
+  end function solver_event_count
+
+  integer(c_int) function solver_get_event(this, i, t, index, direction) result(status)
+    class(galpha_solver), intent(in) :: this
+    integer(c_int), intent(in) :: i
+    real(c_double), intent(out) :: t
+    integer(c_int), intent(out) :: index, direction
+    status = ga_get_event(this%handle, i - 1, t, index, direction)
+    if (status == GA_OK) index = index + 1
+  end function solver_get_event
 
   integer(c_int) function solver_set_constraint_accel(this, fn) result(status)
     class(galpha_solver), intent(inout) :: this

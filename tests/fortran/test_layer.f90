@@ -2,14 +2,32 @@
 ! against what the C API or the analysis says, on the unit pendulum of params_model.f90 (its
 ! parameters through `user`). Stops with a nonzero code at the first failure.
 
+module layer_events
+  use, intrinsic :: iso_c_binding
+  implicit none
+contains
+  ! g(1) = x: the pendulum passes the vertical
+  integer(c_int) function vertical(t, q, v, lambda, g, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*), lambda(*)
+    real(c_double), intent(out) :: g(*)
+    type(c_ptr), value :: user
+    g(1) = q(1)
+    vertical = 0
+  end function vertical
+end module layer_events
+
 program test_layer
   use galpha
   use params_model
+  use layer_events
   implicit none
   type(pendulum_params), target :: unit = pendulum_params(1.0d0, 1.0d0, 9.81d0)
   type(galpha_solver) :: s, r
   real(c_double) :: q(2), v(2), a(2), lam(1), q2(2), v2(2), lam2(1), x, am, af, beta, gam
   real(c_double), allocatable :: ckpt(:), back(:)
+  real(c_double) :: quarter, ag, bg, ag_next, te
+  integer(c_int) :: index, direction
   real(c_double), parameter :: rho = 0.8d0
   integer :: n, m, i, nstate
   character(len=32) :: text
@@ -113,6 +131,34 @@ program test_layer
   call ok(s%get_state(ckpt), 'get_state s')
   call ok(r%get_state(back), 'get_state r')
   call expect(all(ckpt == back), 'restart is bit-identical')
+
+  ! events: released horizontally, the pendulum passes the vertical after a quarter period,
+  ! sqrt(L/g) K(1/sqrt(2)) with K = pi / (2 AGM(1, 1/sqrt(2)))
+  ag = 1.0d0
+  bg = sqrt(0.5d0)
+  do i = 1, 40
+     ag_next = 0.5d0 * (ag + bg)
+     bg = sqrt(ag * bg)
+     ag = ag_next
+  end do
+  quarter = sqrt(1.0d0 / 9.81d0) * acos(-1.0d0) / (2.0d0 * ag)
+  call ok(s%init(0.0d0, [1.0d0, 0.0d0], [0.0d0, 0.0d0]), 'init for events')
+  call expect(s%set_events(vertical, [GA_EVENT_FALLING], [.true., .false.]) == GA_ERR_ARG, &
+              'set_events checks the sizes')
+  call ok(s%set_events(vertical, [GA_EVENT_FALLING], [.true.]), 'set_events')
+  i = GA_OK
+  do while (i == GA_OK)
+     i = s%step(1d-3)
+  end do
+  call expect(i == GA_EVENT, 'a terminal event stops ga_step')
+  call expect(s%event_count() == 1, 'event_count')
+  call ok(s%get_event(1, te, index, direction), 'get_event')
+  call expect(index == 1 .and. direction == GA_EVENT_FALLING, 'event index and direction')
+  call expect(abs(te - quarter) < 3d-6, 'event at the quarter period (1.7 h^2, C suite)')
+  call expect(s%get_event(2, te, index, direction) == GA_ERR_ARG, 'get_event checks i')
+  call ok(s%set_events(vertical, [integer(c_int) ::]), 'set_events removes')
+  call ok(s%step(1d-3), 'step without events')
+  call expect(s%event_count() == 0, 'no events logged')
 
   call s%free()
   call r%free()

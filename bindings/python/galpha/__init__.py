@@ -10,7 +10,8 @@ M(q) q'' = f(q, q', t) - Phi_q^T lambda, Phi(q, t) = 0 -- Python bindings over c
 or, for time histories, galpha.integrate(...). The low-level mirror of the C API is
 galpha._ffi (one function per C function)."""
 from . import _ffi
-from ._ffi import (GA_INDEX2_STABILIZED, GA_INDEX3, GA_INFO_ERROR_ESTIMATE,  # noqa: F401
+from ._ffi import (GA_EVENT_BOTH, GA_EVENT_FALLING, GA_EVENT_RISING,  # noqa: F401
+                   GA_INDEX2_STABILIZED, GA_INDEX3, GA_INFO_ERROR_ESTIMATE,  # noqa: F401
                    GA_INFO_H_NEXT, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_RCOND,
                    GA_INIT_PROJECT, GA_INIT_REFUSE, GA_LINEAR_AUTO, GA_LINEAR_DENSE,
                    GA_LINEAR_DENSE_EIGEN, GA_LINEAR_DENSE_LAPACK, GA_LINEAR_DENSE_UNBLOCKED,
@@ -25,7 +26,7 @@ from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceErr
                      GalphaError, InconsistentError, InternalError, NonFiniteError,
                      OutOfMemoryError, RecoverableError, SingularMatrixError, StateError,
                      StepSizeError)
-from .integrate import IntegrateResult, integrate  # noqa: F401
+from .integrate import IntegrateResult, OdeSolution, integrate  # noqa: F401
 from .solver import Solver  # noqa: F401
 
 __version__ = _ffi.lib.ga_version().decode()

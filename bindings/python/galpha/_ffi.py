@@ -94,6 +94,8 @@ STIFFNESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_dou
                                 c_double_p, c_double_p, ctypes.c_void_p)
 DAMPING_FN = FORCE_FN
 CONSTRAINT_ACCEL_FN = FORCE_FN
+EVENT_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
+                            c_double_p, ctypes.c_void_p)
 
 # Status codes (pinned in galpha.h).
 GA_OK = 0
@@ -108,6 +110,7 @@ GA_ERR_NEWTON = -8
 GA_ERR_INCONSISTENT = -9
 GA_ERR_INTERNAL = -10
 GA_ERR_STEP_SIZE = -11
+GA_EVENT = 1  # not an error: a stepping call stopped at an event
 
 # Enumerations.
 GA_TANGENT_AUTO, GA_TANGENT_FD, GA_TANGENT_NEGLECT = 0, 1, 2
@@ -120,12 +123,14 @@ GA_INDEX3, GA_INDEX2_STABILIZED = 0, 1
 GA_REDUNDANT_REFUSE, GA_REDUNDANT_DROP = 0, 1
 GA_INIT_PROJECT, GA_INIT_REFUSE = 0, 1
 GA_OUTPUT_CONSISTENT, GA_OUTPUT_STEP = 0, 1
+GA_EVENT_BOTH, GA_EVENT_RISING, GA_EVENT_FALLING = 0, 1, -1
+GA_EVENT_LOG = 64
 (GA_INFO_RCOND, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_ERROR_ESTIMATE,
  GA_INFO_H_NEXT) = 0, 1, 2, 3, 4
 COUNTERS = ("steps", "failed_steps", "newton_iters", "factorizations", "residuals",
             "mass_evals", "force_evals", "constraint_evals", "jacobian_evals",
             "stiffness_evals", "damping_evals", "accel_evals", "rejected_steps",
-            "constraint_dt_evals")
+            "constraint_dt_evals", "event_evals")
 
 _S = ctypes.c_void_p  # ga_solver *
 _I = ctypes.c_int
@@ -186,6 +191,9 @@ _SIGNATURES = {
     "ga_interpolate": (_I, [_S, _D, c_double_p, c_double_p, c_double_p]),
     "ga_interpolate_qdd": (_I, [_S, _D, c_double_p]),
     "ga_set_output": (_I, [_S, _I]),
+    "ga_set_events": (_I, [_S, _I, EVENT_FN, _P(_I), _P(_I), _I]),
+    "ga_get_event_count": (_I, [_S, _P(_I)]),
+    "ga_get_event": (_I, [_S, _I, _P(_D), _P(_I), _P(_I)]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():

@@ -30,6 +30,7 @@ _MASS = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp)
 _FORCE = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp)
 _CONSTRAINT = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp)
 _STIFFNESS = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp)
+_EVENT = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp)
 
 
 def _cast(fn, ctype):
@@ -253,6 +254,11 @@ class Solver:
             finally:
                 self._in_callback -= 1
 
+        self._call = call
+        self._copied = copied
+        self._zero_copy = zero_copy
+        self._event_cb = None
+        self._event_fns = ()
         sM, sJ = shape("mass", (n, n)), shape("jacobian", (m, n))
         sK, sC = shape("stiffness", (n, n)), shape("damping", (n, n))
         self._cbs = [
@@ -336,9 +342,10 @@ class Solver:
         pending, self._pending = self._pending, None
         if pending is not None:
             raise pending.with_traceback(pending.__traceback__)
-        if status != _ffi.GA_OK:
+        if status < _ffi.GA_OK:
             message = _ffi.ga_last_error(self._ptr).decode() if self._ptr else ""
             raise error_for(status, message)
+        return status == _ffi.GA_EVENT
 
     def _handle(self):
         if self._ptr is None:
@@ -428,20 +435,72 @@ class Solver:
     @_serialized
     @_runs_callbacks
     def step(self, h):
-        """One step of size h. On failure raises; the state stays at the last accepted step."""
-        self._check(_ffi.ga_step(self._handle(), float(h)))
+        """One step of size h. On failure raises; the state stays at the last accepted step.
+        True if it stopped at a terminal event (see set_events), else False."""
+        return self._check(_ffi.ga_step(self._handle(), float(h)))
 
     @_serialized
     @_runs_callbacks
     def step_adaptive(self, t_stop):
-        """One error-controlled step, not beyond t_stop (see ga_step_adaptive)."""
-        self._check(_ffi.ga_step_adaptive(self._handle(), float(t_stop)))
+        """One error-controlled step, not beyond t_stop (see ga_step_adaptive). True if it
+        stopped at a terminal event."""
+        return self._check(_ffi.ga_step_adaptive(self._handle(), float(t_stop)))
 
     @_serialized
     @_runs_callbacks
     def advance(self, t_out):
-        """Error-controlled steps until t_out exactly (see ga_advance)."""
-        self._check(_ffi.ga_advance(self._handle(), float(t_out)))
+        """Error-controlled steps until t_out exactly (see ga_advance), or until a terminal
+        event: True then (the solver at the end of the step holding it), else False."""
+        return self._check(_ffi.ga_advance(self._handle(), float(t_out)))
+
+    @_serialized
+    def set_events(self, functions, multipliers=False):
+        """Watch event functions g(t, q, v, lam) -> float (see ga_set_events), each with the
+        optional attributes of scipy's solve_ivp: `direction` (> 0 rising, < 0 falling, 0
+        either; default 0) and `terminal` (true: step, step_adaptive and advance stop there
+        and return True; default False). lam is None unless `multipliers` (then the
+        multipliers at the located state, consistent with q and v). An empty list removes
+        them. The events found by the last stepping call: `events`."""
+        functions = tuple(functions)
+        for g in functions:
+            if not callable(g):
+                raise TypeError("event functions must be callable, got %r" % (g,))
+        count, n, m = len(functions), self.n, self.m
+        call = self._call
+
+        def evaluate(t, q, v, lam, g):
+            for k, fn in enumerate(functions):
+                g[k] = fn(t, q, v, lam)
+
+        def trampoline(t, q, v, lam, g, u):
+            if lam:
+                return call(evaluate, g, (count,), t, (q, n), (v, n), (lam, m))
+            return call(lambda t, q, v, g: evaluate(t, q, v, None, g), g, (count,), t,
+                        (q, n), (v, n))
+
+        cb = _EVENT(trampoline) if count else None
+        direction = (_i * max(count, 1))(*[int(np.sign(getattr(g, "direction", 0)))
+                                            for g in functions])
+        terminal = (_i * max(count, 1))(*[int(bool(getattr(g, "terminal", False)))
+                                           for g in functions])
+        self._check(_ffi.ga_set_events(self._handle(), count, _cast(cb, _ffi.EVENT_FN),
+                                       direction, terminal, int(bool(multipliers))))
+        self._event_cb, self._event_fns = cb, functions
+
+    @property
+    @_serialized
+    def events(self):
+        """The events the last step, step_adaptive or advance found, in time order: a list of
+        (t, index, direction) (see ga_get_event)."""
+        count = ctypes.c_int()
+        self._check(_ffi.ga_get_event_count(self._handle(), ctypes.byref(count)))
+        out = []
+        for i in range(count.value):
+            t, k, d = ctypes.c_double(), ctypes.c_int(), ctypes.c_int()
+            self._check(_ffi.ga_get_event(self._handle(), i, ctypes.byref(t), ctypes.byref(k),
+                                          ctypes.byref(d)))
+            out.append((t.value, k.value, d.value))
+        return out
 
     @_serialized
     @_runs_callbacks
