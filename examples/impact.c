@@ -1,9 +1,10 @@
 /* A pendulum that hits a wall: released at 60 degrees, it strikes a wall along the vertical
- * through its pivot at every swing down, and rebounds with restitution e. Each impact is
- * located on the dense output (bisection of x(t) with ga_interpolate inside the step that
- * crossed the wall), the velocity at that instant reflected (v -> -e v: at the wall the
- * velocity is normal to it), and the run restarted there with ga_init, which keeps every
- * option and starts afresh. Between impacts energy is conserved, so the kinetic energy at
+ * through its pivot at every swing down, and rebounds with restitution e. The wall is an event
+ * function, g = x, falling and terminal (ga_set_events): ga_step stops with GA_EVENT in the
+ * step that crossed it, the impact located on that step's dense output; the velocity at that
+ * instant is reflected (v -> -e v: at the wall the velocity is normal to it), and the run
+ * restarted there with ga_init, which keeps every option and the event function and starts
+ * afresh. Between impacts energy is conserved, so the kinetic energy at
  * successive impacts falls by e^2 each time; the first impact comes after a quarter period,
  * K(sin(theta0 / 2)) sqrt(L / g) (K: the complete elliptic integral of the first kind), with
  * the energy the fall released, m g L (1 - cos theta0). Printed, and checked (exit status 1
@@ -31,6 +32,15 @@ static double elliptic_k(double k)
     return M_PI / (2.0 * a);
 }
 
+/* the wall: x = 0 */
+static int wall(double t, const double *q, const double *v, const double *lambda, double *g,
+                void *user)
+{
+    (void)t, (void)v, (void)lambda, (void)user;
+    g[0] = q[0];
+    return 0;
+}
+
 static int check(ga_solver *s, ga_status st)
 {
     if (st != GA_OK)
@@ -52,35 +62,22 @@ int main(void)
     ga_solver *s = NULL;
     if (ga_create(2, 1, &s) != GA_OK)
         return 1;
+    const int falling = GA_EVENT_FALLING, terminal = 1;
     if (check(s, ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
                                   pendulum_jacobian, &p)) ||
+        check(s, ga_set_events(s, 1, wall, &falling, &terminal, 0)) ||
         check(s, ga_init(s, 0.0, q, v)))
         return 1;
     double kinetic[IMPACTS], t = 0.0;
     int failed = 0;
     for (int k = 0; k < IMPACTS && !failed; ++k) {
-        /* steps until x crosses the wall */
-        do {
-            failed = check(s, ga_step(s, h)) || check(s, ga_get_q(s, q));
-        } while (!failed && q[0] > 0.0);
-        if (failed)
-            break;
-        double hi, h_last;
-        ga_get_t(s, &hi);
-        ga_get_h_last(s, &h_last);
-        double lo = hi - h_last;
-        for (int i = 0; i < 60; ++i) { /* x(lo) > 0 >= x(hi) */
-            const double mid = 0.5 * (lo + hi);
-            failed = check(s, ga_interpolate(s, mid, q, NULL, NULL));
-            if (failed)
-                break;
-            if (q[0] > 0.0)
-                lo = mid;
-            else
-                hi = mid;
+        /* steps until the pendulum reaches the wall */
+        ga_status st;
+        while ((st = ga_step(s, h)) == GA_OK) {
         }
-        t = hi;
-        failed = failed || check(s, ga_interpolate(s, t, q, v, NULL));
+        failed = st != GA_EVENT && check(s, st);
+        failed = failed || check(s, ga_get_event(s, 0, &t, NULL, NULL)) ||
+                 check(s, ga_interpolate(s, t, q, v, NULL));
         if (failed)
             break;
         kinetic[k] = 0.5 * p.mass * (v[0] * v[0] + v[1] * v[1]);

@@ -55,6 +55,24 @@ if command -v valgrind >/dev/null; then
             >> "$out/step_instructions.csv"
     done
 fi
+echo "events that never fire: run time with and without (interleaved rounds)"
+"$b/event_cost" 21 > "$out/event_cost.csv"
+if command -v valgrind >/dev/null; then
+    echo "events that never fire: instructions inside the stepping calls (callgrind)"
+    echo "scene,instructions_without,instructions_with,ratio" > "$out/event_instructions.csv"
+    for sc in pendulum slider_crank andrews7 chain1000 andrews7_adaptive_index2; do
+        fn=ga_step
+        [ "$sc" = andrews7_adaptive_index2 ] && fn=ga_advance
+        count() {
+            valgrind --tool=callgrind --toggle-collect="$fn" --callgrind-out-file=/dev/null \
+                "$b/event_cost" one "$sc" "$1" 2>&1 | sed -n "s/.*Collected : \([0-9]*\).*/\1/p"
+        }
+        without=$(count 0)
+        with=$(count 1)
+        awk -v sc="$sc" -v a="$without" -v b="$with" \
+            'BEGIN { printf "%s,%d,%d,%.4f\n", sc, a, b, b / a }' >> "$out/event_instructions.csv"
+    done
+fi
 echo "linear algebra"
 "$b/linear_algebra" > "$out/linear_algebra.csv"
 echo "work-precision against IDA"

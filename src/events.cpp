@@ -124,14 +124,19 @@ void EventSet::configure(int count, ga_event_fn fn, const int *direction, const 
     started = false;
 }
 
+// g_lo and g_hi change under a failing call only where it searched the rest of a step first
+// (search_events leaves them alone when it fails): only then are they copied.
 void EventSet::save()
 {
     saved_started_ = started;
     saved_t_lo_ = t_lo;
     saved_t_hi_ = t_hi;
     saved_log_count_ = log_count_;
-    std::copy(g_lo.begin(), g_lo.end(), saved_g_lo_.begin());
-    std::copy(g_hi.begin(), g_hi.end(), saved_g_hi_.begin());
+    saved_values_ = started && t_lo < t_hi;
+    if (saved_values_) {
+        std::copy(g_lo.begin(), g_lo.end(), saved_g_lo_.begin());
+        std::copy(g_hi.begin(), g_hi.end(), saved_g_hi_.begin());
+    }
 }
 
 void EventSet::restore()
@@ -140,8 +145,10 @@ void EventSet::restore()
     t_lo = saved_t_lo_;
     t_hi = saved_t_hi_;
     log_count_ = saved_log_count_;
-    std::copy(saved_g_lo_.begin(), saved_g_lo_.end(), g_lo.begin());
-    std::copy(saved_g_hi_.begin(), saved_g_hi_.end(), g_hi.begin());
+    if (saved_values_) {
+        std::copy(saved_g_lo_.begin(), saved_g_lo_.end(), g_lo.begin());
+        std::copy(saved_g_hi_.begin(), saved_g_hi_.end(), g_hi.begin());
+    }
 }
 
 // g at t: at the end of the last step from the accepted state, inside it from the dense
@@ -166,26 +173,31 @@ ga_status Solver::event_values(double t, double *g)
 
 // The rest (t_lo, t_hi] of the last step: what fires there is logged in time order. GA_EVENT
 // at a terminal event or a full log, the search left just after the root (or, if the next
-// root's entries do not fit, before it) for the next call.
+// root's entries do not fit, before it) for the next call. A failure leaves t_lo and g_lo as
+// they were (the caller's EventSet::restore puts back the log).
 ga_status Solver::search_events()
 {
     EventSet &e = events_;
     const auto evaluate = [](double t, double *g, void *self) {
         return static_cast<int>(static_cast<Solver *>(self)->event_values(t, g));
     };
-    while (e.t_lo < e.t_hi) {
+    double t_cur = e.t_lo;
+    const double *g_cur = e.g_lo.data();
+    ga_status st = GA_OK;
+    while (t_cur < e.t_hi && e.any_crossing(g_cur, e.g_hi.data())) {
         double t_root = 0.0;
-        const int found = e.locator.locate(e.t_lo, e.g_lo.data(), e.t_hi, e.g_hi.data(),
-                                           e.direction(), evaluate, this, &t_root,
-                                           e.fired.data());
+        const int found = e.locator.locate(t_cur, g_cur, e.t_hi, e.g_hi.data(), e.direction(),
+                                           evaluate, this, &t_root, e.fired.data());
         if (found < 0)
             return static_cast<ga_status>(found);
         if (found == 0)
             break;
         const int crossing = static_cast<int>(
             std::count_if(e.fired.begin(), e.fired.end(), [](int f) { return f != 0; }));
-        if (e.logged() + crossing > e.capacity())
-            return GA_EVENT;
+        if (e.logged() + crossing > e.capacity()) {
+            st = GA_EVENT;
+            break;
+        }
         bool stop = false;
         for (int k = 0; k < e.count(); ++k) {
             if (e.fired[k]) {
@@ -193,14 +205,22 @@ ga_status Solver::search_events()
                 stop = stop || e.terminal(k);
             }
         }
-        e.t_lo = t_root;
-        std::copy(e.locator.root_values(), e.locator.root_values() + e.count(), e.g_lo.begin());
-        if (stop || e.log_full())
-            return GA_EVENT;
+        t_cur = t_root;
+        g_cur = e.locator.root_values();
+        if (stop || e.log_full()) {
+            st = GA_EVENT;
+            break;
+        }
     }
-    e.t_lo = e.t_hi;
-    std::copy(e.g_hi.begin(), e.g_hi.end(), e.g_lo.begin());
-    return GA_OK;
+    if (st == GA_EVENT) {
+        e.t_lo = t_cur;
+        if (g_cur != e.g_lo.data())
+            std::copy(g_cur, g_cur + e.count(), e.g_lo.begin());
+    } else {
+        e.t_lo = e.t_hi;
+        e.g_lo.swap(e.g_hi);  // g_hi is written before it is read again
+    }
+    return st;
 }
 
 // At the start of a stepping call: g at the current state if the search starts afresh, else
@@ -209,7 +229,7 @@ ga_status Solver::resume_events()
 {
     EventSet &e = events_;
     if (e.started)
-        return search_events();
+        return e.t_lo < e.t_hi ? search_events() : GA_OK;
     if (auto st = event_values(accepted_.t, e.g_lo.data()))
         return st;
     e.t_lo = e.t_hi = accepted_.t;
@@ -217,20 +237,27 @@ ga_status Solver::resume_events()
     return GA_OK;
 }
 
-// After a step was accepted: g at its end, and the search over it.
+// After a step was accepted: g at its end, and the search over it (at most steps, nothing
+// crosses: then no more than that check).
 ga_status Solver::events_after_step()
 {
     EventSet &e = events_;
     if (auto st = event_values(accepted_.t, e.g_hi.data()))
         return st;
     e.t_hi = accepted_.t;
-    return search_events();
+    if (e.any_crossing(e.g_lo.data(), e.g_hi.data()))
+        return search_events();
+    e.t_lo = e.t_hi;
+    e.g_lo.swap(e.g_hi);
+    return GA_OK;
 }
 
 // The caller saved the search (events_.save()) where a failure must put it back.
 ga_status Solver::step_with_events(bool adaptive, double h_or_t_stop)
 {
-    const StepUndo undo = undo_point();
+    const StepUndo undo{previous_valid_, start_pending_, adaptive};
+    if (adaptive)
+        undo_control_ = control;
     if (auto st = adaptive ? adaptive_step(h_or_t_stop) : take_step(h_or_t_stop)) {
         events_.restore();
         return st;

@@ -20,7 +20,7 @@ public:
     void setup(int count);
     int count() const { return static_cast<int>(lo_.size()); }
 
-    // g0 = g(t0) and g1 = g(t1) are given. direction[k]: +1 rising only (from below zero to
+    // g0 = g(t0) and g1 = g(t1) are given (g0 may be the root_values() of the last call). direction[k]: +1 rising only (from below zero to
     // zero or above), -1 falling only, 0 both; a function exactly zero at t0 does not fire
     // (it fired there already, or starts there). Returns 0 if nothing fires in (t0, t1],
     // 1 with *t_root (within 100 u (|t1| + |t1 - t0|) after the root, so that the root is
@@ -70,6 +70,15 @@ public:
 
     int capacity() const { return static_cast<int>(log_.size()); }
     bool log_full() const { return log_count_ == capacity(); }
+    // Some function crosses zero, in the direction it watches, between the values a and b.
+    bool any_crossing(const double *a, const double *b) const
+    {
+        for (int k = 0; k < count(); ++k)
+            if ((a[k] < 0.0 && b[k] >= 0.0 && direction_[k] >= 0) ||
+                (a[k] > 0.0 && b[k] <= 0.0 && direction_[k] <= 0))
+                return true;
+        return false;
+    }
     void log(double t, int index, int direction) { log_[log_count_++] = {t, index, direction}; }
     int logged() const { return log_count_; }
     const Entry &entry(int i) const { return log_[i]; }
@@ -91,6 +100,7 @@ private:
     bool saved_started_ = false;
     double saved_t_lo_ = 0.0, saved_t_hi_ = 0.0;
     int saved_log_count_ = 0;
+    bool saved_values_ = false;
     std::vector<double> saved_g_lo_, saved_g_hi_;
 };
 

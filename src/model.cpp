@@ -367,7 +367,10 @@ ga_status Model::event_functions(ga_event_fn fn, double t, const double *q, cons
     if (auto st = callback_status(user([&] { return fn(t, q, v, lambda, g, cb.user); }), "event",
                                   t))
         return st;
-    return check_finite(g, count, 0, "event function g", t);
+    bool finite = true;  // a few values, checked at every step: inline
+    for (int k = 0; k < count; ++k)
+        finite = finite && std::isfinite(g[k]);
+    return finite ? GA_OK : check_finite(g, count, 0, "event function g", t);
 }
 
 ga_status Model::constraint_dt(double t, const Vec &q, Vec &out)

@@ -322,7 +322,8 @@ void Solver::undo_step(const StepUndo &u)
     accepted_.swap(trial_);
     previous_valid_ = u.previous_valid;
     start_pending_ = u.start_pending;
-    control = u.control;
+    if (u.adaptive)
+        control = undo_control_;
     ++state_id_;  // no output computed for the undone state is taken for this one
     output_for_ = -1;
     count(counters, GA_COUNT_STEPS, -1);

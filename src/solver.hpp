@@ -168,12 +168,11 @@ private:
     ga_status take_step(double h);               // ga_step's step, without events
     ga_status adaptive_step(double t_stop);      // control.cpp: ga_step_adaptive's, likewise
     // What a step changes besides the states, so that a step whose event search fails after
-    // its commit can be undone.
+    // its commit can be undone (the controller's state only after an adaptive step).
     struct StepUndo {
-        bool previous_valid, start_pending;
-        Control control;
+        bool previous_valid, start_pending, adaptive;
     };
-    StepUndo undo_point() const { return {previous_valid_, start_pending_, control}; }
+    Control undo_control_;  // the controller before the step (adaptive steps)
     void undo_step(const StepUndo &u);
     // events.cpp
     ga_status event_values(double t, double *g);

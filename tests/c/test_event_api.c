@@ -26,6 +26,7 @@ typedef struct scene {
     double level[3];    /* event functions of t only: g_k = t - level[k] */
     double freq;        /* sines: g_k = sin(2 pi freq t - k pi / 3) */
     int fail_at;        /* the event callback returns `fail_with` at this call (1-based) */
+    double fail_after;  /* levels: ... or at any t > fail_after (if positive) */
     int fail_with;
     int calls;
     double sign_flip;   /* multiplies the multiplier event (test of with_multipliers) */
@@ -76,6 +77,8 @@ static int levels(double t, const double *q, const double *v, const double *lamb
     scene *s = user;
     for (int k = 0; k < 3; ++k)
         g[k] = t - s->level[k];
+    if (s->fail_after > 0.0 && t > s->fail_after)
+        return s->fail_with;
     return counted(user);
 }
 
@@ -661,6 +664,45 @@ static void a_nonfinite_event_value_is_reported(void **state)
     ga_free(s);
 }
 
+/* A call that stopped at a terminal event leaves the rest of its step to the next call; when
+ * that call's step then fails, the rest is searched again by the retry: nothing found twice,
+ * nothing lost. */
+static void a_failed_step_after_a_stop_loses_nothing(void **state)
+{
+    (void)state;
+    scene sc = make_scene();
+    sc.level[0] = 0.3125; /* terminal */
+    sc.level[1] = 0.3375; /* logged */
+    sc.level[2] = 10.0;
+    ga_solver *s = released(&sc, M_PI / 2, 0.0, GA_INDEX3);
+    const int terminal[3] = {1, 0, 0};
+    assert_int_equal(ga_set_events(s, 3, levels, NULL, terminal, 0), GA_OK);
+    for (int i = 0; i < 6; ++i)
+        assert_int_equal(ga_step(s, 0.05), GA_OK);
+    assert_int_equal(ga_step(s, 0.05), GA_EVENT);
+    found f = {0};
+    collect(s, &f);
+    assert_int_equal(f.count, 1);
+    assert_int_equal(f.index[0], 0);
+    sc.fail_after = 0.36; /* the next step's end fails */
+    sc.fail_with = 1;
+    double t0, t1;
+    assert_int_equal(ga_get_t(s, &t0), GA_OK);
+    assert_int_equal(ga_step(s, 0.05), GA_ERR_CALLBACK_RETRY);
+    assert_int_equal(ga_get_t(s, &t1), GA_OK);
+    assert_true(t0 == t1);
+    int n = -1;
+    assert_int_equal(ga_get_event_count(s, &n), GA_OK);
+    assert_int_equal(n, 0);
+    sc.fail_after = 0.0;
+    assert_int_equal(ga_step(s, 0.05), GA_OK);
+    collect(s, &f);
+    assert_int_equal(f.count, 2);
+    assert_int_equal(f.index[1], 1);
+    assert_true(fabs(f.t[1] - 0.3375) < 1e-14);
+    ga_free(s);
+}
+
 /* ga_advance keeps the steps it accepted before a failure, and the events found in them. */
 static void advance_keeps_what_it_accepted(void **state)
 {
@@ -709,6 +751,7 @@ int main(void)
         cmocka_unit_test(a_failed_event_call_changes_nothing),
         cmocka_unit_test(a_nonfinite_event_value_is_reported),
         cmocka_unit_test(advance_keeps_what_it_accepted),
+        cmocka_unit_test(a_failed_step_after_a_stop_loses_nothing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
