@@ -596,9 +596,9 @@ GA_API ga_status ga_set_events(ga_solver *s, int count, ga_event_fn fn, const in
                                const int *terminal, int with_multipliers);
 
 /** Events logged by the last ga_step, ga_step_adaptive or ga_advance (each starts an empty
- *  log; ga_advance keeps those of the steps it accepted before a failure). A call stops with
- *  GA_EVENT when its log is full, as at a terminal event: nothing is lost. Errors: GA_ERR_ARG,
- *  GA_ERR_STATE (from a callback). */
+ *  log; ga_advance keeps those of the steps it accepted before a failure; ga_init, ga_set_state
+ *  and ga_set_events empty it). A call stops with GA_EVENT when its log is full, as at a
+ *  terminal event: nothing is lost. Errors: GA_ERR_ARG, GA_ERR_STATE (from a callback). */
 GA_API ga_status ga_get_event_count(const ga_solver *s, int *count);
 
 /** Entry i (0 <= i < count) of that log, in time order: the located time t, the function

@@ -541,6 +541,7 @@ GA_API ga_status ga_set_initial_step(ga_solver *s, double h0)
 GA_API ga_status ga_step_adaptive(ga_solver *s, double t_stop)
 {
     return guarded(s, [&](ga::Solver &c) {
+        c.events().clear_log();  // the log is this call's, even if it fails at once
         if (!c.initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_step_adaptive before ga_init");
         if (!std::isfinite(t_stop))
@@ -552,6 +553,7 @@ GA_API ga_status ga_step_adaptive(ga_solver *s, double t_stop)
 GA_API ga_status ga_advance(ga_solver *s, double t_out)
 {
     return guarded(s, [&](ga::Solver &c) {
+        c.events().clear_log();  // the log is this call's, even if it fails at once
         if (!c.initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_advance before ga_init");
         if (!std::isfinite(t_out))
@@ -671,6 +673,7 @@ GA_API ga_status ga_init(ga_solver *s, double t0, const double *q0, const double
 GA_API ga_status ga_step(ga_solver *s, double h)
 {
     return guarded(s, [&](ga::Solver &c) {
+        c.events().clear_log();  // the log is this call's, even if it fails at once
         if (!c.initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_step before ga_init");
         if (!(h > 0.0) || !std::isfinite(h))

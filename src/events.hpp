@@ -59,8 +59,13 @@ public:
     const int *direction() const { return direction_.data(); }
     bool terminal(int k) const { return terminal_[k] != 0; }
 
-    // The search starts again from the state at the next stepping call.
-    void restart() { started = false; }
+    // The search starts again from the state at the next stepping call; the log of a state
+    // left behind goes with it.
+    void restart()
+    {
+        started = false;
+        log_count_ = 0;
+    }
 
     // A stepping call starts with an empty log; save() keeps where the search stands (and the
     // log's length) so that restore() can put it back when a step fails.

@@ -42,6 +42,10 @@ typedef struct model {
     int m_diag[NMAX], m_colptr[NMAX + 1];
     int j_rows[4 * MMAX], j_cols[4 * MMAX], j_nnz;
     int k_rows[3 * NMAX], k_cols[3 * NMAX], k_nnz;
+    /* events (ga_set_events): g_k = q_k - level_k, or lambda_0 - level_2 for the third with
+     * multipliers */
+    int ev_count, ev_dir[3], ev_term[3], ev_lambda;
+    double ev_level[3];
 } model;
 
 static uint64_t next(model *md)
@@ -270,6 +274,47 @@ static ga_status declare_pattern(model *md, ga_solver *s, int *must_fail)
     }
 }
 
+static int events(double t, const double *q, const double *v, const double *lambda, double *g,
+                  void *user)
+{
+    (void)t, (void)v;
+    const model *md = user;
+    for (int k = 0; k < md->ev_count; ++k)
+        g[k] = (k == 2 && lambda && md->m > 0 ? lambda[0] : q[k % md->n]) - md->ev_level[k];
+    return 0;
+}
+
+/* The events of `md` set on s (again: the search starts afresh from the current state). */
+static ga_status set_events(const model *md, ga_solver *s)
+{
+    return ga_set_events(s, md->ev_count, md->ev_count ? events : NULL, md->ev_dir, md->ev_term,
+                         md->ev_lambda);
+}
+
+/* The log of the last stepping call: in time order, not after t, entries of known functions;
+ * at least one after GA_EVENT. */
+static void check_event_log(const model *md, ga_solver *s, ga_status st, int seq)
+{
+    int count = -1;
+    double t = 0.0, last = -INFINITY;
+    SEQ_REQUIRE(ga_get_event_count(s, &count) == GA_OK);
+    ga_get_t(s, &t);
+    if (st == GA_EVENT && count < 1)
+        SEQ_FAIL("sequence %d: GA_EVENT with an empty event log", seq);
+    for (int i = 0; i < count; ++i) {
+        double te;
+        int index, direction;
+        SEQ_REQUIRE(ga_get_event(s, i, &te, &index, &direction) == GA_OK);
+        if (!(te >= last && te <= t) || index < 0 || index >= md->ev_count ||
+            (direction != 1 && direction != -1) ||
+            (md->ev_dir[index] != 0 && md->ev_dir[index] != direction))
+            SEQ_FAIL("sequence %d: event %d of %d: t = %.17g (t %.17g), function %d, "
+                     "direction %d", seq, i, count, te, t, index, direction);
+        last = te;
+    }
+    SEQ_REQUIRE(ga_get_event(s, count, &t, NULL, NULL) == GA_ERR_ARG);
+}
+
 static double edge_value(model *md)
 {
     static const double values[] = {0.0, -1.0, 1.0, 0.5, 1e-3, 1e-12, 1e300, -1e300, 1e-320,
@@ -300,12 +345,13 @@ static int snapshot(const model *md, ga_solver *s, double *x)
 
 static void check(ga_solver *s, ga_status st, int changes_solver, const char *call, int seq)
 {
-    if (st > GA_OK || st < GA_ERR_STEP_SIZE)
+    const int stepping = strcmp(call, "ga_step") == 0 || strcmp(call, "ga_step_adaptive") == 0;
+    if (st > (stepping ? GA_EVENT : GA_OK) || st < GA_ERR_STEP_SIZE)
         SEQ_FAIL("sequence %d: %s returned %d, not a ga_status", seq, call, st);
-    if (st != GA_OK && changes_solver && ga_last_error(s)[0] == '\0')
+    if (st < GA_OK && changes_solver && ga_last_error(s)[0] == '\0')
         SEQ_FAIL("sequence %d: %s failed (%s) without a message", seq, call, ga_strerror(st));
     /* a failed read names itself: its message, not one an earlier failure left */
-    if (st != GA_OK && !changes_solver && strncmp(call, "ga_get_", 7) == 0 &&
+    if (st < GA_OK && !changes_solver && strncmp(call, "ga_get_", 7) == 0 &&
         !strstr(ga_last_error(s), call))
         SEQ_FAIL("sequence %d: %s failed (%s) with the message '%s'", seq, call,
                  ga_strerror(st), ga_last_error(s));
@@ -316,7 +362,7 @@ static void check_transaction(const model *md, ga_solver *s, ga_status st,
                               const double *before, int len, const char *call, int seq)
 {
     double after[STATE_MAX];
-    if (st == GA_OK || len == 0)
+    if (st >= GA_OK || len == 0)
         return;
     SEQ_REQUIRE(snapshot(md, s, after) == len);
     if (memcmp(before, after, sizeof(double) * (size_t)len) != 0)
@@ -325,7 +371,7 @@ static void check_transaction(const model *md, ga_solver *s, ga_status st,
 }
 
 typedef struct seq_stats {
-    long long calls, steps_ok, sparse_ok, twin_steps_ok;
+    long long calls, steps_ok, sparse_ok, twin_steps_ok, events;
 } seq_stats;
 
 /* The restart twin: a few steps from a checkpoint, then the checkpoint restored in the same
@@ -349,6 +395,10 @@ static int restart_twin(model *md, ga_solver *s, const double *ckpt, size_t len,
             md->sparse_M, md->sparse_J, md->sparse_K);
 #endif
     for (int run = 0; run < 2; ++run) {
+        /* the event search is not part of a checkpoint: set_state starts it afresh, and so
+         * does setting the events again for the first run */
+        if (run == 0)
+            SEQ_REQUIRE(set_events(md, s) == GA_OK);
         if (run == 1 && ga_set_state(s, ckpt, len) != GA_OK)
             SEQ_FAIL("sequence %d: a solver refused its own checkpoint: %s", seq,
                      ga_last_error(s));
@@ -377,7 +427,7 @@ static int restart_twin(model *md, ga_solver *s, const double *ckpt, size_t len,
                  "after it was taken", seq, k);
     int accepted = 0;
     for (int i = 0; i < k; ++i)
-        accepted += st[0][i] == GA_OK;
+        accepted += st[0][i] >= GA_OK;
     return accepted;
 }
 
@@ -494,7 +544,9 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             call = "ga_step";
             st = ga_step(s, step_size(&md));
             check_transaction(&md, s, st, before, len, call, seq);
-            stats->steps_ok += st == GA_OK;
+            check_event_log(&md, s, st, seq);
+            stats->steps_ok += st >= GA_OK;
+            stats->events += st == GA_EVENT;
             stats->sparse_ok += st == GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
             break;
         }
@@ -506,7 +558,9 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             call = "ga_step_adaptive";
             st = ga_step_adaptive(s, t_stop);
             check_transaction(&md, s, st, before, len, call, seq);
-            stats->steps_ok += st == GA_OK;
+            check_event_log(&md, s, st, seq);
+            stats->steps_ok += st >= GA_OK;
+            stats->events += st == GA_EVENT;
             stats->sparse_ok += st == GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
             break;
         }
@@ -569,6 +623,37 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             break;
         }
         default: {
+            if (pick(&md, 2)) {  /* events: sometimes a direction that must be refused */
+                const model kept = md;  /* a refused call keeps the events set before */
+                const int bad = pick(&md, 8) == 0;
+                md.ev_count = pick(&md, 4);
+                md.ev_lambda = pick(&md, 2);
+                /* levels next to the current values, so that the functions cross soon */
+                double q[NMAX] = {0}, lambda[MMAX] = {0};
+                ga_get_q(s, q);
+                if (md.m)
+                    ga_get_lambda(s, lambda);
+                for (int k = 0; k < 3; ++k) {
+                    md.ev_dir[k] = pick(&md, 3) - 1;
+                    md.ev_term[k] = pick(&md, 2);
+                    const double now = k == 2 && md.ev_lambda && md.m ? lambda[0] : q[k % md.n];
+                    md.ev_level[k] = now + 0.02 * (uniform(&md) - 0.5) * (1.0 + fabs(now));
+                }
+                if (bad)
+                    md.ev_dir[0] = 5;
+                call = "ga_set_events";
+                st = set_events(&md, s);
+                if (bad && md.ev_count > 0 && st != GA_ERR_ARG)
+                    SEQ_FAIL("sequence %d: direction 5 was accepted", seq);
+                if (st != GA_OK) {
+                    md.ev_count = kept.ev_count;
+                    md.ev_lambda = kept.ev_lambda;
+                    memcpy(md.ev_dir, kept.ev_dir, sizeof md.ev_dir);
+                    memcpy(md.ev_term, kept.ev_term, sizeof md.ev_term);
+                    memcpy(md.ev_level, kept.ev_level, sizeof md.ev_level);
+                }
+                break;
+            }
             int active[MMAX];
             call = "ga_get_active_constraints";
             changes = 0;
