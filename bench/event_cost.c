@@ -1,10 +1,12 @@
 /* What watching events costs when none fires: the same run with and without three event
  * functions that stay positive (g_k = 1000 + q_k, no multipliers), fixed steps on the paper's
- * scenes and the 1000-link chain, adaptive steps on Andrews' mechanism in index 2. Rounds
- * alternate the two runs (and which one goes first) and keep each one's best time (this
- * machine's speed drifts between moments).
+ * scenes and the 1000-link chain, adaptive steps on Andrews' mechanism in index 2. Each round
+ * runs both, in alternating order, and gives one ratio of their times; the median ratio over
+ * the rounds (and its quartiles) is robust to this machine's drifts of speed, which move both
+ * runs of a round alike. Best times for scale.
  *
- *   event_cost [rounds]          -> CSV on stdout: scene,steps,us_without,us_with,ratio
+ *   event_cost [rounds]          -> CSV on stdout: scene,steps,us_without,us_with,
+ *                                   median_ratio,lower_quartile,upper_quartile
  *   event_cost one SCENE 0|1     -> one run without (0) or with (1) the events, for callgrind
  *                                   (scripts/bench.sh counts the instructions inside the
  *                                   stepping calls) */
@@ -124,6 +126,12 @@ static double now(void)
     return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
+static int by_value(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 3 && strcmp(argv[1], "one") == 0) {
@@ -133,27 +141,34 @@ int main(int argc, char **argv)
         fprintf(stderr, "unknown scene %s\n", argv[2]);
         return 2;
     }
-    const int rounds = argc > 1 ? atoi(argv[1]) : 11;
-    printf("scene,steps,us_without,us_with,ratio\n");
+    const int rounds = argc > 1 ? atoi(argv[1]) : 41;
+    double *ratio = malloc(sizeof(double) * (size_t)(rounds > 0 ? rounds : 1));
+    if (!ratio || rounds < 1)
+        return 1;
+    printf("scene,steps,us_without,us_with,median_ratio,lower_quartile,upper_quartile\n");
     for (int k = 0; k < SCENES; ++k) {
         double best[2] = {1e30, 1e30};
         long steps = 0;
         for (int r = 0; r < rounds; ++r) {
+            double dt[2];
             for (int i = 0; i < 2; ++i) {
                 const int with = (r + i) % 2; /* which runs first alternates */
                 const double t0 = now();
                 steps = run(k, with);
-                const double dt = now() - t0;
+                dt[with] = now() - t0;
                 if (steps < 0) {
                     fprintf(stderr, "%s failed\n", kNames[k]);
                     return 1;
                 }
-                if (dt < best[with])
-                    best[with] = dt;
+                if (dt[with] < best[with])
+                    best[with] = dt[with];
             }
+            ratio[r] = dt[1] / dt[0];
         }
-        printf("%s,%ld,%.1f,%.1f,%.3f\n", kNames[k], steps, 1e6 * best[0], 1e6 * best[1],
-               best[1] / best[0]);
+        qsort(ratio, (size_t)rounds, sizeof(double), by_value);
+        printf("%s,%ld,%.1f,%.1f,%.3f,%.3f,%.3f\n", kNames[k], steps, 1e6 * best[0],
+               1e6 * best[1], ratio[rounds / 2], ratio[rounds / 4], ratio[(3 * rounds) / 4]);
     }
+    free(ratio);
     return 0;
 }

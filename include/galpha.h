@@ -205,8 +205,10 @@ GA_API ga_status ga_set_callbacks(ga_solver *s, ga_mass_fn mass, ga_force_fn for
  *  (tests/c/test_redundant.c). */
 GA_API ga_status ga_init(ga_solver *s, double t0, const double *q0, const double *v0);
 
-/** Advance by exactly one step of size h > 0 (Algorithm 1). The step is transactional: unless
- *  GA_OK is returned, t, q, v, qdd, lambda and a are bit-identical to the last accepted step
+/** Advance by exactly one step of size h > 0 (Algorithm 1). With event functions
+ *  (ga_set_events) it returns GA_EVENT, a success, when a terminal one fired in the step (or in
+ *  the rest of the step a call before stopped in: then no step is taken). The step is
+ *  transactional: unless GA_OK or GA_EVENT is returned, t, q, v, qdd, lambda and a are bit-identical to the last accepted step
  *  (work counters do count the failed attempt). After GA_ERR_CALLBACK_RETRY, GA_ERR_NEWTON,
  *  GA_ERR_NONFINITE or GA_ERR_SINGULAR the caller may retry, typically with a smaller h.
  *  A step more than 100 times shorter than the one before (a sliver that lands on an output
@@ -513,7 +515,7 @@ GA_API ga_status ga_set_step_limits(ga_solver *s, double h_min, double h_max);
 GA_API ga_status ga_set_initial_step(ga_solver *s, double h0);
 
 /** One adaptive step, of the size the controller proposes but not beyond t_stop (> t); a step
- *  that reaches t_stop lands on it exactly. Steps rejected by the error test (counter
+ *  that reaches t_stop lands on it exactly. GA_EVENT as ga_step. Steps rejected by the error test (counter
  *  GA_COUNT_REJECTED_STEPS) or by a recoverable failure (Newton, callback > 0, NaN, singular
  *  matrix; GA_COUNT_FAILED_STEPS) are retried smaller until one is accepted.
  *  Error estimate (position, docs/algorithms.md sec. 1.5a): h^2 (beta + delta_alpha/2 - 1/6)
@@ -532,7 +534,8 @@ GA_API ga_status ga_set_initial_step(ga_solver *s, double h0);
  *  failure the state is that of the last accepted step. */
 GA_API ga_status ga_step_adaptive(ga_solver *s, double t_stop);
 
-/** Adaptive steps until t_out (>= t), landing on it exactly (ga_get_t then returns t_out).
+/** Adaptive steps until t_out (>= t), landing on it exactly (ga_get_t then returns t_out),
+ *  or until a terminal event: GA_EVENT, with t at the end of the step that holds it.
  *  Errors: as ga_step_adaptive; steps accepted before a failure are kept. */
 GA_API ga_status ga_advance(ga_solver *s, double t_out);
 

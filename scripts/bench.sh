@@ -56,7 +56,7 @@ if command -v valgrind >/dev/null; then
     done
 fi
 echo "events that never fire: run time with and without (interleaved rounds)"
-"$b/event_cost" 21 > "$out/event_cost.csv"
+"$b/event_cost" 41 > "$out/event_cost.csv"
 if command -v valgrind >/dev/null; then
     echo "events that never fire: instructions inside the stepping calls (callgrind)"
     echo "scene,instructions_without,instructions_with,ratio" > "$out/event_instructions.csv"

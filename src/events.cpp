@@ -242,7 +242,12 @@ ga_status Solver::resume_events()
 ga_status Solver::events_after_step()
 {
     EventSet &e = events_;
-    if (auto st = event_values(accepted_.t, e.g_hi.data()))
+    const ga_status st =
+        e.with_lambda() ? event_values(accepted_.t, e.g_hi.data())
+                        : model.event_functions(e.fn(), accepted_.t, accepted_.q.data(),
+                                                accepted_.v.data(), nullptr, e.g_hi.data(),
+                                                e.count());
+    if (st)
         return st;
     e.t_hi = accepted_.t;
     if (e.any_crossing(e.g_lo.data(), e.g_hi.data()))
@@ -270,33 +275,31 @@ ga_status Solver::step_with_events(bool adaptive, double h_or_t_stop)
     return st;
 }
 
-// ga_step and ga_step_adaptive: first the rest of the step a call stopped in, then one step.
+// ga_step and ga_step_adaptive with events: first the search from the current state or over
+// the rest of the step a call stopped in, then one step and the search over it.
+ga_status Solver::watched_step(bool adaptive, double h_or_t_stop)
+{
+    EventSet &e = events_;
+    e.clear_log();
+    e.save();
+    if (!e.started || e.t_lo < e.t_hi) {
+        if (auto st = resume_events()) {
+            if (st < 0)
+                e.restore();
+            return st;
+        }
+    }
+    return step_with_events(adaptive, h_or_t_stop);
+}
+
 ga_status Solver::step(double h)
 {
-    if (!events_.active())
-        return take_step(h);
-    events_.clear_log();
-    events_.save();
-    if (auto st = resume_events()) {
-        if (st < 0)
-            events_.restore();
-        return st;
-    }
-    return step_with_events(false, h);
+    return events_.active() ? watched_step(false, h) : take_step(h);
 }
 
 ga_status Solver::step_adaptive(double t_stop)
 {
-    if (!events_.active())
-        return adaptive_step(t_stop);
-    events_.clear_log();
-    events_.save();
-    if (auto st = resume_events()) {
-        if (st < 0)
-            events_.restore();
-        return st;
-    }
-    return step_with_events(true, t_stop);
+    return events_.active() ? watched_step(true, t_stop) : adaptive_step(t_stop);
 }
 
 }  // namespace ga

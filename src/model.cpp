@@ -360,19 +360,6 @@ ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, Mod
     return GA_OK;
 }
 
-ga_status Model::event_functions(ga_event_fn fn, double t, const double *q, const double *v,
-                                 const double *lambda, double *g, int count)
-{
-    ga::count(counters_, GA_COUNT_EVENT_EVALS);
-    if (auto st = callback_status(user([&] { return fn(t, q, v, lambda, g, cb.user); }), "event",
-                                  t))
-        return st;
-    bool finite = true;  // a few values, checked at every step: inline
-    for (int k = 0; k < count; ++k)
-        finite = finite && std::isfinite(g[k]);
-    return finite ? GA_OK : check_finite(g, count, 0, "event function g", t);
-}
-
 ga_status Model::constraint_dt(double t, const Vec &q, Vec &out)
 {
     if (m_ == 0)

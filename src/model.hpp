@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cfenv>
+#include <cmath>
 #include <vector>
 
 #include "diagnostics.hpp"
@@ -94,14 +95,26 @@ public:
     // time-independent constraints).
     ga_status constraint_dt(double t, const Vec &q, Vec &out);
     // The event functions of ga_set_events: `count` values into g (lambda may be null).
+    // Inline: called after every step, where a run with events that never fire should cost
+    // no more than the call itself.
     ga_status event_functions(ga_event_fn fn, double t, const double *q, const double *v,
-                              const double *lambda, double *g, int count);
+                              const double *lambda, double *g, int count)
+    {
+        count_event();
+        if (const int rc = user([&] { return fn(t, q, v, lambda, g, cb.user); }))
+            return callback_status(rc, "event", t);
+        bool finite = true;
+        for (int k = 0; k < count; ++k)
+            finite = finite && std::isfinite(g[k]);
+        return finite ? GA_OK : check_finite(g, count, 0, "event function g", t);
+    }
 
     // r^q = M qdd - f + Phi_q^T lambda: the residual of eq. (1), not weighted.
     static void dynamics_residual(const ModelMatrix &M, const Vec &qdd, const Vec &f,
                                   const ModelMatrix &J, const Vec &lambda, Vec &rq);
 
 private:
+    void count_event() { ga::count(counters_, GA_COUNT_EVENT_EVALS); }
     // Runs a user callback in the caller's floating-point environment (see caller_fenv).
     template <class Call>
     int user(Call &&call)

@@ -183,6 +183,7 @@ private:
     // after it; a failure of either leaves the solver as it was and the search as the
     // caller saved it.
     ga_status step_with_events(bool adaptive, double h_or_t_stop);
+    ga_status watched_step(bool adaptive, double h_or_t_stop);
     ga_status residual(double t, const State &x);
     ga_status factorize(double t, const State &x, double h, bool tangents_K, bool tangents_C,
                         bool tangent_Z, int iter);
