@@ -1,5 +1,5 @@
 /* What watching events costs when none fires: the same run with and without three event
- * functions that stay positive (g_k = 1000 + q_k, no multipliers), fixed steps on the paper's
+ * functions that stay positive (g_k = 1000 + k + q_0, no multipliers), fixed steps on the paper's
  * scenes and the 1000-link chain, adaptive steps on Andrews' mechanism in index 2. Each round
  * runs both, in alternating order, and gives one ratio of their times; the median ratio over
  * the rounds (and its quartiles) is robust to this machine's drifts of speed, which move both
@@ -9,7 +9,11 @@
  *                                   median_ratio,lower_quartile,upper_quartile
  *   event_cost one SCENE 0|1     -> one run without (0) or with (1) the events, for callgrind
  *                                   (scripts/bench.sh counts the instructions inside the
- *                                   stepping calls) */
+ *                                   stepping calls)
+ *   event_cost side_by_side [rounds] -> the pendulum, whose step is the cheapest: two solvers
+ *                                   stepping in turns, 500 steps each per round, with 3, 1 and
+ *                                   0 event functions against none (0: the control); CSV
+ *                                   functions,median_ratio,lower_quartile,upper_quartile */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,12 +30,14 @@
 #define M_PI 3.14159265358979323846
 #endif
 
+static int by_value(const void *a, const void *b);
+
 static int never(double t, const double *q, const double *v, const double *lambda, double *g,
                  void *user)
 {
     (void)t, (void)v, (void)lambda, (void)user;
     for (int k = 0; k < 3; ++k)
-        g[k] = 1000.0 + q[k];
+        g[k] = 1000.0 + k + q[0]; /* q[0]: every scene has one */
     return 0;
 }
 
@@ -132,8 +138,59 @@ static int by_value(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* Two pendulum solvers, the second watching `functions` events, stepping in turns from the
+ * same start: the median over `rounds` of the ratio of their times for 500 steps. */
+static int side_by_side(int functions, int rounds, double *ratio)
+{
+    ga_solver *s[2] = {NULL, NULL};
+    for (int w = 0; w < 2; ++w) {
+        if (ga_create(2, 1, &s[w]) != GA_OK ||
+            ga_set_callbacks(s[w], pendulum_mass, pendulum_force, pendulum_constraint,
+                             pendulum_jacobian, &g_pendulum) != GA_OK ||
+            ga_set_tangents(s[w], pendulum_stiffness, NULL) != GA_OK ||
+            (w == 1 && functions > 0 &&
+             ga_set_events(s[w], functions, never, NULL, NULL, 0) != GA_OK))
+            return 1;
+    }
+    for (int r = 0; r < rounds; ++r) {
+        double dt[2];
+        for (int i = 0; i < 2; ++i) {
+            const int w = (r + i) % 2;
+            double q[2], v[2];
+            pendulum_state(&g_pendulum, M_PI / 2, 0.0, q, v);
+            if (ga_init(s[w], 0.0, q, v) != GA_OK)
+                return 1;
+            const double t0 = now();
+            for (int k = 0; k < 500; ++k)
+                if (ga_step(s[w], 1e-3) != GA_OK)
+                    return 1;
+            dt[w] = now() - t0;
+        }
+        ratio[r] = dt[1] / dt[0];
+    }
+    ga_free(s[0]);
+    ga_free(s[1]);
+    qsort(ratio, (size_t)rounds, sizeof(double), by_value);
+    printf("%d,%.3f,%.3f,%.3f\n", functions, ratio[rounds / 2], ratio[rounds / 4],
+           ratio[(3 * rounds) / 4]);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "side_by_side") == 0) {
+        const int rounds = argc > 2 ? atoi(argv[2]) : 400;
+        double *ratio = malloc(sizeof(double) * (size_t)(rounds > 0 ? rounds : 1));
+        if (!ratio || rounds < 1)
+            return 1;
+        printf("functions,median_ratio,lower_quartile,upper_quartile\n");
+        const int functions[3] = {3, 1, 0};
+        for (int i = 0; i < 3; ++i)
+            if (side_by_side(functions[i], rounds, ratio))
+                return 1;
+        free(ratio);
+        return 0;
+    }
     if (argc > 3 && strcmp(argv[1], "one") == 0) {
         for (int k = 0; k < SCENES; ++k)
             if (strcmp(argv[2], kNames[k]) == 0)

@@ -57,6 +57,7 @@ if command -v valgrind >/dev/null; then
 fi
 echo "events that never fire: run time with and without (interleaved rounds)"
 "$b/event_cost" 41 > "$out/event_cost.csv"
+"$b/event_cost" side_by_side 800 > "$out/event_side_by_side.csv"
 if command -v valgrind >/dev/null; then
     echo "events that never fire: instructions inside the stepping calls (callgrind)"
     echo "scene,instructions_without,instructions_with,ratio" > "$out/event_instructions.csv"

@@ -292,9 +292,37 @@ ga_status Solver::watched_step(bool adaptive, double h_or_t_stop)
     return step_with_events(adaptive, h_or_t_stop);
 }
 
+// ga_step with events. The common case -- the search stands at the end of the last step and
+// the functions need no multipliers -- goes without save points: a failure puts back what
+// it changed (the step, t_hi, the log) from what it knows.
 ga_status Solver::step(double h)
 {
-    return events_.active() ? watched_step(false, h) : take_step(h);
+    EventSet &e = events_;
+    if (!e.active())
+        return take_step(h);
+    if (!e.started || e.t_lo < e.t_hi || e.with_lambda())
+        return watched_step(false, h);
+    e.clear_log();
+    const StepUndo undo{previous_valid_, start_pending_, false};
+    if (auto st = take_step(h))
+        return st;
+    ga_status st = model.event_functions(e.fn(), accepted_.t, accepted_.q.data(),
+                                         accepted_.v.data(), nullptr, e.g_hi.data(), e.count());
+    if (st == GA_OK) {
+        e.t_hi = accepted_.t;
+        if (!e.any_crossing(e.g_lo.data(), e.g_hi.data())) {
+            e.t_lo = e.t_hi;
+            e.g_lo.swap(e.g_hi);
+            return GA_OK;
+        }
+        st = search_events();
+        if (st >= GA_OK)
+            return st;
+    }
+    undo_step(undo);
+    e.t_hi = e.t_lo;  // search_events leaves t_lo and g_lo alone when it fails
+    e.clear_log();
+    return st;
 }
 
 ga_status Solver::step_adaptive(double t_stop)
