@@ -4,6 +4,7 @@
  * its allocation hooks count instead. */
 #include <setjmp.h>
 #include <stdarg.h>
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
@@ -350,6 +351,59 @@ static long steps_after_option_changes(ga_solver *s, double h)
     return total;
 }
 
+/* Events located in steps (x at the vertical, lambda crossing a level, with multipliers; a
+ * fast sine, terminal), and event calls failing now and then: fixed steps, adaptive ones and
+ * ga_advance, none allocates. */
+static int event_failure = 0;
+static int watch(double t, const double *q, const double *v, const double *lambda, double *g,
+                 void *user)
+{
+    (void)t, (void)v, (void)user;
+    g[0] = q[0];
+    g[1] = lambda[0] - 9.0;
+    g[2] = sin(200.0 * t); /* many roots */
+    return event_failure;
+}
+
+static void no_allocation_with_events(void **state)
+{
+    (void)state;
+    for (int mode = 0; mode < 3; ++mode) {
+        pendulum p = {1.0, 1.0, 9.81};
+        double q[2], v[2];
+        ga_solver *s = NULL;
+        pendulum_state(&p, 1.5, 0.0, q, v);
+        assert_int_equal(ga_create(2, 1, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                          pendulum_jacobian, &p),
+                         GA_OK);
+        const int terminal[3] = {0, 0, 1};
+        assert_int_equal(ga_set_events(s, 3, watch, NULL, terminal, 1), GA_OK);
+        assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        if (mode > 0)
+            assert_true(ga_step_adaptive(s, 1e3) >= GA_OK);
+        allocations = 0;
+        armed = 1;
+        long events = 0, failed = 0;
+        for (int i = 0; i < 300; ++i) {
+            event_failure = i % 11 == 5 ? (i % 2 ? -1 : 1) : 0;
+            const ga_status st = mode == 0 ? ga_step(s, 3e-3)
+                                 : mode == 1 ? ga_step_adaptive(s, 1e3)
+                                             : ga_advance(s, 0.01 * (i + 1));
+            events += st == GA_EVENT;
+            failed += st < GA_OK;
+        }
+        armed = 0;
+        event_failure = 0;
+        printf("  mode %d: %ld stops at events, %ld failed calls, %ld allocations\n", mode,
+               events, failed, allocations);
+        assert_true(events > 0 && failed > 0);
+        assert_int_equal(allocations, 0);
+        ga_free(s);
+    }
+}
+
 static void no_allocation_after_tangent_options_change(void **state)
 {
     (void)state;
@@ -385,6 +439,7 @@ int main(void)
         cmocka_unit_test(no_allocation_with_dropped_constraints),
         cmocka_unit_test(no_allocation_with_any_dense_kernel),
         cmocka_unit_test(no_allocation_after_tangent_options_change),
+        cmocka_unit_test(no_allocation_with_events),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

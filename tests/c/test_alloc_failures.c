@@ -2,7 +2,8 @@
  * GA_ERR_NOMEM with a message, and retried without the failure it works, and the run that
  * follows is bit for bit that of a solver that never met the failure. Calls swept: ga_init,
  * ga_set_state, and the options that allocate after ga_init (ga_set_formulation to index 2,
- * ga_set_tangent_mode to finite differences, ga_set_output) -- on the sparse path with
+ * ga_set_tangent_mode to finite differences, ga_set_output) and ga_set_events (replacing
+ * an earlier set) -- on the sparse path with
  * finite-difference tangents grouped by pattern. malloc and friends are
  * interposed here (not under the sanitizers, whose allocator cannot be made to fail so; nor
  * under valgrind, which replaces them). */
@@ -114,12 +115,22 @@ static ga_solver *make_redundant(void)
 }
 
 typedef enum call {
-    INIT, INIT_INDEX2, INIT_REDUNDANT, SET_STATE, FORMULATION, TANGENT_MODE, OUTPUT
+    INIT, INIT_INDEX2, INIT_REDUNDANT, SET_STATE, FORMULATION, TANGENT_MODE, OUTPUT, EVENTS
 } call;
 static const char *const kNames[] = {"ga_init", "ga_init (index 2)",
                                      "ga_init (a redundant constraint)", "ga_set_state",
                                      "ga_set_formulation", "ga_set_tangent_mode",
-                                     "ga_set_output"};
+                                     "ga_set_output", "ga_set_events"};
+
+/* event functions that never fire */
+static int far_away(double t, const double *q, const double *v, const double *lambda,
+                    double *g, void *user)
+{
+    (void)t, (void)v, (void)lambda, (void)user;
+    g[0] = 100.0 + q[0];
+    g[1] = 100.0 - q[1];
+    return 0;
+}
 
 /* The call under test on a solver prepared for it. */
 static ga_status do_call(ga_solver *s, call c, const double *checkpoint, size_t len)
@@ -133,6 +144,7 @@ static ga_status do_call(ga_solver *s, call c, const double *checkpoint, size_t 
     case SET_STATE: return ga_set_state(s, checkpoint, len);
     case FORMULATION: return ga_set_formulation(s, GA_INDEX2_STABILIZED);
     case TANGENT_MODE: return ga_set_tangent_mode(s, GA_TANGENT_FD);
+    case EVENTS: return ga_set_events(s, 2, far_away, NULL, NULL, 1);
     default: return ga_set_output(s, GA_OUTPUT_CONSISTENT);
     }
 }
@@ -150,6 +162,8 @@ static ga_solver *prepare(call c)
         assert_int_equal(ga_set_output(s, GA_OUTPUT_STEP), GA_OK);
     if (c == INIT_INDEX2)
         assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
+    if (c == EVENTS)
+        assert_int_equal(ga_set_events(s, 1, far_away, NULL, NULL, 0), GA_OK);
     if (c != INIT && c != INIT_INDEX2 && c != INIT_REDUNDANT && c != SET_STATE)
         assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     return s;
@@ -238,6 +252,7 @@ static void set_state_sweep(void **state) { (void)state; sweep(SET_STATE); }
 static void formulation_sweep(void **state) { (void)state; sweep(FORMULATION); }
 static void tangent_mode_sweep(void **state) { (void)state; sweep(TANGENT_MODE); }
 static void output_sweep(void **state) { (void)state; sweep(OUTPUT); }
+static void events_sweep(void **state) { (void)state; sweep(EVENTS); }
 
 int main(void)
 {
@@ -246,7 +261,7 @@ int main(void)
         cmocka_unit_test(init_redundant_sweep),
         cmocka_unit_test(set_state_sweep),
         cmocka_unit_test(formulation_sweep),  cmocka_unit_test(tangent_mode_sweep),
-        cmocka_unit_test(output_sweep),
+        cmocka_unit_test(output_sweep),       cmocka_unit_test(events_sweep),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
