@@ -47,4 +47,20 @@ NewtonCoefficients newton_coefficients(const Params &p, double h)
     return c;
 }
 
+// gamma: second order iff gamma = 1/2 + alpha_f - alpha_m (w lags y' by (alpha_m - alpha_f) h);
+// the stiff-limit roots -(1 - gamma)/gamma and -alpha_f/(1 - alpha_f) both equal -rho_inf.
+FirstOrderParams first_order_params_from_rho_inf(double rho_inf)
+{
+    FirstOrderParams p{};
+    p.alpha_m = (3.0 * rho_inf - 1.0) / (2.0 * (rho_inf + 1.0));
+    p.alpha_f = rho_inf / (rho_inf + 1.0);
+    p.gamma = 0.5 + p.alpha_f - p.alpha_m;  // = 1 / (1 + rho_inf)
+    return p;
+}
+
+double first_order_newton_coefficient(const FirstOrderParams &p, double h)
+{
+    return (1.0 - p.alpha_m) / (h * p.gamma * (1.0 - p.alpha_f));
+}
+
 }  // namespace ga

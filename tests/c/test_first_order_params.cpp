@@ -1,0 +1,133 @@
+// The first-order generalized-alpha parameters (src/params.cpp, docs/algorithms.md sec. 11),
+// checked by stepping the scheme they define: on y' = mu y its amplification matrix has
+// spectral radius rho_inf in the stiff limit (the trapezoidal rule, rho_inf = 1, keeps 1) and
+// roots 1 and -alpha_m/(1 - alpha_m) at h mu = 0; the solution converges at order 2 on
+// y' = -2 y and on y' = -y^2 (exact solutions e^(-2t) and 1/(1 + t)); and the Newton
+// coefficient d y'/d y makes Newton's method on the nonlinear one converge quadratically.
+// The scheme is written out here from its two defining equations, independently of the
+// solver (which does not integrate first-order states yet).
+#include <cmath>
+#include <complex>
+#include <cstdarg>
+#include <cstddef>
+#include <csetjmp>
+#include <cstdio>
+
+extern "C" {
+#include <cmocka.h>
+}
+
+#include "params.hpp"
+
+namespace {
+
+const double kRhos[] = {0.0, 0.5, 0.9, 1.0};
+
+// Spectral radius of the scheme's amplification matrix on y' = mu y at z = h mu, in the
+// variables (y, h w): from (1 - am) w1 + am w0 = (1 - af) mu y1 + af mu y0 and
+// y1 = y0 + h ((1 - g) w0 + g w1).
+double spectral_radius(const ga::FirstOrderParams &p, double z)
+{
+    const double am = p.alpha_m, af = p.alpha_f, g = p.gamma;
+    // y1 (1 - g (1 - af) z / (1 - am)) = y0 (1 + g af z / (1 - am)) + hw0 ((1 - g) - g am / (1 - am))
+    const double d = 1.0 - g * (1.0 - af) * z / (1.0 - am);
+    const double a11 = (1.0 + g * af * z / (1.0 - am)) / d;
+    const double a12 = ((1.0 - g) - g * am / (1.0 - am)) / d;
+    // h w1 = ((1 - af) z y1 + af z y0 - am h w0) / (1 - am)
+    const double a21 = ((1.0 - af) * z * a11 + af * z) / (1.0 - am);
+    const double a22 = ((1.0 - af) * z * a12 - am) / (1.0 - am);
+    const double tr = a11 + a22, det = a11 * a22 - a12 * a21;
+    const std::complex<double> s = std::sqrt(std::complex<double>(tr * tr - 4.0 * det, 0.0));
+    return std::max(std::abs(0.5 * (tr + s)), std::abs(0.5 * (tr - s)));
+}
+
+void stiff_limit_is_rho_inf(void **)
+{
+    for (const double rho : kRhos) {
+        const ga::FirstOrderParams p = ga::first_order_params_from_rho_inf(rho);
+        const double r = spectral_radius(p, -1e12);
+        std::printf("    rho_inf %.1f: spectral radius %.8f at h mu = -1e12\n", rho, r);
+        // a double root -rho_inf split by O(1 / sqrt(|h mu|))
+        assert_true(std::fabs(r - rho) < 1e-5);
+        // and no larger anywhere on the negative axis (A-stability there); at rho_inf = 1 the
+        // root -1 is double, and the eigenvalues of the computed matrix carry sqrt(eps) of it
+        for (double z = -1e-3; z > -1e9; z *= 1.7)
+            assert_true(spectral_radius(p, z) <= 1.0 + 1e-7);
+    }
+}
+
+void parameters_satisfy_their_conditions(void **)
+{
+    for (const double rho : kRhos) {
+        const ga::FirstOrderParams p = ga::first_order_params_from_rho_inf(rho);
+        const ga::Params second = ga::params_from_rho_inf(rho);
+        assert_true(std::fabs(p.gamma - 1.0 / (1.0 + rho)) < 1e-15);
+        assert_true(std::fabs(p.gamma - (0.5 + p.alpha_f - p.alpha_m)) < 1e-15);
+        assert_true(p.alpha_f == second.alpha_f);
+        // zero stability: the root -alpha_m/(1 - alpha_m) of h mu = 0 inside the unit disc
+        assert_true(std::fabs(p.alpha_m / (1.0 - p.alpha_m)) <= 1.0 + 1e-15);
+        assert_true(std::fabs(spectral_radius(p, 0.0) - 1.0) < 1e-12);
+    }
+}
+
+// y' = f(y) over [0, 1] with N steps; Newton on y'_{n+1} with the scheme's coefficient.
+// Returns |y_N - exact|; *worst_iters: the most Newton iterations of a step to 1e-14.
+template <class F, class Fy>
+double integrate(const ga::FirstOrderParams &p, int N, double y0, double exact, F f, Fy fy,
+                 int *worst_iters)
+{
+    const double h = 1.0 / N, c = ga::first_order_newton_coefficient(p, h);
+    double y = y0, yd = f(y0), w = yd;  // w_0 = y'_0
+    *worst_iters = 0;
+    for (int n = 0; n < N; ++n) {
+        double yd1 = yd, y1 = y, w1 = w;  // predictor: y' constant
+        int it = 0;
+        for (; it < 20; ++it) {
+            w1 = ((1.0 - p.alpha_f) * yd1 + p.alpha_f * yd - p.alpha_m * w) / (1.0 - p.alpha_m);
+            y1 = y + h * ((1.0 - p.gamma) * w + p.gamma * w1);
+            const double r = yd1 - f(y1);
+            if (std::fabs(r) < 1e-14 * (1.0 + std::fabs(yd1)))
+                break;
+            yd1 -= r / (1.0 - fy(y1) / c);  // dy1/dyd1 = 1 / c
+        }
+        *worst_iters = std::max(*worst_iters, it);
+        y = y1, yd = yd1, w = w1;
+    }
+    return std::fabs(y - exact);
+}
+
+void order_two_and_quadratic_newton(void **)
+{
+    for (const double rho : {0.0, 0.5, 0.9}) {
+        const ga::FirstOrderParams p = ga::first_order_params_from_rho_inf(rho);
+        double e_lin[2], e_nl[2];
+        int iters = 0, worst = 0;
+        for (int k = 0; k < 2; ++k) {
+            const int N = 200 << k;
+            e_lin[k] = integrate(p, N, 1.0, std::exp(-2.0), [](double y) { return -2.0 * y; },
+                                 [](double) { return -2.0; }, &iters);
+            e_nl[k] = integrate(p, N, 1.0, 0.5, [](double y) { return -y * y; },
+                                [](double y) { return -2.0 * y; }, &iters);
+            worst = std::max(worst, iters);
+        }
+        const double o_lin = std::log2(e_lin[0] / e_lin[1]), o_nl = std::log2(e_nl[0] / e_nl[1]);
+        std::printf("    rho_inf %.1f: orders %.3f (linear), %.3f (y' = -y^2); at most %d "
+                    "Newton iterations per step\n",
+                    rho, o_lin, o_nl, worst);
+        assert_true(std::fabs(o_lin - 2.0) < 0.05 && std::fabs(o_nl - 2.0) < 0.05);
+        // from the predictor (an O(h) guess) to 1e-14 in three updates: quadratic
+        assert_true(worst <= 3);
+    }
+}
+
+}  // namespace
+
+int main()
+{
+    const CMUnitTest tests[] = {
+        cmocka_unit_test(parameters_satisfy_their_conditions),
+        cmocka_unit_test(stiff_limit_is_rho_inf),
+        cmocka_unit_test(order_two_and_quadratic_newton),
+    };
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
