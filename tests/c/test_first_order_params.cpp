@@ -3,7 +3,8 @@
 // spectral radius rho_inf in the stiff limit (the trapezoidal rule, rho_inf = 1, keeps 1) and
 // roots 1 and -alpha_m/(1 - alpha_m) at h mu = 0; the solution converges at order 2 on
 // y' = -2 y and on y' = -y^2 (exact solutions e^(-2t) and 1/(1 + t)); and the Newton
-// coefficient d y'/d y makes Newton's method on the nonlinear one converge quadratically.
+// coefficient d y'/d y makes Newton's method on the nonlinear one converge quadratically; the
+// auxiliary w is of order 2 only from a corrected start.
 // The scheme is written out here from its two defining equations, independently of the
 // solver (which does not integrate first-order states yet).
 #include <cmath>
@@ -72,13 +73,19 @@ void parameters_satisfy_their_conditions(void **)
 
 // y' = f(y) over [0, 1] with N steps; Newton on y'_{n+1} with the scheme's coefficient.
 // Returns |y_N - exact|; *worst_iters: the most Newton iterations of a step to 1e-14.
+// w_0 = y'_0, or with `corrected` y'_0 + (alpha_m - alpha_f) h y''_0 (y'' = f_y f), and then
+// *w_error: the largest |w_n - y'(t_n + (alpha_m - alpha_f) h)| of the exact solution yd_exact.
 template <class F, class Fy>
 double integrate(const ga::FirstOrderParams &p, int N, double y0, double exact, F f, Fy fy,
-                 int *worst_iters)
+                 int *worst_iters, bool corrected = false, double (*yd_exact)(double) = nullptr,
+                 double *w_error = nullptr)
 {
     const double h = 1.0 / N, c = ga::first_order_newton_coefficient(p, h);
-    double y = y0, yd = f(y0), w = yd;  // w_0 = y'_0
+    const double lag = p.alpha_m - p.alpha_f;
+    double y = y0, yd = f(y0), w = corrected ? yd + lag * h * fy(y0) * yd : yd;
     *worst_iters = 0;
+    if (w_error)
+        *w_error = 0.0;
     for (int n = 0; n < N; ++n) {
         double yd1 = yd, y1 = y, w1 = w;  // predictor: y' constant
         int it = 0;
@@ -92,8 +99,35 @@ double integrate(const ga::FirstOrderParams &p, int N, double y0, double exact, 
         }
         *worst_iters = std::max(*worst_iters, it);
         y = y1, yd = yd1, w = w1;
+        if (w_error)
+            *w_error = std::max(*w_error, std::fabs(w - yd_exact((n + 1 + lag) * h)));
     }
     return std::fabs(y - exact);
+}
+
+// w approximates y' at the lagged time t_n + (alpha_m - alpha_f) h: started from y'_0 it is
+// off by O(h) in the first steps (order 1), started from the corrected value (the analogue of
+// a_0 in sec. 3.4) by O(h^2) throughout. y is of order 2 either way.
+void corrected_start_makes_w_second_order(void **)
+{
+    const auto f = [](double y) { return -y * y; };
+    const auto fy = [](double y) { return -2.0 * y; };
+    const auto yd_exact = [](double t) { return -1.0 / ((1.0 + t) * (1.0 + t)); };
+    for (const double rho : {0.0, 0.5, 0.9}) {
+        const ga::FirstOrderParams p = ga::first_order_params_from_rho_inf(rho);
+        double order[2];
+        for (int corrected = 0; corrected < 2; ++corrected) {
+            double e[2];
+            int iters;
+            for (int k = 0; k < 2; ++k)
+                integrate(p, 100 << k, 1.0, 0.5, f, fy, &iters, corrected != 0, yd_exact, &e[k]);
+            order[corrected] = std::log2(e[0] / e[1]);
+        }
+        std::printf("    rho_inf %.1f: order of w %.2f from y'_0, %.2f from the corrected start\n",
+                    rho, order[0], order[1]);
+        assert_true(std::fabs(order[0] - 1.0) < 0.1);
+        assert_true(std::fabs(order[1] - 2.0) < 0.1);
+    }
 }
 
 void order_two_and_quadratic_newton(void **)
@@ -128,6 +162,7 @@ int main()
         cmocka_unit_test(parameters_satisfy_their_conditions),
         cmocka_unit_test(stiff_limit_is_rho_inf),
         cmocka_unit_test(order_two_and_quadratic_newton),
+        cmocka_unit_test(corrected_start_makes_w_second_order),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
