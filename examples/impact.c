@@ -94,6 +94,11 @@ int main(void)
         ga_free(s);
         return 1;
     }
+    /* the state of the last restart, for the comparison with examples/python/impact.py */
+    double lambda[1];
+    ga_get_q(s, q);
+    ga_get_lambda(s, lambda);
+    printf("final q = %.17e %.17e\nfinal lambda = %.17e\n", q[0], q[1], lambda[0]);
     double worst = 0.0;
     for (int k = 1; k < IMPACTS; ++k)
         worst = fmax(worst, fabs(kinetic[k] / kinetic[k - 1] / (e * e) - 1.0));

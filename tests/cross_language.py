@@ -1,4 +1,5 @@
-"""The same scene in C, Fortran and Python gives the same numbers (to round-off).
+"""The same scene in C, Fortran and Python gives the same numbers (to round-off); the impact
+scene (events and restarts) in C and Python.
 
 Usage: cross_language.py BIN_DIR PY_EXAMPLES_DIR  (ctest passes both)."""
 import os
@@ -16,6 +17,8 @@ SCENES = {
     "slider_crank": [("C", [os.path.join(bin_dir, "slider_crank_demo")]),
                      ("Fortran", [os.path.join(bin_dir, "slider_crank_fortran")]),
                      ("Python", [sys.executable, os.path.join(py_dir, "slider_crank.py")])],
+    "impact": [("C", [os.path.join(bin_dir, "impact_demo")]),
+               ("Python", [sys.executable, os.path.join(py_dir, "impact.py")])],
     "chain_200": [("C", [os.path.join(bin_dir, "chain_demo"), "200", "--print"]),
                   ("Fortran", [os.path.join(bin_dir, "chain_fortran"), "200"]),
                   ("Python", [sys.executable, os.path.join(py_dir, "chain.py"), "200",
