@@ -193,8 +193,9 @@ GA_API ga_status ga_set_callbacks(ga_solver *s, ga_mass_fn mass, ga_force_fn for
  *      [M Phi_q^T; Phi_q 0] [qdd0; lambda0] = [f; -(Phi_qq(v,v) + 2 Phi_qt v + Phi_tt)];
  *   4. a0 = qdd0 (eq. 3 of the paper).
  *  Called again on a running solver it is the restart after a jump in q or v (an impact law,
- *  a switched force): every option, pattern and callback stays, nothing of the run before
- *  does (step-size history, kept matrix, sparse pivots), and the first step applies the
+ *  a switched force): every option, pattern, callback and event function stays, nothing of
+ *  the run before does (step-size history, kept matrix, sparse pivots, the event search and
+ *  its log), and the first step applies the
  *  corrected start; the run then repeats a new solver started there with the same options,
  *  bit for bit (tests/c/test_checkpoint.c).
  *  Allocates the solver's linear-algebra workspace (the last allocation before stepping).
