@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """The pendulum hitting a wall of examples/impact.c, written in Python: the wall a terminal
 event (Solver.set_events), the velocity reflected with restitution e at each impact and the run
-restarted there with init(). Same scene, same numbers; exits with 1 if the energy ratios are not
-e^2 or the first impact is not at the exact quarter period."""
+restarted there with init(); the model is that of pendulum.py. Same scene, same numbers; exits
+with 1 if the energy ratios are not e^2 or the first impact is not at the exact quarter
+period."""
 import math
 import os
 import sys
@@ -12,26 +13,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
                                 "bindings", "python"))
 import galpha  # noqa: E402
-
-MASS, LENGTH, GRAVITY = 1.0, 1.0, 9.81
-
-
-def mass(t, q, M):
-    M[:] = ((MASS, 0.0), (0.0, MASS))
-
-
-def force(t, q, v, f):
-    f[0] = 0.0
-    f[1] = -MASS * GRAVITY
-
-
-def constraint(t, q, phi):
-    phi[0] = 0.5 * (q[0] * q[0] + q[1] * q[1] - LENGTH * LENGTH)
-
-
-def jacobian(t, q, J):
-    J[0, 0] = q[0]
-    J[0, 1] = q[1]
+from pendulum import GRAVITY, LENGTH, MASS, constraint, force, jacobian, mass  # noqa: E402
 
 
 def wall(t, q, v, lam):

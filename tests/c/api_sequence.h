@@ -432,6 +432,17 @@ static int restart_twin(model *md, ga_solver *s, const double *ckpt, size_t len,
 }
 
 
+/* The checks after a stepping call, and what it counts. */
+static void after_step(const model *md, ga_solver *s, ga_status st, const double *before,
+                       int len, const char *call, int seq, seq_stats *stats)
+{
+    check_transaction(md, s, st, before, len, call, seq);
+    check_event_log(md, s, st, seq);
+    stats->steps_ok += st >= GA_OK;
+    stats->events += st == GA_EVENT;
+    stats->sparse_ok += st >= GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
+}
+
 /* One sequence: its choices from `data` (fuzzing; the sequence ends with the bytes) or from a
  * generator seeded by `seq`. */
 static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *stats)
@@ -543,11 +554,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             const int len = snapshot(&md, s, before);
             call = "ga_step";
             st = ga_step(s, step_size(&md));
-            check_transaction(&md, s, st, before, len, call, seq);
-            check_event_log(&md, s, st, seq);
-            stats->steps_ok += st >= GA_OK;
-            stats->events += st == GA_EVENT;
-            stats->sparse_ok += st == GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
+            after_step(&md, s, st, before, len, call, seq, stats);
             break;
         }
         case 26: {
@@ -557,11 +564,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             const double t_stop = pick(&md, 4) ? t + step_size(&md) : edge_value(&md);
             call = "ga_step_adaptive";
             st = ga_step_adaptive(s, t_stop);
-            check_transaction(&md, s, st, before, len, call, seq);
-            check_event_log(&md, s, st, seq);
-            stats->steps_ok += st >= GA_OK;
-            stats->events += st == GA_EVENT;
-            stats->sparse_ok += st == GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
+            after_step(&md, s, st, before, len, call, seq, stats);
             break;
         }
         case 27: {
