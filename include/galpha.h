@@ -573,7 +573,8 @@ typedef enum ga_event_direction {
     GA_EVENT_FALLING = -1 /**< from above zero to zero or below */
 } ga_event_direction;
 
-/** Entries of the event log of one stepping call. */
+/** Entries of the event log of one stepping call: GA_EVENT_LOG, or the number of event
+ *  functions if that is larger (every root fits an empty log). */
 #define GA_EVENT_LOG 64
 
 /** Watch `count` event functions (0 removes them), evaluated by `fn` with the user pointer of
@@ -593,9 +594,10 @@ typedef enum ga_event_direction {
  *  the next stepping call after ga_init, ga_set_state or this call.
  *  A failed event callback (or a NaN in g) fails the step that called it, which is undone like
  *  any failed step; a failed ga_step or ga_step_adaptive leaves the search where it was, so
- *  that a retry finds the same events. Allocates (count + n + m doubles and the log); may be
- *  called before or after ga_init. Errors: GA_ERR_ARG (count < 0, fn NULL with count > 0, a
- *  direction not -1, 0 or 1), GA_ERR_STATE, GA_ERR_NOMEM. */
+ *  that a retry finds the same events. Allocates (a few arrays of `count` entries, 2 n + m
+ *  doubles and the log); may be called before or after ga_init. Errors: GA_ERR_ARG
+ *  (count < 0, fn NULL with count > 0, a direction not -1, 0 or 1), GA_ERR_STATE, GA_ERR_NOMEM
+ *  (the events set before stay). */
 GA_API ga_status ga_set_events(ga_solver *s, int count, ga_event_fn fn, const int *direction,
                                const int *terminal, int with_multipliers);
 
