@@ -8,18 +8,6 @@
 
 namespace ga {
 
-namespace {
-// +1 / -1: function k crosses zero from a to b in a direction it watches; 0: it does not.
-int crossing(double a, double b, int direction)
-{
-    if (a < 0.0 && b >= 0.0 && direction >= 0)
-        return 1;
-    if (a > 0.0 && b <= 0.0 && direction <= 0)
-        return -1;
-    return 0;
-}
-}  // namespace
-
 void EventLocator::setup(int count)
 {
     lo_.assign(count, 0.0);
@@ -192,9 +180,9 @@ ga_status Solver::search_events()
             return static_cast<ga_status>(found);
         if (found == 0)
             break;
-        const int crossing = static_cast<int>(
+        const int crossed = static_cast<int>(
             std::count_if(e.fired.begin(), e.fired.end(), [](int f) { return f != 0; }));
-        if (e.logged() + crossing > e.capacity()) {
+        if (e.logged() + crossed > e.capacity()) {
             st = GA_EVENT;
             break;
         }

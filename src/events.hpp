@@ -10,6 +10,18 @@
 
 namespace ga {
 
+// A function crosses zero from a to b in a direction it watches (+1 rising, -1 falling, 0
+// both). One expression without early exits: it runs after every step.
+inline bool crosses(double a, double b, int direction)
+{
+    return (a < 0.0 && b >= 0.0 && direction >= 0) || (a > 0.0 && b <= 0.0 && direction <= 0);
+}
+// +1 / -1: the direction of that crossing; 0: none.
+inline int crossing(double a, double b, int direction)
+{
+    return crosses(a, b, direction) ? (a < 0.0 ? 1 : -1) : 0;
+}
+
 class EventLocator {
 public:
     // Fills g (one value per function) at time t from the interpolant; 0 on success, anything
@@ -79,8 +91,7 @@ public:
     bool any_crossing(const double *a, const double *b) const
     {
         for (int k = 0; k < count(); ++k)
-            if ((a[k] < 0.0 && b[k] >= 0.0 && direction_[k] >= 0) ||
-                (a[k] > 0.0 && b[k] <= 0.0 && direction_[k] <= 0))
+            if (crosses(a[k], b[k], direction_[k]))
                 return true;
         return false;
     }
