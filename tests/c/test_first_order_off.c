@@ -1,0 +1,105 @@
+/* Without first-order states the solver is the one before them, bit for bit (issue 19): runs
+ * of the shipped scenes -- fixed steps in index 3 and 2, adaptive steps in index 2 -- end in
+ * states whose FNV-1a hash over the bytes of (t, q, v, qdd, lambda) and the work counters
+ * equals the hash recorded with galpha 912a78b, the last commit before first-order states.
+ * The same runs with ga_set_first_order(s, 0, ...) declared give the same hashes. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "scene_catalog.h"
+
+enum { kRuns = 3 };
+
+static uint64_t fnv(uint64_t h, const void *data, size_t len)
+{
+    const unsigned char *p = data;
+    for (size_t k = 0; k < len; ++k) {
+        h ^= p[k];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+/* run 0: index 3, h = t_end / 200; run 1: index 2, the same h; run 2: index 2 adaptive,
+ * rtol = atol = 1e-6 to t_end. */
+static uint64_t run_hash(int scene, int run, int declare_zero)
+{
+    catalog_scene sc = catalog_make(scene);
+    ga_solver *s = catalog_solver(&sc);
+    assert_non_null(s);
+#ifdef GALPHA_HAS_FIRST_ORDER
+    if (declare_zero)
+        assert_int_equal(ga_set_first_order(s, 0, NULL, NULL), GA_OK);
+#else
+    (void)declare_zero;
+#endif
+    if (run > 0)
+        assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, sc.q0, sc.v0), GA_OK);
+    if (run < 2) {
+        const double h = sc.t_end / 200;
+        for (int k = 0; k < 200; ++k)
+            assert_int_equal(ga_step(s, h), GA_OK);
+    } else {
+        assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+        assert_int_equal(ga_advance(s, sc.t_end), GA_OK);
+    }
+    const int n = sc.n, m = sc.m;
+    double t, q[kCatalogMaxN], v[kCatalogMaxN], qdd[kCatalogMaxN], lambda[kCatalogMaxN];
+    assert_int_equal(ga_get_t(s, &t), GA_OK);
+    assert_int_equal(ga_get_q(s, q), GA_OK);
+    assert_int_equal(ga_get_v(s, v), GA_OK);
+    assert_int_equal(ga_get_qdd(s, qdd), GA_OK);
+    assert_int_equal(ga_get_lambda(s, lambda), GA_OK);
+    long long counters[GA_COUNTER_COUNT];
+    for (int k = 0; k < GA_COUNTER_COUNT; ++k)
+        assert_int_equal(ga_get_counter(s, k, &counters[k]), GA_OK);
+    uint64_t hash = 14695981039346656037ull;
+    hash = fnv(hash, &t, sizeof t);
+    hash = fnv(hash, q, sizeof(double) * (size_t)n);
+    hash = fnv(hash, v, sizeof(double) * (size_t)n);
+    hash = fnv(hash, qdd, sizeof(double) * (size_t)n);
+    hash = fnv(hash, lambda, sizeof(double) * (size_t)m);
+    hash = fnv(hash, counters, sizeof counters);
+    ga_free(s);
+    return hash;
+}
+
+/* Recorded with galpha 912a78b (release and sanitizer builds agree). */
+static const uint64_t kGolden[kCatalogScenes][kRuns] = {
+#include "first_order_off_golden.inc"
+};
+
+static void same_as_before(void **state)
+{
+    (void)state;
+    if (getenv("GALPHA_PRINT_GOLDEN")) {
+        for (int sc = 0; sc < kCatalogScenes; ++sc)
+            printf("    {0x%016llxull, 0x%016llxull, 0x%016llxull},\n",
+                   (unsigned long long)run_hash(sc, 0, 0), (unsigned long long)run_hash(sc, 1, 0),
+                   (unsigned long long)run_hash(sc, 2, 0));
+        return;
+    }
+    for (int sc = 0; sc < kCatalogScenes; ++sc)
+        for (int run = 0; run < kRuns; ++run) {
+            const uint64_t h0 = run_hash(sc, run, 0);
+            if (h0 != kGolden[sc][run])
+                print_error("%s run %d: hash %016llx, before first-order states %016llx\n",
+                            catalog_make(sc).name, run, (unsigned long long)h0,
+                            (unsigned long long)kGolden[sc][run]);
+            assert_true(h0 == kGolden[sc][run]);
+            assert_true(run_hash(sc, run, 1) == h0);
+        }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(same_as_before)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
