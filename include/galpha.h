@@ -615,6 +615,64 @@ GA_API ga_status ga_get_event(const ga_solver *s, int i, double *t, int *index, 
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */
+/** @name First-order states
+ *  r states y with first-order equations integrated in the same Newton solve as the mechanism
+ *  (a motor current, a controller's integral, a pressure):
+ *
+ *      M(q) q'' = f(t, q, v, y) - Phi_q^T lambda,   Phi(q, t) = 0,   y' = g(t, q, v, y),
+ *
+ *  by the first-order generalized-alpha method of Jansen, Whiting and Hulbert with parameters
+ *  from the same rho_inf (its spectral radius at infinity is rho_inf; with ga_set_params,
+ *  rho_inf = alpha_f / (1 - alpha_f)), second order in y and y'. The coupling blocks enter
+ *  the iteration matrix exactly (docs/algorithms.md sec. 11). Without them (r = 0, the
+ *  default) the solver is the one it was before they existed, bit for bit. They run on the
+ *  dense linear algebra (GA_LINEAR_SPARSE is refused). */
+/**@{*/
+/** Applied forces that depend on the first-order states: f(t, q, v, y), length n. */
+typedef int (*ga_force_y_fn)(double t, const double *q, const double *v, const double *y,
+                             double *f, void *user);
+/** The rates y' = g(t, q, v, y): length r. */
+typedef int (*ga_rate_fn)(double t, const double *q, const double *v, const double *y,
+                          double *ydot, void *user);
+/** The coupling blocks, dense and column-major: g_q = dg/dq (r x n), g_v = dg/dv (r x n),
+ *  g_y = dg/dy (r x r), f_y = df/dy (n x r). All four are written at every call. */
+typedef int (*ga_coupling_fn)(double t, const double *q, const double *v, const double *y,
+                              double *g_q, double *g_v, double *g_y, double *f_y, void *user);
+
+/** Declare r >= 0 first-order states, before the first ga_init or ga_init_y (they size the
+ *  workspace). rate is required when r > 0; force (may be NULL) then replaces the force
+ *  callback of ga_set_callbacks, so that the applied forces see y. Both receive the user
+ *  pointer of ga_set_callbacks. r = 0 removes them. Errors: GA_ERR_ARG (r < 0, rate NULL with
+ *  r > 0), GA_ERR_STATE (after the solver was set up by ga_init or ga_set_state). */
+GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga_rate_fn rate);
+
+/** The coupling blocks by a callback (NULL: finite differences, r + 1 force and 2 n + r rate
+ *  calls per iteration matrix). Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_coupling(ga_solver *s, ga_coupling_fn fn);
+
+/** exact nonzero (default): the coupling blocks g_q, g_v and f_y are in the iteration matrix;
+ *  zero: they are left out (only g_y, in the rows of y), as codes that couple such states
+ *  loosely do -- the same solution, at the price of more Newton iterations (a measurement
+ *  aid). Errors: GA_ERR_ARG, GA_ERR_STATE. */
+GA_API ga_status ga_set_coupling_exact(ga_solver *s, int exact);
+
+/** ga_init with the initial first-order states y0 (length r): y'0 = g(t0, q0, v0, y0) after
+ *  the positions and velocities are made consistent. ga_init on a solver with r > 0 keeps the
+ *  states it holds (a restart after an impact) and is refused before the first ga_init_y.
+ *  Errors: those of ga_init; GA_ERR_ARG (y0 NULL or not finite). */
+GA_API ga_status ga_init_y(ga_solver *s, double t0, const double *q0, const double *v0,
+                           const double *y0);
+
+/** The first-order states y and their rates y' = g at the accepted step (length r each; either
+ *  pointer may be NULL). Errors: GA_ERR_ARG, GA_ERR_STATE (before ga_init_y). */
+GA_API ga_status ga_get_y(const ga_solver *s, double *y, double *ydot);
+
+/** Dense output of y and y' inside the last step (as ga_interpolate): cubic Hermite from y and
+ *  y' at both ends, and its derivative. Errors: as ga_interpolate. */
+GA_API ga_status ga_interpolate_y(const ga_solver *s, double t, double *y, double *ydot);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
 /** @name Consistent start */
 /**@{*/
 /** Optional callback for the constraint acceleration term (finite differences of Phi_q and Phi
@@ -762,9 +820,13 @@ typedef enum ga_counter {
     GA_COUNT_CONSTRAINT_DT_EVALS = 13, /**< Phi_t evaluations (callback, or finite differences:
                                       their constraint calls count in
                                       GA_COUNT_CONSTRAINT_EVALS too) */
-    GA_COUNT_EVENT_EVALS = 14    /**< event function callback calls (ga_set_events) */
+    GA_COUNT_EVENT_EVALS = 14,   /**< event function callback calls (ga_set_events) */
+    GA_COUNT_RATE_EVALS = 15,    /**< first-order rate callback calls, y' = g (finite
+                                      differences of the coupling blocks included) */
+    GA_COUNT_COUPLING_EVALS = 16 /**< evaluations of the coupling blocks g_q, g_v, g_y, f_y
+                                      (callback or finite differences) */
 } ga_counter;
-#define GA_COUNTER_COUNT 15
+#define GA_COUNTER_COUNT 17
 
 /** Value of the counter `key` (a ::ga_counter). Errors: GA_ERR_ARG (NULL or unknown key),
  *  GA_ERR_STATE. */

@@ -1,5 +1,6 @@
 // The C ABI: argument checks, the re-entrancy guard, exceptions turned into statuses.
 // No mathematics here; it lives in the ga:: core.
+#include <algorithm>
 #include <cfenv>
 #include <climits>
 #include <cmath>
@@ -295,6 +296,7 @@ GA_API ga_status ga_set_rho_inf(ga_solver *s, double rho_inf)
         if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
             return c.diag.fail(GA_ERR_ARG, "rho_inf = %g is outside [0, 1]", rho_inf);
         c.params = ga::params_from_rho_inf(rho_inf);
+        c.params1 = ga::first_order_params_from_rho_inf(rho_inf);
         c.invalidate_jacobian();
         return GA_OK;
     });
@@ -308,6 +310,9 @@ GA_API ga_status ga_set_params(ga_solver *s, double alpha_m, double alpha_f, dou
         if (const char *why = ga::check_params(p))
             return c.diag.fail(GA_ERR_ARG, "parameters refused: %s", why);
         c.params = p;
+        // the first-order states' damping from the same alpha_f = rho_inf / (1 + rho_inf)
+        c.params1 = ga::first_order_params_from_rho_inf(
+            std::min(1.0, std::max(0.0, alpha_f / (1.0 - alpha_f))));
         c.invalidate_jacobian();
         return GA_OK;
     });
@@ -629,6 +634,79 @@ GA_API ga_status ga_interpolate_qdd(const ga_solver *s, double t, double *qdd)
             return c.diag.fail(GA_ERR_ARG, "ga_interpolate_qdd: t = %g not finite or qdd NULL",
                                t);
         return c.interpolate(t, nullptr, nullptr, qdd, nullptr);
+    });
+}
+
+GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga_rate_fn rate)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (r < 0)
+            return c.diag.fail(GA_ERR_ARG, "r = %d first-order states: must be >= 0", r);
+        if (r > 0 && !rate)
+            return c.diag.fail(GA_ERR_ARG, "r = %d > 0: the rate callback is required", r);
+        if (c.setup_done())
+            return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after the solver was set up "
+                               "(ga_init or ga_set_state): declare the states before");
+        c.set_first_order(r);  // may throw std::bad_alloc before anything below changed
+        c.model.cb.force_y = r > 0 ? force : nullptr;
+        c.model.cb.rate = r > 0 ? rate : nullptr;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_coupling(ga_solver *s, ga_coupling_fn fn)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        c.model.cb.coupling = fn;
+        c.invalidate_jacobian();
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_coupling_exact(ga_solver *s, int exact)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        c.coupling_exact = exact != 0;
+        c.invalidate_jacobian();
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_init_y(ga_solver *s, double t0, const double *q0, const double *v0,
+                           const double *y0)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!q0 || !v0 || (!y0 && c.r() > 0))
+            return c.diag.fail(GA_ERR_ARG, "q0, v0 and y0 must not be NULL");
+        if (!std::isfinite(t0))
+            return c.diag.fail(GA_ERR_ARG, "t0 = %g is not finite", t0);
+        if (!c.model.ready())
+            return c.diag.fail(GA_ERR_STATE, "ga_init_y before ga_set_callbacks");
+        return c.init_y(t0, q0, v0, y0);
+    });
+}
+
+GA_API ga_status ga_get_y(const ga_solver *s, double *y, double *ydot)
+{
+    return reading(s, "ga_get_y", "no argument can fail", [&](const ga::Solver &c) {
+        if (!c.initialized())
+            return GA_ERR_STATE;
+        if (y)
+            Eigen::Map<ga::Vec>(y, c.r()) = c.state().y;
+        if (ydot)
+            Eigen::Map<ga::Vec>(ydot, c.r()) = c.state().ydot;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_interpolate_y(const ga_solver *s, double t, double *y, double *ydot)
+{
+    return computing(s, [&](ga::Solver &c) {
+        if (!c.initialized())
+            return c.diag.fail(GA_ERR_STATE, "ga_interpolate_y before ga_init");
+        if (!std::isfinite(t))
+            return c.diag.fail(GA_ERR_ARG, "ga_interpolate_y: t = %g is not finite", t);
+        return c.interpolate_y(t, y, ydot);
     });
 }
 

@@ -7,6 +7,8 @@
 //   active   the constraints in use (m flags; all 1 unless GA_REDUNDANT_DROP dropped some)
 //   pivots   blocks of pivot_state_size(N) (backend.hpp) for S_ (N = n + m), S2_ (2n + 2m),
 //            P_ and O_ (n + m each)
+//   y        with r first-order states only: y, y', w, w_prev and the kept matrix's y, y'
+//            (r each)
 // Taking one only reads. Restoring rebuilds the kept matrix from the callbacks at the same
 // iterate and hands every sparse LU its pivots back, so the restored run repeats the run it
 // came from bit for bit (a kept matrix or pivots left out would make the next steps converge
@@ -46,7 +48,10 @@ Layout layout(int n, int m)
 }
 }  // namespace
 
-std::size_t Solver::state_size() const { return layout(n_, m_).end; }
+std::size_t Solver::state_size() const
+{
+    return layout(n_, m_).end + 6 * static_cast<std::size_t>(r());
+}
 
 void Solver::get_state(double *buf) const
 {
@@ -87,6 +92,11 @@ void Solver::get_state(double *buf) const
     S2_.save_pivots(buf + l.pivots[1]);
     P_.save_pivots(buf + l.pivots[2]);
     O_.save_pivots(buf + l.pivots[3]);
+    p = buf + l.end;
+    for (const Vec *x : {&s.y, &s.ydot, &s.w, &s.w_prev, &r.y, &r.ydot}) {
+        Eigen::Map<Vec>(p, x->size()) = *x;
+        p += x->size();
+    }
 }
 
 ga_status Solver::set_state(const double *buf, std::size_t len)
@@ -95,10 +105,13 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
     const Layout l = layout(n_, m_);
     const std::size_t expected =
         layout2 ? kHeader2 + 5 * static_cast<std::size_t>(n_) + static_cast<std::size_t>(m_)
-                : l.end;
+                : state_size();
     if (len != expected)
         return diag.fail(GA_ERR_ARG, "checkpoint has %zu doubles, this solver needs %zu", len,
-                         l.end);
+                         state_size());
+    if (layout2 && r() > 0)
+        return diag.fail(GA_ERR_ARG, "a layout-2 checkpoint has no first-order states; this "
+                         "solver has %d", r());
     if (buf[0] != kStateMagic || (buf[1] != kStateVersion && !layout2))
         return diag.fail(GA_ERR_ARG, "not a galpha checkpoint (magic %g, layout version %g)",
                          buf[0], buf[1]);
@@ -194,6 +207,13 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
         *x = Eigen::Map<const Vec>(p, x->size());
         p += x->size();
     }
+    const double *py = buf + l.end;
+    if (!layout2)
+        for (Vec *x : {&s.y, &s.ydot, &s.w, &s.w_prev, &recipe_.y, &recipe_.ydot}) {
+            *x = Eigen::Map<const Vec>(py, x->size());
+            py += x->size();
+        }
+    y_started_ = y_started_ || r() > 0;
     invalidate_jacobian();
     previous_valid_ = false;
     events_.restart();
@@ -249,6 +269,8 @@ ga_status Solver::rebuild_matrix()
     x.v = r.v;
     x.qdd = r.qdd;
     x.lambda = r.lambda;
+    x.y = r.y;
+    x.ydot = r.ydot;
     ga_status st = residual(r.t, x);
     if (!st && formulation == GA_INDEX2_STABILIZED && m_ > 0) {
         st = model.jacobian(r.t_b, r.q_b, B_);
@@ -261,6 +283,8 @@ ga_status Solver::rebuild_matrix()
         st = model.damping(r.t, x.q, x.v, f_, C_);
     if (!st && r.Z)
         st = model.velocity_constraint_tangent(r.t, x.q, x.v, J_, Z_);
+    if (!st && this->r() > 0)
+        st = first_order_matrix(r.t, x, r.h, r.K, r.C);
     if (!st)
         st = factorize(r.t, x, r.h, r.K, r.C, r.Z, 0);
     return st;

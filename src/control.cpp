@@ -81,6 +81,8 @@ double Solver::error_norm(double h)
         const double wv = scale * (atol + rtol * std::max(std::fabs(s.v[i]), std::fabs(x.v[i])));
         sum += (eq[i] / wq) * (eq[i] / wq) + (ev[i] / wv) * (ev[i] / wv);
     }
+    if (r() > 0)
+        return std::sqrt((sum + first_order_error_sum(h, scale)) / (2.0 * n_ + r()));
     return std::sqrt(sum / (2.0 * n_));
 }
 

@@ -43,8 +43,26 @@ Eigen::Index argmax_abs(const Vec &x)
 // stepped on without a constraint it needed (issue 17).
 ga_status Solver::init(double t0, const double *q0, const double *v0)
 {
+    if (r() > 0 && !y_started_)
+        return diag.fail(GA_ERR_STATE, "%d first-order states declared: the first start "
+                         "needs their initial values (ga_init_y)", r());
     if (auto st = setup())
         return st;
+    trial_.y = accepted_.y;  // a restart keeps the first-order states it holds
+    const std::vector<unsigned char> active_before = active_;
+    const ga_status st = start(t0, q0, v0);
+    if (st)
+        restore_active(active_before);
+    return st;
+}
+
+ga_status Solver::init_y(double t0, const double *q0, const double *v0, const double *y0)
+{
+    if (auto st = setup())
+        return st;
+    trial_.y = Eigen::Map<const Vec>(y0, r());
+    if (!all_finite(trial_.y))
+        return diag.fail(GA_ERR_ARG, "y0 contains NaN or Inf");
     const std::vector<unsigned char> active_before = active_;
     const ga_status st = start(t0, q0, v0);
     if (st)
@@ -87,9 +105,19 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
             return st;
     }
 
+    if (r() > 0)
+        model.y_now = &x.y;  // start() callers put y0 into trial_.y
     if (auto st = consistent_accelerations(t0, x.q, x.v, x.qdd, x.lambda)) {
         diag.append(" (consistent initial accelerations at t0 = %.17g)", t0);
         return st;
+    }
+    if (r() > 0) {  // y'_0 = g(t0, q0, v0, y0); w_0 = y'_0 as a_0 = qdd_0
+        if (auto st = model.rate(t0, x.q, x.v, x.y, x.ydot)) {
+            diag.append(" (initial rates of the first-order states at t0 = %.17g)", t0);
+            return st;
+        }
+        x.w = x.ydot;
+        x.w_prev = x.w;
     }
     x.a = x.qdd;  // eq. (3): a_0 = qdd_0
     x.a_prev = x.a;
@@ -97,6 +125,7 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
     accepted_.swap(trial_);
     ++state_id_;
     initialized_ = true;
+    y_started_ = y_started_ || r() > 0;
     previous_valid_ = false;
     events_.restart();
     start_pending_ = true;  // corrected starting values need the h of the first step
@@ -234,12 +263,17 @@ ga_status Solver::starting_values(double h)
         const double sh = side == 0 ? h : -h;
         x.q = s.q + sh * s.v + (0.5 * sh * sh) * *qdd_start_;
         x.v = s.v + sh * *qdd_start_;
+        if (r() > 0) {  // the forces at t0 -+ h see y there (to first order: see first_order.cpp)
+            y_tmp_ = s.y + sh * s.ydot;
+            model.y_now = &y_tmp_;
+        }
         Vec &out = side == 0 ? x.a : x.a_prev;
         if (auto st = consistent_accelerations(s.t + sh, x.q, x.v, out, lambda_tmp_)) {
             diag.append(" (corrected starting values for the first step, h = %g)", h);
             return st;
         }
     }
+    model.y_now = &s.y;
     qdd_tmp_ = 0.5 * (x.a - x.a_prev);  // h qddd_0
     a_n_ = *qdd_start_ + delta_alpha * qdd_tmp_;
     a_start_ = &a_n_;

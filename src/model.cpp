@@ -110,6 +110,8 @@ void Model::allocate_workspace(const ModelMatrix &M, const ModelMatrix &J, const
     g_plus_.setZero(m_);
     g_minus_.setZero(m_);
     J_pert_.copy_layout(J);  // also serves the constraint acceleration term
+    y_pert_.setZero(r_);
+    rate_pert_.setZero(r_);
     prepare_differences(M, K, C);
 }
 
@@ -171,6 +173,15 @@ ga_status Model::mass(double t, const Vec &q, ModelMatrix &M)
 
 ga_status Model::force(double t, const Vec &q, const Vec &v, Vec &f, Check check)
 {
+    if (r_ > 0 && cb.force_y) {
+        count(counters_, GA_COUNT_FORCE_EVALS);
+        const double *y = y_now->data();
+        if (auto st = callback_status(
+                user([&] { return cb.force_y(t, q.data(), v.data(), y, f.data(), cb.user); }),
+                "force", t))
+            return st;
+        return check == Check::Now ? check_finite(f.data(), n_, 0, "force f", t) : GA_OK;
+    }
     if (!cb.force) {  // no applied forces: nothing to evaluate, nothing to count
         f.setZero();
         return GA_OK;
@@ -207,7 +218,7 @@ ga_status Model::jacobian(double t, const Vec &q, ModelMatrix &J, Check check)
 
 ga_status Model::check_deferred(double t, const Vec &f, const ModelMatrix &J)
 {
-    if (cb.force)
+    if (has_force())
         if (auto st = check_finite(f.data(), n_, 0, "force f", t))
             return st;
     if (m_ == 0 || J.zero())
@@ -320,7 +331,7 @@ ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, Mod
             return st;
         return check_finite(C.data(), C.size(), message_rows(C), "tangent damping C_t", t);
     }
-    if (!cb.force) {
+    if (!has_force()) {
         C.set_zero();
         return GA_OK;
     }
@@ -419,6 +430,78 @@ ga_status Model::constraint_accel(double t, const Vec &q, const Vec &v, Vec &out
         J_pert_.multiply_add(1.0, v, g);
     }
     out = (g_plus_ - g_minus_) / (2.0 * s);
+    return GA_OK;
+}
+
+}  // namespace ga
+
+namespace ga {
+
+ga_status Model::rate(double t, const Vec &q, const Vec &v, const Vec &y, Vec &ydot)
+{
+    count(counters_, GA_COUNT_RATE_EVALS);
+    if (auto st = callback_status(
+            user([&] { return cb.rate(t, q.data(), v.data(), y.data(), ydot.data(), cb.user); }),
+            "rate", t))
+        return st;
+    return check_finite(ydot.data(), r_, 0, "rate g", t);
+}
+
+// Forward differences with fd_increment: column j of g_q from g at q + e_j, of g_v from v + e_j,
+// of g_y and f_y from y + e_j (the force sees the perturbed y through y_now).
+ga_status Model::coupling(double t, const Vec &q, const Vec &v, const Vec &y, const Vec &f,
+                          const Vec &ydot, CouplingBlocks &B)
+{
+    count(counters_, GA_COUNT_COUPLING_EVALS);
+    if (cb.coupling) {
+        if (auto st = callback_status(user([&] {
+                                          return cb.coupling(t, q.data(), v.data(), y.data(),
+                                                             B.g_q.data(), B.g_v.data(),
+                                                             B.g_y.data(), B.f_y.data(), cb.user);
+                                      }),
+                                      "coupling", t))
+            return st;
+        for (const Mat *X : {&B.g_q, &B.g_v, &B.g_y, &B.f_y})
+            if (!all_finite(X->data(), X->size()))
+                return check_finite(X->data(), X->size(), X->rows(), "coupling block", t);
+        return GA_OK;
+    }
+    for (int pass = 0; pass < 2; ++pass) {  // columns of q, then of v
+        Vec &x = pass == 0 ? q_pert_ : v_pert_;
+        x = pass == 0 ? q : v;
+        Mat &G = pass == 0 ? B.g_q : B.g_v;
+        for (int j = 0; j < n_; ++j) {
+            const double e = fd_increment(x[j]), keep = x[j];
+            x[j] += e;
+            const ga_status st = pass == 0 ? rate(t, q_pert_, v, y, rate_pert_)
+                                           : rate(t, q, v_pert_, y, rate_pert_);
+            x[j] = keep;
+            if (st)
+                return st;
+            G.col(j) = (rate_pert_ - ydot) / e;
+        }
+    }
+    const Vec *y_before = y_now;
+    y_pert_ = y;
+    y_now = &y_pert_;
+    for (int j = 0; j < r_; ++j) {
+        const double e = fd_increment(y[j]);
+        y_pert_[j] += e;
+        ga_status st = rate(t, q, v, y_pert_, rate_pert_);
+        if (!st && cb.force_y)
+            st = force(t, q, v, f_pert_);
+        y_pert_[j] = y[j];
+        if (st) {
+            y_now = y_before;
+            return st;
+        }
+        B.g_y.col(j) = (rate_pert_ - ydot) / e;
+        if (cb.force_y)
+            B.f_y.col(j) = (f_pert_ - f) / e;
+        else
+            B.f_y.col(j).setZero();
+    }
+    y_now = y_before;
     return GA_OK;
 }
 

@@ -24,7 +24,23 @@ struct Callbacks {
     ga_damping_fn damping = nullptr;
     ga_constraint_accel_fn constraint_accel = nullptr;
     ga_constraint_fn constraint_dt = nullptr;
+    // first-order states (ga_set_first_order, ga_set_coupling)
+    ga_force_y_fn force_y = nullptr;
+    ga_rate_fn rate = nullptr;
+    ga_coupling_fn coupling = nullptr;
     void *user = nullptr;
+};
+
+// The coupling blocks of first-order states, dense: g_q, g_v (r x n), g_y (r x r), f_y (n x r).
+struct CouplingBlocks {
+    Mat g_q, g_v, g_y, f_y;
+    void allocate(int n, int r)
+    {
+        g_q.setZero(r, n);
+        g_v.setZero(r, n);
+        g_y.setZero(r, r);
+        f_y.setZero(n, r);
+    }
 };
 
 // Columns of a sparse matrix grouped so that no two columns of a group share a row.
@@ -58,11 +74,26 @@ public:
     void prepare_differences(const ModelMatrix &M, const ModelMatrix &K, const ModelMatrix &C);
 
     bool ready() const { return cb.mass != nullptr && (m_ == 0 || (cb.constraint && cb.jacobian)); }
+
+    // First-order states (docs/algorithms.md sec. 11): their number, and the states the force
+    // callback sees. The solver points y_now at the states that belong with each (t, q, v) it
+    // evaluates f at; with r = 0 the force is that of ga_set_callbacks and y_now is unused.
+    int first_order_count() const { return r_; }
+    void set_first_order_count(int r) { r_ = r; }
+    const Vec *y_now = nullptr;
+    // y' = g(t, q, v, y) into ydot (length r).
+    ga_status rate(double t, const Vec &q, const Vec &v, const Vec &y, Vec &ydot);
+    // The coupling blocks at (t, q, v, y): the callback, or forward differences from f and
+    // g there (f = f(t, q, v, y), ydot = g(t, q, v, y)).
+    ga_status coupling(double t, const Vec &q, const Vec &v, const Vec &y, const Vec &f,
+                       const Vec &ydot, CouplingBlocks &B);
     bool uses_tangents() const { return tangent_mode != GA_TANGENT_NEGLECT; }
+    // applied forces exist: the callback of ga_set_callbacks, or with first-order states theirs
+    bool has_force() const { return cb.force || (r_ > 0 && cb.force_y); }
     bool stiffness_needed(const ModelMatrix &K) const { return uses_tangents() && !K.zero(); }
     bool damping_needed(const ModelMatrix &C) const
     {
-        return uses_tangents() && !C.zero() && (cb.force || cb.damping);
+        return uses_tangents() && !C.zero() && (has_force() || cb.damping);
     }
 
     // Callback values are checked for NaN and Inf as they come (Now), or by the caller
@@ -138,6 +169,8 @@ private:
     Diagnostics &diag_;
     // finite-difference scratch
     Vec q_pert_, v_pert_, f_pert_, r_pert_, phi_plus_, phi_minus_, g_plus_, g_minus_, step_;
+    int r_ = 0;
+    Vec y_pert_, rate_pert_;  // first-order differences
     ModelMatrix M_pert_, J_pert_;
     ColumnGroups k_groups_, c_groups_;
 };

@@ -34,11 +34,13 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &s
 {
     ++iteration_;
     ++with_matrix_;
-    enum { Q, A, L, K };
+    enum { Q, A, L, Y, YD, K };
     const std::array<double, K> e = {relative(size.dq, tol, size.q),
                                      relative(beta_prime * size.dw, tol, size.qdd),
-                                     relative(size.dlambda, tol, size.lambda)};
-    ratio_ = std::max({e[Q], e[A], e[L]});
+                                     relative(size.dlambda, tol, size.lambda),
+                                     relative(size.dy, tol, size.y),
+                                     relative(size.c1 * size.dy, tol, size.ydot)};
+    ratio_ = std::max({e[Q], e[A], e[L], e[Y], e[YD]});
 
     // Round-off floors (newton.hpp).
     const double ulps = kFloorUlps * std::numeric_limits<double>::epsilon();
@@ -47,8 +49,10 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &s
                             : gamma_prime > 0.0 ? ulps * size.v / gamma_prime
                                                 : 0.0;
     const double relative_qdd_floor = size.qdd > 0.0 ? beta_prime * dw_floor / size.qdd : 0.0;
+    const bool y_at_floor = size.dy <= ulps * size.y;
     const std::array<bool, K> at_floor = {size.dq <= q_floor, size.dw <= dw_floor,
-                                          size.dlambda <= relative_qdd_floor * size.lambda};
+                                          size.dlambda <= relative_qdd_floor * size.lambda,
+                                          y_at_floor, y_at_floor};
 
     // One update at the floor with a matrix factorized in this step at an iterate within the
     // tolerance (within round-off where the tolerance is below it) of the current one: it
@@ -56,7 +60,7 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &s
     moved_since_matrix_ += e[Q];
     const double moved_limit = std::max(1.0, ulps / tol);
     const bool matrix_current = fresh_matrix_ && moved_since_matrix_ <= moved_limit &&
-                                at_floor[Q] && at_floor[A];
+                                at_floor[Q] && at_floor[A] && at_floor[Y];
 
     previous_dq_at_roundoff_ = at_floor[Q];
     if (matrix_current) {

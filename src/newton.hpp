@@ -19,6 +19,9 @@
 //     either stagnates (theta_k >= 1/2: what is left is noise) or was computed with a matrix
 //     factorized in this step near the current q (one Newton update with the current matrix
 //     at fixed q solves the equations, linear in lambda and qdd once q stays).
+// First-order states (docs/algorithms.md sec. 11) are two more quantities of the same kind:
+// e_y = |dy| / (tol |y|) and e_y' = |c1 dy| / (tol |y'|), floor 64 ulps of |y| (times c1); with
+// none (r = 0) both are 0 and at their floor, and the test is the one before them.
 // Floors: positions 64 ulps of |q|; accelerations beta' times the floor of dw (that of q in
 // index 3, where qdd is known only to eps |q| / (beta h^2), paper sec. 3.3; 64 ulps of |v|
 // over gamma' in index 2, where v is fixed by the velocity constraint); multipliers the
@@ -41,6 +44,7 @@ namespace ga {
 struct UpdateSizes {
     double dq = 0.0, dw = 0.0, dlambda = 0.0;           // increments
     double q = 0.0, v = 0.0, qdd = 0.0, lambda = 0.0;   // the updated iterate
+    double dy = 0.0, y = 0.0, ydot = 0.0, c1 = 0.0;     // first-order states: |dy|, |y|, |y'|
     bool dw_is_dq = true;  // index 3: the accelerations move with the positions
     bool increments_finite = true, iterate_finite = true;
 };
@@ -85,7 +89,7 @@ public:
 private:
     int iteration_ = 0;
     double ratio_ = 0.0, theta_prev_ = -1.0, rate_ = -1.0;
-    std::array<double, 3> previous_{{-1.0, -1.0, -1.0}};  // e_q, e_a, e_l of the last update
+    std::array<double, 5> previous_{{-1.0, -1.0, -1.0, -1.0, -1.0}};  // e_q, e_a, e_l, e_y, e_y'
     bool previous_dq_at_roundoff_ = false;
     int with_matrix_ = 0;  // iterations with the current matrix in this step
     bool fresh_matrix_ = false;        // the matrix was factorized in this step

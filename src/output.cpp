@@ -62,6 +62,7 @@ ga_status Solver::output_state(double *qdd, double *lambda)
         return GA_OK;
     }
     if (output_for_ != state_id_) {
+        model.y_now = &x.y;
         if (auto st = consistent_output(x.t, x.q, x.v))
             return st;
         output_for_ = state_id_;
@@ -98,6 +99,11 @@ ga_status Solver::interpolate(double t, double *q, double *v, double *qdd, doubl
     if (v)
         Eigen::Map<Vec>(v, n_) = out_v_;
     if (consistent) {
+        if (r() > 0) {  // the forces at t see y there
+            if (auto st = interpolate_y(t, out_y_.data(), nullptr))
+                return st;
+            model.y_now = &out_y_;
+        }
         if (auto st = consistent_output(t, out_q_, out_v_))
             return st;
         output_for_ = -1;  // out_qdd_, out_lambda_ now hold values at t

@@ -98,6 +98,14 @@ void State::allocate(int n, int m)
     a_prev.setZero(n);
 }
 
+void State::allocate_first_order(int r)
+{
+    y.setZero(r);
+    ydot.setZero(r);
+    w.setZero(r);
+    w_prev.setZero(r);
+}
+
 void State::swap(State &other)
 {
     std::swap(t, other.t);
@@ -109,10 +117,15 @@ void State::swap(State &other)
     lambda.swap(other.lambda);
     a.swap(other.a);
     a_prev.swap(other.a_prev);
+    y.swap(other.y);
+    ydot.swap(other.ydot);
+    w.swap(other.w);
+    w_prev.swap(other.w_prev);
 }
 
 Solver::Solver(int n, int m)
-    : params(params_from_rho_inf(0.9)), model(n, m, counters, diag), n_(n), m_(m)
+    : params(params_from_rho_inf(0.9)), params1(first_order_params_from_rho_inf(0.9)),
+      model(n, m, counters, diag), n_(n), m_(m)
 {
     accepted_.allocate(n, m);
     trial_.allocate(n, m);
@@ -165,12 +178,15 @@ ga_status Solver::setup_workspace()
 {
     // Which linear algebra: sparse needs declared patterns of M and Phi_q, and K_t, C_t either
     // declared (possibly empty), not needed, or neglected.
-    const bool sparse_possible = !M_.dense() && (m_ == 0 || !J_.dense()) &&
+    const bool sparse_possible = r() == 0 && !M_.dense() && (m_ == 0 || !J_.dense()) &&
                                  (!model.stiffness_needed(K_) || !K_.dense()) &&
                                  (!model.damping_needed(C_) || !C_.dense());
     bool sparse = false;
     switch (linear_solver) {
     case GA_LINEAR_SPARSE:
+        if (r() > 0)
+            return diag.fail(GA_ERR_ARG, "first-order states run on the dense linear algebra "
+                             "only: GA_LINEAR_SPARSE is refused with r = %d", r());
         if (!sparse_possible)
             return diag.fail(GA_ERR_ARG,
                              "the sparse solver needs the patterns of M and Phi_q, and of K_t "
@@ -217,6 +233,20 @@ ga_status Solver::setup_workspace()
     c_.setZero(m_);
     qdd_tmp_.setZero(n_);
     lambda_tmp_.setZero(m_);
+    if (r() > 0) {
+        const int r1 = r();
+        blocks_.allocate(n_, r1);
+        H_.setZero(r1, r1);
+        H_lu_ = Eigen::PartialPivLU<Mat>(r1);
+        Hg_q_.setZero(r1, n_);
+        Hg_v_.setZero(r1, n_);
+        Keff_.set_dense(n_, n_);
+        Keff_.allocate();
+        Ceff_.set_dense(n_, n_);
+        Ceff_.allocate();
+        for (Vec *x : {&rate_, &ry_, &hry_, &dy_, &w_n_, &y_tmp_})
+            x->setZero(r1);
+    }
     model.allocate_workspace(M_, J_, K_, C_);
     sparse_backend_ = sparse && backend;
     if (redundancy == GA_REDUNDANT_DROP)
@@ -367,6 +397,7 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     lambda_start_ = &s.lambda;
     const bool long_after_short = s.h_last > 0.0 && h > kShortStepRatio * s.h_last;
     fresh_start_ = start_pending_ || long_after_short || restart_short;
+    model.y_now = &s.y;  // the forces the start's own evaluations see
     if (long_after_short) {
         if (auto st = consistent_accelerations(s.t, s.q, s.v, qdd_n_, lambda_n_)) {
             diag.append(" (start of a step %g times longer than the one before)", h / s.h_last);
@@ -383,6 +414,12 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     } else if (rescale_a && s.h_last > 0.0 && h != s.h_last) {
         a_n_ = s.qdd + (h / s.h_last) * (s.a - s.qdd);
         a_start_ = &a_n_;
+    }
+    if (r() > 0) {
+        if (fresh_start_ && corrected_start)
+            if (auto st = first_order_starting_values(h))
+                return st;
+        first_order_start(h);
     }
 
     // After a reused matrix was too slow, the next steps start with a fresh one; how many
@@ -470,6 +507,8 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
                  (1.0 - p.alpha_m);
         x.a_prev[i] = a_n[i];
     }
+    if (r() > 0)
+        finish_first_order(x);
     x.t = s.t + h;
     x.h_last = h;
     x.sliver_span = 0.0;
@@ -508,6 +547,11 @@ ga_status Solver::sliver_step(double h)
         J_.multiply_add(1.0, x.v, phi_);
         st = correct_velocities(x.v, "the velocities");
     }
+    if (!st && r() > 0) {  // y by its own Taylor step (local error O(h^2), h tiny)
+        x.y = s.y + h * s.ydot;
+        model.y_now = &x.y;
+        st = model.rate(x.t, x.q, x.v, x.y, x.ydot);
+    }
     if (!st)
         st = consistent_accelerations(x.t, x.q, x.v, x.qdd, x.lambda);
     if (st) {
@@ -521,6 +565,10 @@ ga_status Solver::sliver_step(double h)
     qdd_tmp_ = x.qdd - s.qdd;
     x.a = s.a + qdd_tmp_;
     x.a_prev = s.a_prev + qdd_tmp_;
+    if (r() > 0) {
+        x.w = s.w + (x.ydot - s.ydot);
+        x.w_prev = s.w_prev + (x.ydot - s.ydot);
+    }
     x.h_last = s.h_last;
     x.sliver_span = s.sliver_span + h;
     a_start_ = &x.a;  // for the error estimate of adaptive steps: none from this step
@@ -532,6 +580,7 @@ ga_status Solver::sliver_step(double h)
 // leaving M_, f_ and J_ evaluated there.
 ga_status Solver::residual(double t, const State &x)
 {
+    model.y_now = &x.y;
     ga_status st = evaluate_mass(t, x.q);
     if (!st)
         st = model.force(t, x.q, x.v, f_, Model::Check::Deferred);
@@ -541,6 +590,11 @@ ga_status Solver::residual(double t, const State &x)
         st = model.jacobian(t, x.q, J_, Model::Check::Deferred);
     if (st)
         return st;
+    if (r() > 0) {  // r^y = y' - g(t, q, v, y)
+        if ((st = model.rate(t, x.q, x.v, x.y, rate_)))
+            return st;
+        ry_ = x.ydot - rate_;
+    }
     Model::dynamics_residual(M_, x.qdd, f_, J_, x.lambda, rq_);
     count(counters, GA_COUNT_RESIDUALS);
     // f and Phi_q are checked through r^q, which every entry of both enters (a NaN or an Inf
@@ -562,6 +616,10 @@ ga_status Solver::factorize(double t, const State &x, double h, bool tangents_K,
     count(counters, GA_COUNT_FACTORIZATIONS);
     jacobian_valid_ = false;
     const ModelMatrix *C = tangents_C ? &C_ : nullptr, *K = tangents_K ? &K_ : nullptr;
+    if (coupling_in_matrix_) {  // first_order_matrix folded the coupling into copies
+        K = &Keff_;
+        C = &Ceff_;
+    }
     const bool ok = formulation == GA_INDEX2_STABILIZED
                         ? S2_.factorize(M_, C, K, J_, B_, tangent_Z ? &Z_ : nullptr, params, h)
                         : S_.factorize_step(M_, C, K, J_, params, h, scaling);
@@ -596,6 +654,10 @@ ga_status Solver::factorize(double t, const State &x, double h, bool tangents_K,
     r.v = x.v;
     r.qdd = x.qdd;
     r.lambda = x.lambda;
+    if (this->r() > 0) {
+        r.y = x.y;
+        r.ydot = x.ydot;
+    }
     if (formulation == GA_INDEX2_STABILIZED && m_ > 0) {
         r.t_b = b_t_;
         if (b_q_ != &r.q_b)
@@ -658,6 +720,10 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         x.lambda = *lambda_start_;  // finite, as every accepted state
     // The iteration starts from a finite iterate (the updates keep it so or report it): a
     // predictor can overflow where the accepted state is huge or h is.
+    if (r() > 0) {
+        predict_first_order(h);
+        finite = finite && all_finite(x.y) && all_finite(x.ydot);
+    }
     if (!finite)
         return diag.fail(GA_ERR_NONFINITE,
                          "predicted Newton iterate is not finite in the step from t = %.17g "
@@ -703,6 +769,8 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         const bool tangent_Z = index2 && m_ > 0 && model.uses_tangents();
         if (!st && refresh && tangent_Z)
             st = model.velocity_constraint_tangent(t1, x.q, x.v, J_, Z_);
+        if (!st && refresh && r() > 0)
+            st = first_order_matrix(t1, x, h, tangents_K, tangents_C);
         if (!st && refresh) {
             st = factorize(t1, x, h, tangents_K, tangents_C, tangent_Z, iter);
             refresh = false;
@@ -717,6 +785,8 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
             return st;
         }
         // [dq; dlambda] = -S_t^{-1} [r^q; r^lambda], in the scaled form (9)-(10)
+        if (r() > 0)
+            eliminate_first_order_rhs();
         const Vec *dw = &dq_;
         if (index2) {
             // dw_: the Newmark part of the update, dq + B^T deta
@@ -728,6 +798,8 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         count(counters, GA_COUNT_NEWTON_ITERS);
         UpdateSizes size;
         apply_update(dq_, *dw, dlambda_, c.gamma_prime, c.beta_prime, x, size);
+        if (r() > 0)
+            update_first_order(c, h, *dw, x, size);
         if (!size.increments_finite || !size.iterate_finite)
             return diag.fail(GA_ERR_NONFINITE,
                              "Newton %s is not finite in iteration %d of the step from "

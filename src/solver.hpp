@@ -23,8 +23,12 @@ struct State {
     double sliver_span = 0.0;
     Vec q, v, qdd, lambda, a;
     Vec a_prev;           // a of the state before (variable-step error estimate)
+    // First-order states (docs/algorithms.md sec. 11): y, y' = g, the auxiliary w of y' (as a
+    // is of qdd) and w of the state before; empty when r = 0.
+    Vec y, ydot, w, w_prev;
 
     void allocate(int n, int m);
+    void allocate_first_order(int r);
     void swap(State &other);  // pointer swaps only: no allocation, no copy
 };
 
@@ -76,6 +80,17 @@ public:
     bool rescale_a = true;
     bool corrected_start = true;
     Control control;
+    // First-order states: the method's parameters (from rho_inf, or from alpha_f after
+    // ga_set_params) and whether the coupling blocks are in the iteration matrix.
+    FirstOrderParams params1;
+    bool coupling_exact = true;
+    int r() const { return model.first_order_count(); }
+    // Declares r first-order states (before setup; allocates the states' vectors).
+    void set_first_order(int r);
+    // ga_init_y: ga_init with y0; first_order_started(): y holds states to start from.
+    ga_status init_y(double t0, const double *q0, const double *v0, const double *y0);
+    bool first_order_started() const { return y_started_; }
+    ga_status interpolate_y(double t, double *y, double *ydot);
 
     Counters counters{};
     Diagnostics diag;
@@ -185,6 +200,18 @@ private:
     ga_status step_with_events(bool adaptive, double h_or_t_stop);
     ga_status watched_step(bool adaptive, double h_or_t_stop);
     ga_status residual(double t, const State &x);
+    // first_order.cpp: the parts of a step that concern first-order states.
+    void first_order_start(double h);
+    void predict_first_order(double h);
+    ga_status first_order_matrix(double t, const State &x, double h, bool tangents_K,
+                                 bool tangents_C);
+    void eliminate_first_order_rhs();
+    void update_first_order(const NewtonCoefficients &c, double h, const Vec &dw, State &x,
+                            UpdateSizes &size);
+    void finish_first_order(State &x);
+    ga_status start_first_order(double t0, State &x);
+    ga_status first_order_starting_values(double h);
+    double first_order_error_sum(double h, double scale);
     ga_status factorize(double t, const State &x, double h, bool tangents_K, bool tangents_C,
                         bool tangent_Z, int iter);
     ga_status rebuild_matrix();  // checkpoint.cpp: the kept matrix again, from recipe_
@@ -255,6 +282,7 @@ private:
         double t = 0.0, h = 0.0, t_b = 0.0;
         bool K = false, C = false, Z = false;
         Vec q, v, qdd, lambda, q_b;
+        Vec y, ydot;  // first-order states
     } recipe_;
     double b_t_ = 0.0;            // where B_ was evaluated last (index 2)
     const Vec *b_q_ = nullptr;
@@ -280,6 +308,21 @@ private:
     ConvergenceTest convergence_;
 
     EventSet events_;
+
+    // First-order states (first_order.cpp): the coupling blocks, the LU of H = c1 I - g_y, and
+    // H^-1 g_q, H^-1 g_v for the elimination of dy; K_t and C_t with the coupling folded in
+    // (Keff_, Ceff_, dense); the residual r^y = y' - g and scratch. w_n_ is the w the step
+    // starts from when it is rescaled or corrected.
+    bool y_started_ = false;
+    bool coupling_in_matrix_ = false;  // the kept matrix holds Keff_, Ceff_
+    CouplingBlocks blocks_;
+    Eigen::PartialPivLU<Mat> H_lu_;
+    Mat H_, Hg_q_, Hg_v_;
+    ModelMatrix Keff_, Ceff_;
+    Vec rate_, ry_, hry_, dy_, w_n_, y_tmp_;
+    Vec out_y_;  // y at an interpolated time, for consistent output
+    const Vec *w_start_ = nullptr;
+    double c1_matrix_ = 0.0;  // c1 of the kept matrix
 };
 
 }  // namespace ga

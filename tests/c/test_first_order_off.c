@@ -14,7 +14,8 @@
 
 #include "scene_catalog.h"
 
-enum { kRuns = 3 };
+/* The counters galpha 912a78b had: later ones are not part of the recorded hash. */
+enum { kRuns = 3, kCountersBefore = 15 };
 
 static uint64_t fnv(uint64_t h, const void *data, size_t len)
 {
@@ -33,12 +34,8 @@ static uint64_t run_hash(int scene, int run, int declare_zero)
     catalog_scene sc = catalog_make(scene);
     ga_solver *s = catalog_solver(&sc);
     assert_non_null(s);
-#ifdef GALPHA_HAS_FIRST_ORDER
     if (declare_zero)
         assert_int_equal(ga_set_first_order(s, 0, NULL, NULL), GA_OK);
-#else
-    (void)declare_zero;
-#endif
     if (run > 0)
         assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
     assert_int_equal(ga_init(s, 0.0, sc.q0, sc.v0), GA_OK);
@@ -57,8 +54,8 @@ static uint64_t run_hash(int scene, int run, int declare_zero)
     assert_int_equal(ga_get_v(s, v), GA_OK);
     assert_int_equal(ga_get_qdd(s, qdd), GA_OK);
     assert_int_equal(ga_get_lambda(s, lambda), GA_OK);
-    long long counters[GA_COUNTER_COUNT];
-    for (int k = 0; k < GA_COUNTER_COUNT; ++k)
+    long long counters[kCountersBefore];
+    for (int k = 0; k < kCountersBefore; ++k)
         assert_int_equal(ga_get_counter(s, k, &counters[k]), GA_OK);
     uint64_t hash = 14695981039346656037ull;
     hash = fnv(hash, &t, sizeof t);

@@ -1,0 +1,479 @@
+/* First-order states y' = g(t, q, v, y) in the same solve (issue 19, docs/algorithms.md sec. 11):
+ * the stiff limit measured by stepping galpha, order 2 in every quantity against an exact
+ * solution (a matrix exponential computed here), Newton with and without the coupling blocks,
+ * restart and checkpoints, and the API's refusals. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "helpers.h"
+
+/* ---- a scalar stiff state beside a trivial mechanism: x'' = -x, y' = mu y ---- */
+static double g_mu;
+static int one_mass(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    M[0] = 1.0;
+    return 0;
+}
+static int spring_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)v, (void)u;
+    f[0] = -q[0];
+    return 0;
+}
+static int linear_rate(double t, const double *q, const double *v, const double *y,
+                       double *ydot, void *u)
+{
+    (void)t, (void)q, (void)v, (void)u;
+    ydot[0] = g_mu * y[0];
+    return 0;
+}
+
+/* On y' = mu y with h mu -> -infinity, y vanishes against y' and (y', w) follow a two-term
+ * recursion whose roots are the method's at infinity. They are measured from four consecutive
+ * y'_n by fitting y'_{n+2} = s y'_{n+1} - p y'_n (s, p: sum and product of the roots); with
+ * rho_inf = 0 both roots are 0, and y' vanishes after two steps. */
+static void stiff_limit_roots(double rho, double *root_modulus)
+{
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(1, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, one_mass, spring_force, NULL, NULL, NULL), GA_OK);
+    assert_int_equal(ga_set_first_order(s, 1, NULL, linear_rate), GA_OK);
+    assert_int_equal(ga_set_rho_inf(s, rho), GA_OK);
+    assert_int_equal(ga_set_corrected_start(s, 0), GA_OK); /* w_0 = y'_0 */
+    const double h = 0.1, q0 = 1.0, v0 = 0.0, y0 = 1.0;
+    g_mu = -1e12 / h;
+    assert_int_equal(ga_init_y(s, 0.0, &q0, &v0, &y0), GA_OK);
+    double yd[8];
+    assert_int_equal(ga_get_y(s, NULL, &yd[0]), GA_OK);
+    for (int k = 1; k < 8; ++k) {
+        assert_int_equal(ga_step(s, h), GA_OK);
+        assert_int_equal(ga_get_y(s, NULL, &yd[k]), GA_OK);
+    }
+    if (rho == 0.0) {
+        for (int k = 2; k < 8; ++k)
+            assert_true(fabs(yd[k]) <= 1e-9 * fabs(yd[0]));
+        *root_modulus = 0.0;
+    } else {
+        /* y'_{n+2} = sum y'_{n+1} - prod y'_n at n = 2 and 3 */
+        const double a11 = yd[3], a12 = -yd[2], b1 = yd[4];
+        const double a21 = yd[4], a22 = -yd[3], b2 = yd[5];
+        const double det = a11 * a22 - a12 * a21;
+        if (fabs(det) <= 1e-9 * (fabs(a11 * a22) + fabs(a12 * a21))) {
+            /* y'_n geometric (the start did not excite the second mode): one root */
+            const double root = yd[5] / yd[4];
+            assert_true(fabs(root + rho) < 1e-6);
+            assert_true(fabs(yd[4] / yd[3] - root) < 1e-9);
+            *root_modulus = fabs(root);
+            ga_free(s);
+            return;
+        }
+        const double sum = (b1 * a22 - a12 * b2) / det, prod = (a11 * b2 - b1 * a21) / det;
+        const double disc = sum * sum - 4.0 * prod;
+        /* a double root -rho: sum = -2 rho, prod = rho^2, disc = 0 up to the fit's noise */
+        assert_true(fabs(sum + 2.0 * rho) < 1e-6);
+        assert_true(fabs(prod - rho * rho) < 1e-6);
+        *root_modulus = disc >= 0 ? fmax(fabs(0.5 * (sum + sqrt(disc))),
+                                         fabs(0.5 * (sum - sqrt(disc))))
+                                  : sqrt(prod);
+    }
+    ga_free(s);
+}
+
+static void stiff_limit_has_spectral_radius_rho_inf(void **state)
+{
+    (void)state;
+    const double rhos[] = {0.0, 0.5, 0.9, 1.0};
+    for (int k = 0; k < 4; ++k) {
+        double radius = -1.0;
+        stiff_limit_roots(rhos[k], &radius);
+        print_message("rho_inf %.1f: measured spectral radius at h mu = -1e12: %.9f\n", rhos[k],
+                      radius);
+        assert_true(fabs(radius - rhos[k]) < 1e-6);
+    }
+}
+
+/* ---- a linear electromechanical model with an exact solution ----
+ * Two masses joined rigidly (Phi = x1 - x2 = 0, lambda the force in the joint); a spring and a
+ * damper on mass 1, a DC motor's force Kt i on mass 2; the motor's current i and a PI
+ * controller's integral z as first-order states:
+ *     m1 x1'' = -k x1 - c v1 - lambda,   m2 x2'' = Kt i + lambda,
+ *     L i' = u - R i - Ke v2,   u = -Kp (x2 - xr) - Ki z,   z' = x2 - xr.
+ * Reduced to (x, v, i, z) it is Z' = A Z + b, solved exactly by the exponential of the
+ * augmented matrix [A b; 0 0] (scaling and squaring of its Taylor series, below). */
+enum { EM_N = 2, EM_M = 1, EM_R = 2 };
+static const double m1 = 1.0, m2 = 0.5, k_s = 20.0, c_d = 0.5, Kt = 2.0, L_i = 0.05, R_i = 1.0,
+                    Ke = 2.0, Kp = 30.0, Ki = 40.0, xr = 1.0;
+
+static int em_mass(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    M[0] = m1, M[1] = 0.0, M[2] = 0.0, M[3] = m2;
+    return 0;
+}
+static int em_force(double t, const double *q, const double *v, const double *y, double *f,
+                    void *u)
+{
+    (void)t, (void)u;
+    f[0] = -k_s * q[0] - c_d * v[0];
+    f[1] = Kt * y[0];
+    return 0;
+}
+static int em_rate(double t, const double *q, const double *v, const double *y, double *ydot,
+                   void *u)
+{
+    (void)t, (void)u;
+    const double volt = -Kp * (q[1] - xr) - Ki * y[1];
+    ydot[0] = (volt - R_i * y[0] - Ke * v[1]) / L_i;
+    ydot[1] = q[1] - xr;
+    return 0;
+}
+static int em_constraint(double t, const double *q, double *phi, void *u)
+{
+    (void)t, (void)u;
+    phi[0] = q[0] - q[1];
+    return 0;
+}
+static int em_jacobian(double t, const double *q, double *J, void *u)
+{
+    (void)t, (void)q, (void)u;
+    J[0] = 1.0, J[1] = -1.0;
+    return 0;
+}
+static int em_coupling(double t, const double *q, const double *v, const double *y,
+                       double *g_q, double *g_v, double *g_y, double *f_y, void *u)
+{
+    (void)t, (void)q, (void)v, (void)y, (void)u;
+    /* g_q, g_v: 2 x 2 column-major (rows i, z); g_y 2 x 2; f_y 2 x 2 */
+    g_q[0] = 0.0, g_q[1] = 0.0, g_q[2] = -Kp / L_i, g_q[3] = 1.0;
+    g_v[0] = 0.0, g_v[1] = 0.0, g_v[2] = -Ke / L_i, g_v[3] = 0.0;
+    g_y[0] = -R_i / L_i, g_y[1] = 0.0, g_y[2] = -Ki / L_i, g_y[3] = 0.0;
+    f_y[0] = 0.0, f_y[1] = Kt, f_y[2] = 0.0, f_y[3] = 0.0;
+    return 0;
+}
+
+/* exp(T A5) for the 5 x 5 augmented matrix, by scaling and squaring of the Taylor series. */
+static void expm5(const double A[5][5], double T, double E[5][5])
+{
+    double norm = 0.0;
+    for (int i = 0; i < 5; ++i) {
+        double row = 0.0;
+        for (int j = 0; j < 5; ++j)
+            row += fabs(A[i][j] * T);
+        norm = fmax(norm, row);
+    }
+    int squarings = 0;
+    while (norm > 0.05) {
+        norm *= 0.5;
+        ++squarings;
+    }
+    const double scale = T / ldexp(1.0, squarings);
+    double term[5][5], next[5][5];
+    for (int i = 0; i < 5; ++i)
+        for (int j = 0; j < 5; ++j)
+            E[i][j] = term[i][j] = i == j ? 1.0 : 0.0;
+    for (int k = 1; k <= 18; ++k) {
+        for (int i = 0; i < 5; ++i)
+            for (int j = 0; j < 5; ++j) {
+                double acc = 0.0;
+                for (int l = 0; l < 5; ++l)
+                    acc += term[i][l] * A[l][j] * scale;
+                next[i][j] = acc / k;
+            }
+        for (int i = 0; i < 5; ++i)
+            for (int j = 0; j < 5; ++j) {
+                term[i][j] = next[i][j];
+                E[i][j] += term[i][j];
+            }
+    }
+    for (int s = 0; s < squarings; ++s) {
+        for (int i = 0; i < 5; ++i)
+            for (int j = 0; j < 5; ++j) {
+                double acc = 0.0;
+                for (int l = 0; l < 5; ++l)
+                    acc += E[i][l] * E[l][j];
+                next[i][j] = acc;
+            }
+        memcpy(E, next, sizeof next);
+    }
+}
+
+/* The exact (x, v, i, z) at T from rest, and the derived exact qdd, lambda, i', z'. */
+typedef struct em_exact {
+    double x, v, i, z, a, lambda, idot, zdot;
+} em_exact;
+
+static em_exact em_reference(double T)
+{
+    const double mt = m1 + m2;
+    const double A[5][5] = {
+        {0, 1, 0, 0, 0},
+        {-k_s / mt, -c_d / mt, Kt / mt, 0, 0},
+        {-Kp / L_i, -Ke / L_i, -R_i / L_i, -Ki / L_i, Kp * xr / L_i},
+        {1, 0, 0, 0, -xr},
+        {0, 0, 0, 0, 0}};
+    double E[5][5];
+    expm5(A, T, E);
+    em_exact e;
+    /* Z(0) = (0, 0, 0, 0) and the constant 1 in the fifth slot */
+    e.x = E[0][4], e.v = E[1][4], e.i = E[2][4], e.z = E[3][4];
+    e.a = (-k_s * e.x - c_d * e.v + Kt * e.i) / mt;
+    e.lambda = -k_s * e.x - c_d * e.v - m1 * e.a;
+    e.idot = (-Kp * (e.x - xr) - Ki * e.z - R_i * e.i - Ke * e.v) / L_i;
+    e.zdot = e.x - xr;
+    return e;
+}
+
+static ga_solver *em_solver(int formulation, int output, int exact_coupling, int with_callback)
+{
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(EM_N, EM_M, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, em_mass, NULL, em_constraint, em_jacobian, NULL), GA_OK);
+    assert_int_equal(ga_set_first_order(s, EM_R, em_force, em_rate), GA_OK);
+    if (with_callback)
+        assert_int_equal(ga_set_coupling(s, em_coupling), GA_OK);
+    assert_int_equal(ga_set_coupling_exact(s, exact_coupling), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    assert_int_equal(ga_set_output(s, output), GA_OK);
+    const double q0[EM_N] = {0, 0}, v0[EM_N] = {0, 0}, y0[EM_R] = {0, 0};
+    assert_int_equal(ga_init_y(s, 0.0, q0, v0, y0), GA_OK);
+    return s;
+}
+
+enum { kQ, kV, kA, kL, kY, kYD, kQuantities };
+static const char *const kNames[kQuantities] = {"q", "v", "qdd", "lambda", "y", "y'"};
+
+/* Errors at T = 1 of every quantity with N steps. */
+static void em_errors(int formulation, int output, int N, double err[kQuantities])
+{
+    const double T = 1.0;
+    ga_solver *s = em_solver(formulation, output, 1, 0);
+    for (int k = 0; k < N; ++k)
+        assert_int_equal(ga_step(s, T / N), GA_OK);
+    double q[EM_N], v[EM_N], qdd[EM_N], lambda, y[EM_R], yd[EM_R];
+    assert_int_equal(ga_get_q(s, q), GA_OK);
+    assert_int_equal(ga_get_v(s, v), GA_OK);
+    assert_int_equal(ga_get_qdd(s, qdd), GA_OK);
+    assert_int_equal(ga_get_lambda(s, &lambda), GA_OK);
+    assert_int_equal(ga_get_y(s, y, yd), GA_OK);
+    const em_exact e = em_reference(T);
+    err[kQ] = fmax(fabs(q[0] - e.x), fabs(q[1] - e.x));
+    err[kV] = fmax(fabs(v[0] - e.v), fabs(v[1] - e.v));
+    err[kA] = fmax(fabs(qdd[0] - e.a), fabs(qdd[1] - e.a));
+    err[kL] = fabs(lambda - e.lambda);
+    err[kY] = fmax(fabs(y[0] - e.i), fabs(y[1] - e.z));
+    err[kYD] = fmax(fabs(yd[0] - e.idot), fabs(yd[1] - e.zdot));
+    ga_free(s);
+}
+
+static void order_two_in_every_quantity(void **state)
+{
+    (void)state;
+    const int steps[] = {200, 400, 800, 1600};
+    const struct {
+        int formulation, output;
+        const char *name;
+    } cases[] = {{GA_INDEX3, GA_OUTPUT_CONSISTENT, "index 3"},
+                 {GA_INDEX3, GA_OUTPUT_STEP, "index 3, the step's own qdd, lambda"},
+                 {GA_INDEX2_STABILIZED, GA_OUTPUT_CONSISTENT, "index 2"},
+                 {GA_INDEX2_STABILIZED, GA_OUTPUT_STEP, "index 2, the step's own qdd, lambda"}};
+    for (int c = 0; c < 4; ++c) {
+        double h[4], e[kQuantities][4];
+        for (int k = 0; k < 4; ++k) {
+            double err[kQuantities];
+            em_errors(cases[c].formulation, cases[c].output, steps[k], err);
+            h[k] = 1.0 / steps[k];
+            for (int j = 0; j < kQuantities; ++j)
+                e[j][k] = err[j];
+        }
+        for (int j = 0; j < kQuantities; ++j) {
+            const double p = fit_order(h, e[j], 4);
+            print_message("%-36s %-7s errors %.2e ... %.2e  order %.3f\n", cases[c].name,
+                          kNames[j], e[j][0], e[j][3], p);
+            assert_true(p > 1.9 && p < 2.1);
+        }
+    }
+}
+
+/* Full Newton (a matrix at every iteration, tangents K_t, C_t by differences) with the exact
+ * coupling blocks solves this linear model in one update per step (the second confirms it);
+ * without g_q, g_v, f_y in the matrix the iteration only contracts. Finite differences and the
+ * callback agree. */
+static long long em_newton_iterations(int exact, int with_callback)
+{
+    ga_solver *s = em_solver(GA_INDEX3, GA_OUTPUT_CONSISTENT, exact, with_callback);
+    assert_int_equal(ga_set_jacobian_reuse(s, GA_REUSE_NEVER), GA_OK);
+    assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
+    assert_int_equal(ga_reset_counters(s), GA_OK);
+    for (int k = 0; k < 100; ++k)
+        assert_int_equal(ga_step(s, 0.01), GA_OK);
+    long long iters = 0;
+    assert_int_equal(ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &iters), GA_OK);
+    ga_free(s);
+    return iters;
+}
+
+static void exact_coupling_converges_in_one_update(void **state)
+{
+    (void)state;
+    const long long fd = em_newton_iterations(1, 0), cb = em_newton_iterations(1, 1),
+                    loose = em_newton_iterations(0, 1);
+    print_message("Newton iterations over 100 steps: exact coupling %lld (differences), %lld "
+                  "(callback); without the coupling blocks %lld\n",
+                  fd, cb, loose);
+    /* two updates per step with the callback; differences of the blocks (errors ~ sqrt(eps))
+     * leave r^y at ~1e-7 after the first update, and a few steps take a third */
+    assert_true(cb <= 200);
+    assert_true(fd <= 220);
+    assert_true(loose > 3 * cb);
+}
+
+static void checkpoint_continues_bit_for_bit(void **state)
+{
+    (void)state;
+    ga_solver *a = em_solver(GA_INDEX2_STABILIZED, GA_OUTPUT_CONSISTENT, 1, 0);
+    for (int k = 0; k < 10; ++k)
+        assert_int_equal(ga_step(a, 0.01), GA_OK);
+    size_t len = 0;
+    assert_int_equal(ga_state_size(a, &len), GA_OK);
+    double *buf = malloc(len * sizeof(double));
+    assert_non_null(buf);
+    assert_int_equal(ga_get_state(a, buf, len), GA_OK);
+    ga_solver *b = NULL;
+    assert_int_equal(ga_create(EM_N, EM_M, &b), GA_OK);
+    assert_int_equal(ga_set_callbacks(b, em_mass, NULL, em_constraint, em_jacobian, NULL), GA_OK);
+    assert_int_equal(ga_set_first_order(b, EM_R, em_force, em_rate), GA_OK);
+    assert_int_equal(ga_set_formulation(b, GA_INDEX2_STABILIZED), GA_OK);
+    assert_int_equal(ga_set_state(b, buf, len), GA_OK);
+    /* a checkpoint of a solver without first-order states does not fit */
+    ga_solver *plain = NULL;
+    assert_int_equal(ga_create(EM_N, EM_M, &plain), GA_OK);
+    assert_int_equal(ga_set_callbacks(plain, em_mass, NULL, em_constraint, em_jacobian, NULL),
+                     GA_OK);
+    assert_int_equal(ga_set_state(plain, buf, len), GA_ERR_ARG);
+    ga_free(plain);
+    for (int k = 0; k < 20; ++k) {
+        assert_int_equal(ga_step(a, 0.01), GA_OK);
+        assert_int_equal(ga_step(b, 0.01), GA_OK);
+    }
+    double ya[EM_R], yb[EM_R], qa[EM_N], qb[EM_N];
+    assert_int_equal(ga_get_y(a, ya, NULL), GA_OK);
+    assert_int_equal(ga_get_y(b, yb, NULL), GA_OK);
+    assert_int_equal(ga_get_q(a, qa), GA_OK);
+    assert_int_equal(ga_get_q(b, qb), GA_OK);
+    assert_memory_equal(ya, yb, sizeof ya);
+    assert_memory_equal(qa, qb, sizeof qa);
+    free(buf);
+    ga_free(a);
+    ga_free(b);
+}
+
+/* Dense output of y against the exact solution inside a step: third-order local accuracy of
+ * the cubic Hermite, so at h = 1e-2 its error is the step's own (order 2) and no larger. */
+static void dense_output_of_y(void **state)
+{
+    (void)state;
+    ga_solver *s = em_solver(GA_INDEX3, GA_OUTPUT_CONSISTENT, 1, 0);
+    const int N = 100;
+    double worst = 0.0;
+    for (int k = 0; k < N; ++k) {
+        assert_int_equal(ga_step(s, 1.0 / N), GA_OK);
+        for (int j = 1; j < 4; ++j) {
+            const double t = (k + 0.25 * j) / N;
+            double y[EM_R], yd[EM_R];
+            assert_int_equal(ga_interpolate_y(s, t, y, yd), GA_OK);
+            const em_exact e = em_reference(t);
+            worst = fmax(worst, fabs(y[0] - e.i) / 3.0);  /* |i| up to about 3 */
+        }
+    }
+    double y[EM_R];
+    assert_int_equal(ga_interpolate_y(s, 2.0, y, NULL), GA_ERR_ARG);
+    print_message("dense output of the current, h = 1e-2: largest error %.2e\n", worst * 3.0);
+    double err[kQuantities];
+    em_errors(GA_INDEX3, GA_OUTPUT_CONSISTENT, N, err);
+    assert_true(worst * 3.0 < 3.0 * err[kY] + 1e-3);
+    ga_free(s);
+}
+
+/* ---- what the API refuses, and failures that leave the solver as it was ---- */
+static int g_fail_rate_after;
+static int failing_rate(double t, const double *q, const double *v, const double *y,
+                        double *ydot, void *u)
+{
+    if (g_fail_rate_after-- == 0)
+        return 1;
+    return em_rate(t, q, v, y, ydot, u);
+}
+
+static void refusals_and_failures(void **state)
+{
+    (void)state;
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(EM_N, EM_M, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, em_mass, NULL, em_constraint, em_jacobian, NULL), GA_OK);
+    assert_int_equal(ga_set_first_order(s, -1, NULL, em_rate), GA_ERR_ARG);
+    assert_int_equal(ga_set_first_order(s, 2, em_force, NULL), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "rate"));
+    assert_int_equal(ga_set_first_order(s, EM_R, em_force, failing_rate), GA_OK);
+    const double q0[EM_N] = {0, 0}, v0[EM_N] = {0, 0}, y0[EM_R] = {0, 0};
+    const double bad[EM_R] = {0, NAN};
+    assert_int_equal(ga_init(s, 0.0, q0, v0), GA_ERR_STATE); /* y0 never given */
+    assert_non_null(strstr(ga_last_error(s), "ga_init_y"));
+    assert_int_equal(ga_init_y(s, 0.0, q0, v0, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_init_y(s, 0.0, q0, v0, bad), GA_ERR_ARG);
+    g_fail_rate_after = 1000000;
+    assert_int_equal(ga_init_y(s, 0.0, q0, v0, y0), GA_OK);
+    assert_int_equal(ga_set_first_order(s, 1, em_force, em_rate), GA_ERR_STATE);
+    for (int k = 0; k < 5; ++k)
+        assert_int_equal(ga_step(s, 0.01), GA_OK);
+    size_t len = 0;
+    assert_int_equal(ga_state_size(s, &len), GA_OK);
+    double *before = malloc(len * sizeof(double)), *after = malloc(len * sizeof(double));
+    assert_non_null(before);
+    assert_non_null(after);
+    assert_int_equal(ga_get_state(s, before, len), GA_OK);
+    g_fail_rate_after = 0;
+    assert_int_equal(ga_step(s, 0.01), GA_ERR_CALLBACK_RETRY);
+    assert_non_null(strstr(ga_last_error(s), "rate"));
+    assert_int_equal(ga_get_state(s, after, len), GA_OK);
+    assert_true(ckpt_same_state(before, after));
+    assert_memory_equal(before + len - 6 * EM_R, after + len - 6 * EM_R, 4 * EM_R * sizeof(double));
+    g_fail_rate_after = 1000000;
+    assert_int_equal(ga_step(s, 0.01), GA_OK);
+    /* a restart by ga_init keeps the states it holds */
+    double y_now[EM_R], y_restart[EM_R];
+    assert_int_equal(ga_get_y(s, y_now, NULL), GA_OK);
+    assert_int_equal(ga_init(s, 0.06, q0, v0), GA_OK);
+    assert_int_equal(ga_get_y(s, y_restart, NULL), GA_OK);
+    assert_memory_equal(y_now, y_restart, sizeof y_now);
+    free(before);
+    free(after);
+    ga_free(s);
+
+    /* the sparse linear algebra is refused with first-order states */
+    assert_int_equal(ga_create(EM_N, EM_M, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, em_mass, NULL, em_constraint, em_jacobian, NULL), GA_OK);
+    assert_int_equal(ga_set_first_order(s, EM_R, em_force, em_rate), GA_OK);
+    assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    assert_int_equal(ga_init_y(s, 0.0, q0, v0, y0), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "dense"));
+    ga_free(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(stiff_limit_has_spectral_radius_rho_inf),
+        cmocka_unit_test(order_two_in_every_quantity),
+        cmocka_unit_test(exact_coupling_converges_in_one_update),
+        cmocka_unit_test(checkpoint_continues_bit_for_bit),
+        cmocka_unit_test(dense_output_of_y),
+        cmocka_unit_test(refusals_and_failures),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
