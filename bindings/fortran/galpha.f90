@@ -44,7 +44,8 @@ module galpha
        GA_COUNT_MASS_EVALS = 5, GA_COUNT_FORCE_EVALS = 6, GA_COUNT_CONSTRAINT_EVALS = 7, &
        GA_COUNT_JACOBIAN_EVALS = 8, GA_COUNT_STIFFNESS_EVALS = 9, &
        GA_COUNT_DAMPING_EVALS = 10, GA_COUNT_ACCEL_EVALS = 11, GA_COUNT_REJECTED_STEPS = 12, &
-       GA_COUNT_CONSTRAINT_DT_EVALS = 13, GA_COUNT_EVENT_EVALS = 14
+       GA_COUNT_CONSTRAINT_DT_EVALS = 13, GA_COUNT_EVENT_EVALS = 14, &
+       GA_COUNT_RATE_EVALS = 15, GA_COUNT_COUPLING_EVALS = 16
   integer(c_int), parameter, public :: GA_INFO_RCOND = 0, GA_INFO_NEWTON_ITERS = 1, &
        GA_INFO_NEWTON_RATIO = 2, GA_INFO_ERROR_ESTIMATE = 3, GA_INFO_H_NEXT = 4
 
@@ -86,8 +87,25 @@ module galpha
        real(c_double), intent(out) :: g(*)
        type(c_ptr), value :: user
      end function ga_event_fn
+     ! first-order states: forces f(t, q, v, y) (n) and rates y' = g(t, q, v, y) (r)
+     integer(c_int) function ga_force_y_fn(t, q, v, y, f, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*), v(*), y(*)
+       real(c_double), intent(out) :: f(*)
+       type(c_ptr), value :: user
+     end function ga_force_y_fn
+     ! the coupling blocks, column-major: g_q, g_v (r x n), g_y (r x r), f_y (n x r)
+     integer(c_int) function ga_coupling_fn(t, q, v, y, g_q, g_v, g_y, f_y, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*), v(*), y(*)
+       real(c_double), intent(out) :: g_q(*), g_v(*), g_y(*), f_y(*)
+       type(c_ptr), value :: user
+     end function ga_coupling_fn
   end interface
-  public :: ga_mass_fn, ga_force_fn, ga_constraint_fn, ga_stiffness_fn, ga_event_fn
+  public :: ga_mass_fn, ga_force_fn, ga_constraint_fn, ga_stiffness_fn, ga_event_fn, &
+       ga_force_y_fn, ga_coupling_fn
 
   ! ---- the C API, one to one ----------------------------------------------------------------
   interface
@@ -393,6 +411,41 @@ module galpha
        real(c_double), intent(out), optional :: t  ! absent: NULL
        integer(c_int), intent(out), optional :: index, direction
      end function ga_get_event
+     integer(c_int) function ga_set_first_order(s, r, force, rate) &
+          bind(C, name="ga_set_first_order")
+       import :: c_int, c_ptr, c_funptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: r
+       type(c_funptr), value :: force, rate
+     end function ga_set_first_order
+     integer(c_int) function ga_set_coupling(s, fn) bind(C, name="ga_set_coupling")
+       import :: c_int, c_ptr, c_funptr
+       type(c_ptr), value :: s
+       type(c_funptr), value :: fn
+     end function ga_set_coupling
+     integer(c_int) function ga_set_coupling_exact(s, exact) &
+          bind(C, name="ga_set_coupling_exact")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: exact
+     end function ga_set_coupling_exact
+     integer(c_int) function ga_init_y(s, t0, q0, v0, y0) bind(C, name="ga_init_y")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: t0
+       real(c_double), intent(in) :: q0(*), v0(*), y0(*)
+     end function ga_init_y
+     integer(c_int) function ga_get_y(s, y, ydot) bind(C, name="ga_get_y")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), intent(out), optional :: y(*), ydot(*)  ! absent: NULL
+     end function ga_get_y
+     integer(c_int) function ga_interpolate_y(s, t, y, ydot) bind(C, name="ga_interpolate_y")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: t
+       real(c_double), intent(out), optional :: y(*), ydot(*)  ! absent: NULL
+     end function ga_interpolate_y
      function c_strlen(p) bind(C, name="strlen")
        import :: c_ptr, c_size_t
        type(c_ptr), value :: p
@@ -412,12 +465,13 @@ module galpha
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
        ga_interpolate, ga_interpolate_qdd, ga_set_output, ga_set_events, ga_get_event_count, &
-       ga_get_event
+       ga_get_event, ga_set_first_order, ga_set_coupling, ga_set_coupling_exact, ga_init_y, &
+       ga_get_y, ga_interpolate_y
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
      type(c_ptr) :: handle = c_null_ptr
-     integer :: n = 0, m = 0
+     integer :: n = 0, m = 0, r = 0
    contains
      procedure :: create => solver_create
      procedure :: free => solver_free
@@ -498,6 +552,19 @@ module galpha
      !> get_event(i, t, index, direction): the i-th (1-based), index 1-based as well
      procedure :: event_count => solver_event_count
      procedure :: get_event => solver_get_event
+     !> set_first_order(r, rate, force): r first-order states y' = rate(t, q, v, y), force
+     !> (optional) replacing the force callback so that it sees y; before the first start
+     procedure :: set_first_order => solver_set_first_order
+     !> set_coupling(fn): the coupling blocks by a callback; set_coupling_exact(.false.) leaves
+     !> g_q, g_v, f_y out of the iteration matrix
+     procedure :: set_coupling => solver_set_coupling
+     procedure :: set_coupling_exact => solver_set_coupling_exact
+     !> init_y(t0, q0, v0, y0): init with the initial first-order states
+     procedure :: init_y => solver_init_y
+     !> get_y(y, ydot) and interpolate_y(t, y, ydot): y, y' at the accepted step or inside
+     !> the last one (either optional)
+     procedure :: get_y => solver_get_y
+     procedure :: interpolate_y => solver_interpolate_y
   end type galpha_solver
   public :: galpha_strerror, galpha_version, galpha_version_number
 
@@ -632,6 +699,61 @@ contains
     status = ga_get_event(this%handle, i - 1, t, index, direction)
     if (status == GA_OK) index = index + 1
   end function solver_get_event
+
+  integer(c_int) function solver_set_first_order(this, r, rate, force) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer, intent(in) :: r
+    procedure(ga_force_y_fn) :: rate
+    procedure(ga_force_y_fn), optional :: force
+    type(c_funptr) :: f
+    f = c_null_funptr
+    if (present(force)) f = c_funloc(force)
+    status = ga_set_first_order(this%handle, int(r, c_int), f, c_funloc(rate))
+    if (status == GA_OK) this%r = r
+  end function solver_set_first_order
+
+  integer(c_int) function solver_set_coupling(this, fn) result(status)
+    class(galpha_solver), intent(inout) :: this
+    procedure(ga_coupling_fn) :: fn
+    status = ga_set_coupling(this%handle, c_funloc(fn))
+  end function solver_set_coupling
+
+  integer(c_int) function solver_set_coupling_exact(this, exact) result(status)
+    class(galpha_solver), intent(inout) :: this
+    logical, intent(in) :: exact
+    status = ga_set_coupling_exact(this%handle, merge(1_c_int, 0_c_int, exact))
+  end function solver_set_coupling_exact
+
+  integer(c_int) function solver_init_y(this, t0, q0, v0, y0) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t0, q0(:), v0(:), y0(:)
+    if (size(q0) < this%n .or. size(v0) < this%n .or. size(y0) < this%r) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_init_y(this%handle, t0, q0, v0, y0)
+  end function solver_init_y
+
+  integer(c_int) function solver_get_y(this, y, ydot) result(status)
+    class(galpha_solver), intent(in) :: this
+    real(c_double), intent(out), optional :: y(:), ydot(:)
+    real(c_double) :: yy(max(this%r, 1)), dd(max(this%r, 1))
+    status = ga_get_y(this%handle, yy, dd)
+    if (status /= GA_OK) return
+    if (present(y)) y(1:this%r) = yy(1:this%r)
+    if (present(ydot)) ydot(1:this%r) = dd(1:this%r)
+  end function solver_get_y
+
+  integer(c_int) function solver_interpolate_y(this, t, y, ydot) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t
+    real(c_double), intent(out), optional :: y(:), ydot(:)
+    real(c_double) :: yy(max(this%r, 1)), dd(max(this%r, 1))
+    status = ga_interpolate_y(this%handle, t, yy, dd)
+    if (status /= GA_OK) return
+    if (present(y)) y(1:this%r) = yy(1:this%r)
+    if (present(ydot)) ydot(1:this%r) = dd(1:this%r)
+  end function solver_interpolate_y
 
   integer(c_int) function solver_set_constraint_accel(this, fn) result(status)
     class(galpha_solver), intent(inout) :: this

@@ -15,6 +15,43 @@ contains
     g(1) = q(1)
     vertical = 0
   end function vertical
+
+  ! first-order states: x'' = -x + y with y' = -2 y (y = exp(-2 t) from y0 = 1)
+  integer(c_int) function unit_mass(t, q, M, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*)
+    real(c_double), intent(out) :: M(*)
+    type(c_ptr), value :: user
+    M(1) = 1.0d0
+    unit_mass = 0
+  end function unit_mass
+  integer(c_int) function driven(t, q, v, y, f, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*), y(*)
+    real(c_double), intent(out) :: f(*)
+    type(c_ptr), value :: user
+    f(1) = -q(1) + y(1)
+    driven = 0
+  end function driven
+  integer(c_int) function decay(t, q, v, y, ydot, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*), y(*)
+    real(c_double), intent(out) :: ydot(*)
+    type(c_ptr), value :: user
+    ydot(1) = -2.0d0 * y(1)
+    decay = 0
+  end function decay
+  integer(c_int) function blocks(t, q, v, y, g_q, g_v, g_y, f_y, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*), y(*)
+    real(c_double), intent(out) :: g_q(*), g_v(*), g_y(*), f_y(*)
+    type(c_ptr), value :: user
+    g_q(1) = 0.0d0
+    g_v(1) = 0.0d0
+    g_y(1) = -2.0d0
+    f_y(1) = 1.0d0
+    blocks = 0
+  end function blocks
 end module layer_events
 
 program test_layer
@@ -159,6 +196,26 @@ program test_layer
   call ok(s%set_events(vertical, [integer(c_int) ::]), 'set_events removes')
   call ok(s%step(1d-3), 'step without events')
   call expect(s%event_count() == 0, 'no events logged')
+
+  ! first-order states: y = exp(-2 t); the step's error at h = 1e-3 is ~1e-7 (order 2, C suite)
+  call r%free()
+  call ok(r%create(1, 0), 'create for first-order states')
+  call ok(r%set_callbacks(unit_mass), 'callbacks')
+  call ok(r%set_first_order(1, decay, driven), 'set_first_order')
+  call ok(r%set_coupling(blocks), 'set_coupling')
+  call ok(r%set_coupling_exact(.true.), 'set_coupling_exact')
+  call expect(r%init(0.0d0, [0.0d0], [0.0d0]) == GA_ERR_STATE, 'init needs y0 first')
+  call ok(r%init_y(0.0d0, [0.0d0], [0.0d0], [1.0d0]), 'init_y')
+  do i = 1, 1000
+     call ok(r%step(1d-3), 'step with first-order states')
+  end do
+  call ok(r%get_y(q(1:1), v(1:1)), 'get_y')
+  call expect(abs(q(1) - exp(-2.0d0)) < 1d-6, 'y = exp(-2 t) at t = 1')
+  call expect(abs(v(1) + 2.0d0 * q(1)) < 1d-9, "y' = -2 y")
+  call ok(r%interpolate_y(0.9995d0, q2(1:1)), 'interpolate_y')
+  call expect(abs(q2(1) - exp(-1.999d0)) < 1d-6, 'interpolated y')
+  call expect(r%counter(GA_COUNT_RATE_EVALS) > 0 .and. r%counter(GA_COUNT_COUPLING_EVALS) > 0, &
+              'rate and coupling counters')
 
   call s%free()
   call r%free()

@@ -96,6 +96,10 @@ DAMPING_FN = FORCE_FN
 CONSTRAINT_ACCEL_FN = FORCE_FN
 EVENT_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
                             c_double_p, ctypes.c_void_p)
+FORCE_Y_FN = EVENT_FN  # (t, q, v, y, f, user)
+RATE_FN = EVENT_FN     # (t, q, v, y, ydot, user)
+COUPLING_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
+                               c_double_p, c_double_p, c_double_p, c_double_p, ctypes.c_void_p)
 
 # Status codes (pinned in galpha.h).
 GA_OK = 0
@@ -130,7 +134,7 @@ GA_EVENT_LOG = 64
 COUNTERS = ("steps", "failed_steps", "newton_iters", "factorizations", "residuals",
             "mass_evals", "force_evals", "constraint_evals", "jacobian_evals",
             "stiffness_evals", "damping_evals", "accel_evals", "rejected_steps",
-            "constraint_dt_evals", "event_evals")
+            "constraint_dt_evals", "event_evals", "rate_evals", "coupling_evals")
 
 _S = ctypes.c_void_p  # ga_solver *
 _I = ctypes.c_int
@@ -194,6 +198,12 @@ _SIGNATURES = {
     "ga_set_events": (_I, [_S, _I, EVENT_FN, _P(_I), _P(_I), _I]),
     "ga_get_event_count": (_I, [_S, _P(_I)]),
     "ga_get_event": (_I, [_S, _I, _P(_D), _P(_I), _P(_I)]),
+    "ga_set_first_order": (_I, [_S, _I, FORCE_Y_FN, RATE_FN]),
+    "ga_set_coupling": (_I, [_S, COUPLING_FN]),
+    "ga_set_coupling_exact": (_I, [_S, _I]),
+    "ga_init_y": (_I, [_S, _D, c_double_p, c_double_p, c_double_p]),
+    "ga_get_y": (_I, [_S, c_double_p, c_double_p]),
+    "ga_interpolate_y": (_I, [_S, _D, c_double_p, c_double_p]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():

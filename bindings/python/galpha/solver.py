@@ -31,6 +31,7 @@ _FORCE = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp)
 _CONSTRAINT = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp)
 _STIFFNESS = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp)
 _EVENT = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp)
+_COUPLING = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp)
 
 
 def _cast(fn, ctype):
@@ -141,6 +142,14 @@ class Solver:
         gamma)), ga_set_newton((tol, max_iter)), ga_set_tolerances((rtol, atol)),
         ga_set_step_limits((h_min, h_max)), ga_set_formulation(galpha.GA_INDEX2_STABILIZED),
         ...).
+    r, rate(t, q, v, y, ydot), force_y(t, q, v, y, f), coupling(t, q, v, y, g_q, g_v, g_y, f_y),
+    coupling_exact
+        First-order states y' = g(t, q, v, y) (ga_set_first_order): r of them, `rate` fills
+        ydot (length r); `force_y`, if given, replaces `force` so that the applied forces see
+        y. `coupling` optionally fills the blocks dg/dq, dg/dv (r x n), dg/dy (r x r), df/dy
+        (n x r) (finite differences otherwise); coupling_exact=False leaves g_q, g_v, f_y out
+        of the iteration matrix (a measurement aid). Start with init(t0, q0, v0, y0); read
+        `y`, `ydot` and interpolate_y(t).
     zero_copy : bool
         False (default): callbacks get copies of their inputs and an array of their own to
         fill, so what they keep stays valid and unchanged after the call. True: views of the
@@ -158,6 +167,7 @@ class Solver:
                  init_mode=None, formulation=None, redundant=None, tolerances=None, reuse=None,
                  constant_mass=None, linear_solver=None, rescale=None, corrected_start=None,
                  step_limits=None, initial_step=None, output=None, patterns=None,
+                 r=0, rate=None, force_y=None, coupling=None, coupling_exact=None,
                  zero_copy=False):
         self._ptr = None
         self._lock = threading.RLock()  # see _serialized
@@ -240,13 +250,20 @@ class Solver:
                 return -1
             self._in_callback += 1
             try:
+                # several outputs (the coupling blocks): tuples of addresses and shapes
+                many = isinstance(out_address, tuple)
+                places = tuple(zip(out_address, out_shape)) if many else ((out_address,
+                                                                           out_shape),)
                 if zero_copy:
+                    outs = [v(a, sh, True) for a, sh in places]
                     return status(fn, fn(t, *[v(a, (k,)) for a, k in inputs],
-                                         v(out_address, out_shape, True)))
-                out = np.zeros(out_shape, order="F")
-                rc = status(fn, fn(t, *[copied(a, k) for a, k in inputs], out))
+                                         outs if many else outs[0]))
+                outs = [np.zeros(sh, order="F") for _, sh in places]
+                rc = status(fn, fn(t, *[copied(a, k) for a, k in inputs],
+                                   outs if many else outs[0]))
                 if rc == 0:
-                    v(out_address, out_shape, True)[...] = out
+                    for (a, sh), out in zip(places, outs):
+                        v(a, sh, True)[...] = out
                 return rc
             except BaseException as e:  # re-raised by the call that stepped
                 self._pending = e
@@ -291,6 +308,28 @@ class Solver:
                                                      _cast(ac, _ffi.CONSTRAINT_ACCEL_FN)))
         if tc:
             self._check(_ffi.ga_set_constraint_dt(self._ptr, _cast(tc, _ffi.CONSTRAINT_FN)))
+        self.r = int(r)
+        if self.r or rate is not None:
+            r = self.r
+            self._user.update(rate=rate, force_y=force_y, coupling=coupling)
+            fo = [
+                _EVENT(lambda t, q, qd, y, f, u: call(force_y, f, (n,), t, (q, n), (qd, n),
+                                                      (y, r))) if force_y else None,
+                _EVENT(lambda t, q, qd, y, yd, u: call(rate, yd, (r,), t, (q, n), (qd, n),
+                                                       (y, r))) if rate else None,
+                _COUPLING(lambda t, q, qd, y, gq, gv, gy, fy, u: call(
+                    lambda t, q, qd, y, out: coupling(t, q, qd, y, out[0], out[1], out[2],
+                                                      out[3]),
+                    (gq, gv, gy, fy), ((r, n), (r, n), (r, r), (n, r)), t, (q, n), (qd, n),
+                    (y, r))) if coupling else None,
+            ]
+            self._cbs += fo
+            self._check(_ffi.ga_set_first_order(self._ptr, r, _cast(fo[0], _ffi.FORCE_Y_FN),
+                                                _cast(fo[1], _ffi.RATE_FN)))
+            if coupling:
+                self._check(_ffi.ga_set_coupling(self._ptr, _cast(fo[2], _ffi.COUPLING_FN)))
+        if coupling_exact is not None:
+            self._check(_ffi.ga_set_coupling_exact(self._ptr, int(bool(coupling_exact))))
         if rho_inf is not None:
             self.set_rho_inf(rho_inf)
         if params is not None:
@@ -424,13 +463,49 @@ class Solver:
     # ---- stepping ---------------------------------------------------------------------------
     @_serialized
     @_runs_callbacks
-    def init(self, t0, q0, v0):
-        """Consistent initial values at t0 (see ga_init)."""
+    def init(self, t0, q0, v0, y0=None):
+        """Consistent initial values at t0 (see ga_init); with first-order states, y0 their
+        initial values (ga_init_y; None on a running solver keeps the states it holds)."""
         q0 = np.ascontiguousarray(q0, dtype=float)
         v0 = np.ascontiguousarray(v0, dtype=float)
         if q0.shape != (self.n,) or v0.shape != (self.n,):
             raise error_for(_ffi.GA_ERR_ARG, "q0 and v0 must have shape (%d,)" % self.n)
-        self._check(_ffi.ga_init(self._handle(), float(t0), self._dp(q0), self._dp(v0)))
+        if y0 is None:
+            self._check(_ffi.ga_init(self._handle(), float(t0), self._dp(q0), self._dp(v0)))
+            return
+        y0 = np.ascontiguousarray(y0, dtype=float).reshape(-1)
+        if y0.shape != (self.r,):
+            raise error_for(_ffi.GA_ERR_ARG, "y0 must have shape (%d,)" % self.r)
+        self._check(_ffi.ga_init_y(self._handle(), float(t0), self._dp(q0), self._dp(v0),
+                                   self._dp(np.append(y0, 0.0))))
+
+    @_serialized
+    def set_coupling_exact(self, exact):
+        """Whether g_q, g_v, f_y are in the iteration matrix (see ga_set_coupling_exact)."""
+        self._check(_ffi.ga_set_coupling_exact(self._handle(), int(bool(exact))))
+
+    def _y_pair(self, fn, *args):
+        y, yd = np.empty(max(self.r, 1)), np.empty(max(self.r, 1))
+        self._check(fn(self._handle(), *args, self._dp(y), self._dp(yd)))
+        return y[:self.r], yd[:self.r]
+
+    @property
+    @_serialized
+    def y(self):
+        """First-order states at the accepted step (copy)."""
+        return self._y_pair(_ffi.ga_get_y)[0]
+
+    @property
+    @_serialized
+    def ydot(self):
+        """Their rates y' = g at the accepted step (copy)."""
+        return self._y_pair(_ffi.ga_get_y)[1]
+
+    @_serialized
+    @_runs_callbacks
+    def interpolate_y(self, t):
+        """(y, ydot) at t inside the last step (see ga_interpolate_y)."""
+        return self._y_pair(_ffi.ga_interpolate_y, float(t))
 
     @_serialized
     @_runs_callbacks
