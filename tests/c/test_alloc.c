@@ -15,6 +15,7 @@
 
 #include "helpers.h"
 #include "chain_solver.h"
+#include "electromech.h"
 
 static volatile int armed = 0;
 static volatile long allocations = 0;
@@ -404,6 +405,52 @@ static void no_allocation_with_events(void **state)
     }
 }
 
+/* First-order states: coupling blocks by differences and by callback, both formulations, fixed
+ * and adaptive steps, rate callbacks that fail now and then. */
+static int rate_failure;
+static int sometimes_failing_rate(double t, const double *q, const double *v, const double *y,
+                                  double *ydot, void *u)
+{
+    return rate_failure ? rate_failure : em_rate(t, q, v, y, ydot, u);
+}
+
+static void no_allocation_with_first_order_states(void **state)
+{
+    (void)state;
+    for (int mode = 0; mode < 4; ++mode) {
+        ga_solver *s = NULL;
+        assert_int_equal(ga_create(EM_N, EM_M, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, em_mass, NULL, em_constraint, em_jacobian, NULL),
+                         GA_OK);
+        assert_int_equal(ga_set_first_order(s, EM_R, em_force, sometimes_failing_rate), GA_OK);
+        if (mode & 1)
+            assert_int_equal(ga_set_coupling(s, em_coupling), GA_OK);
+        if (mode >= 2)
+            assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
+        assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
+        assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+        const double q0[EM_N] = {0, 0}, v0[EM_N] = {0, 0}, y0[EM_R] = {0, 0};
+        assert_int_equal(ga_init_y(s, 0.0, q0, v0, y0), GA_OK);
+        assert_int_equal(ga_step(s, 1e-3), GA_OK);
+        if (mode >= 2)
+            assert_int_equal(ga_step_adaptive(s, 1e3), GA_OK);
+        allocations = 0;
+        armed = 1;
+        long failed = 0;
+        for (int i = 0; i < 200; ++i) {
+            rate_failure = i % 13 == 7 ? (i % 2 ? -1 : 1) : 0;
+            const ga_status st = mode < 2 ? ga_step(s, 1e-3) : ga_step_adaptive(s, 1e3);
+            failed += st < GA_OK;
+        }
+        armed = 0;
+        rate_failure = 0;
+        printf("  mode %d: %ld failed calls, %ld allocations\n", mode, failed, allocations);
+        assert_true(failed > 0);
+        assert_int_equal(allocations, 0);
+        ga_free(s);
+    }
+}
+
 static void no_allocation_after_tangent_options_change(void **state)
 {
     (void)state;
@@ -440,6 +487,7 @@ int main(void)
         cmocka_unit_test(no_allocation_with_any_dense_kernel),
         cmocka_unit_test(no_allocation_after_tangent_options_change),
         cmocka_unit_test(no_allocation_with_events),
+        cmocka_unit_test(no_allocation_with_first_order_states),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -67,8 +67,31 @@ static ga_solver *make(void)
     return s;
 }
 
+/* A first-order state on the chain: y' = v_0 - y, acting on coordinate 0 as a force y. */
+static int chain_force_y(double t, const double *q, const double *v, const double *y, double *f,
+                         void *u)
+{
+    const int rc = chain_force(t, q, v, f, u);
+    f[0] += y[0];
+    return rc;
+}
+static int chain_rate(double t, const double *q, const double *v, const double *y, double *ydot,
+                      void *u)
+{
+    (void)t, (void)q, (void)u;
+    ydot[0] = v[0] - y[0];
+    return 0;
+}
+static const double kY0[1] = {0.5};
+static int g_start_before_steps; /* SET_FIRST_ORDER: the call is made before ga_init_y */
+
 static void steps(ga_solver *s, double *q)
 {
+    if (g_start_before_steps) {
+        double q0[N], v0[N];
+        chain_initial(&g_chain, q0, v0);
+        assert_int_equal(ga_init_y(s, 0.0, q0, v0, kY0), GA_OK);
+    }
     for (int i = 0; i < 5; ++i)
         assert_int_equal(ga_step(s, 1e-3), GA_OK);
     assert_int_equal(ga_get_q(s, q), GA_OK);
@@ -115,12 +138,14 @@ static ga_solver *make_redundant(void)
 }
 
 typedef enum call {
-    INIT, INIT_INDEX2, INIT_REDUNDANT, SET_STATE, FORMULATION, TANGENT_MODE, OUTPUT, EVENTS
+    INIT, INIT_INDEX2, INIT_REDUNDANT, SET_STATE, FORMULATION, TANGENT_MODE, OUTPUT, EVENTS,
+    SET_FIRST_ORDER, INIT_Y
 } call;
 static const char *const kNames[] = {"ga_init", "ga_init (index 2)",
                                      "ga_init (a redundant constraint)", "ga_set_state",
                                      "ga_set_formulation", "ga_set_tangent_mode",
-                                     "ga_set_output", "ga_set_events"};
+                                     "ga_set_output", "ga_set_events", "ga_set_first_order",
+                                     "ga_init_y"};
 
 /* event functions that never fire */
 static int far_away(double t, const double *q, const double *v, const double *lambda,
@@ -145,6 +170,8 @@ static ga_status do_call(ga_solver *s, call c, const double *checkpoint, size_t 
     case FORMULATION: return ga_set_formulation(s, GA_INDEX2_STABILIZED);
     case TANGENT_MODE: return ga_set_tangent_mode(s, GA_TANGENT_FD);
     case EVENTS: return ga_set_events(s, 2, far_away, NULL, NULL, 1);
+    case SET_FIRST_ORDER: return ga_set_first_order(s, 1, chain_force_y, chain_rate);
+    case INIT_Y: return ga_init_y(s, 0.0, q, v, kY0);
     default: return ga_set_output(s, GA_OUTPUT_CONSISTENT);
     }
 }
@@ -164,7 +191,11 @@ static ga_solver *prepare(call c)
         assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
     if (c == EVENTS)
         assert_int_equal(ga_set_events(s, 1, far_away, NULL, NULL, 0), GA_OK);
-    if (c != INIT && c != INIT_INDEX2 && c != INIT_REDUNDANT && c != SET_STATE)
+    if (c == INIT_Y)
+        assert_int_equal(ga_set_first_order(s, 1, chain_force_y, chain_rate), GA_OK);
+    g_start_before_steps = c == SET_FIRST_ORDER;
+    if (c != INIT && c != INIT_INDEX2 && c != INIT_REDUNDANT && c != SET_STATE &&
+        c != SET_FIRST_ORDER && c != INIT_Y)
         assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     return s;
 }
@@ -253,6 +284,8 @@ static void formulation_sweep(void **state) { (void)state; sweep(FORMULATION); }
 static void tangent_mode_sweep(void **state) { (void)state; sweep(TANGENT_MODE); }
 static void output_sweep(void **state) { (void)state; sweep(OUTPUT); }
 static void events_sweep(void **state) { (void)state; sweep(EVENTS); }
+static void first_order_sweep(void **state) { (void)state; sweep(SET_FIRST_ORDER); }
+static void init_y_sweep(void **state) { (void)state; sweep(INIT_Y); }
 
 int main(void)
 {
@@ -262,6 +295,7 @@ int main(void)
         cmocka_unit_test(set_state_sweep),
         cmocka_unit_test(formulation_sweep),  cmocka_unit_test(tangent_mode_sweep),
         cmocka_unit_test(output_sweep),       cmocka_unit_test(events_sweep),
+        cmocka_unit_test(first_order_sweep),  cmocka_unit_test(init_y_sweep),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
