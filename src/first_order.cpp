@@ -92,7 +92,8 @@ void Solver::predict_first_order(double h)
 
 // The coupling blocks at the iterate x (f_, rate_ from the residual there), H = c1 I - g_y
 // and its LU, H^-1 g_q, H^-1 g_v, and K_t, C_t with the coupling folded in (Keff_, Ceff_)
-// when the forces depend on y. Leaves out g_q, g_v (and so the fold) unless coupling_exact.
+// when the forces depend on y. Without coupling_exact the fold is left out, and the update of
+// y leaves out g_q, g_v.
 ga_status Solver::first_order_matrix(double t, const State &x, double h, bool tangents_K,
                                      bool tangents_C)
 {
@@ -112,10 +113,11 @@ ga_status Solver::first_order_matrix(double t, const State &x, double h, bool ta
                          c1, spread, accepted_.t, h);
     c1_matrix_ = c1;
     coupling_in_matrix_ = coupling_exact && model.cb.force_y != nullptr;
-    if (!coupling_exact)
-        return GA_OK;
+    // (without coupling_exact, H^-1 g_q and H^-1 g_v still give the convergence test its scale)
     Hg_q_ = H_lu_.solve(blocks_.g_q);
     Hg_v_ = H_lu_.solve(blocks_.g_v);
+    Hg_q_norm_ = Hg_q_.cwiseAbs().rowwise().sum().maxCoeff();
+    Hg_v_norm_ = Hg_v_.cwiseAbs().rowwise().sum().maxCoeff();
     if (!coupling_in_matrix_)
         return GA_OK;
     // Keff = K - f_y H^-1 g_q, Ceff = C - f_y H^-1 g_v: rank-r updates, column by column.
@@ -158,11 +160,16 @@ void Solver::update_first_order(const NewtonCoefficients &c, double h, const Vec
     const double c1 = first_order_newton_coefficient(params1, h);
     x.y += dy_;
     x.ydot += c1 * dy_;
+    // The scale y is measured against: |y|, and the y that a change of q by its own size
+    // makes through the coupling, |H^-1 g_q| |q| + gamma' |H^-1 g_v| |q|: a state that starts
+    // from 0 (a current at rest) converges to the accuracy of q instead of to a relative
+    // accuracy its round-off, carried over from q, never reaches.
+    const double through_q = (Hg_q_norm_ + c.gamma_prime * Hg_v_norm_) * size.q;
     size.dy = dy_.cwiseAbs().maxCoeff();
-    size.y = x.y.cwiseAbs().maxCoeff();
-    size.ydot = x.ydot.cwiseAbs().maxCoeff();
+    size.y = x.y.cwiseAbs().maxCoeff() + through_q;
+    size.ydot = x.ydot.cwiseAbs().maxCoeff() + c1 * through_q;
     size.c1 = c1;
-    const bool finite = all_finite(dy_) && std::isfinite(size.y) && std::isfinite(size.ydot);
+    const bool finite = all_finite(dy_) && all_finite(x.y) && all_finite(x.ydot);
     size.increments_finite = size.increments_finite && all_finite(dy_);
     size.iterate_finite = size.iterate_finite && finite;
 }

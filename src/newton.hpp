@@ -20,7 +20,8 @@
 //     factorized in this step near the current q (one Newton update with the current matrix
 //     at fixed q solves the equations, linear in lambda and qdd once q stays).
 // First-order states (docs/algorithms.md sec. 11) are two more quantities of the same kind:
-// e_y = |dy| / (tol |y|) and e_y' = |c1 dy| / (tol |y'|), floor 64 ulps of |y| (times c1); with
+// e_y = |dy| / (tol |y|) and e_y' = |c1 dy| / (tol |y'|), floor 64 ulps of |y| (times c1), where
+// |y| and |y'| include what q's own size makes of them through the coupling (first_order.cpp); with
 // none (r = 0) both are 0 and at their floor, and the test is the one before them.
 // Floors: positions 64 ulps of |q|; accelerations beta' times the floor of dw (that of q in
 // index 3, where qdd is known only to eps |q| / (beta h^2), paper sec. 3.3; 64 ulps of |v|
@@ -44,7 +45,8 @@ namespace ga {
 struct UpdateSizes {
     double dq = 0.0, dw = 0.0, dlambda = 0.0;           // increments
     double q = 0.0, v = 0.0, qdd = 0.0, lambda = 0.0;   // the updated iterate
-    double dy = 0.0, y = 0.0, ydot = 0.0, c1 = 0.0;     // first-order states: |dy|, |y|, |y'|
+    double dy = 0.0, y = 0.0, ydot = 0.0, c1 = 0.0;     // first-order states: |dy|, scales of
+                                                        // y and y' (first_order.cpp), c1
     bool dw_is_dq = true;  // index 3: the accelerations move with the positions
     bool increments_finite = true, iterate_finite = true;
 };

@@ -323,6 +323,7 @@ private:
     Vec out_y_;  // y at an interpolated time, for consistent output
     const Vec *w_start_ = nullptr;
     double c1_matrix_ = 0.0;  // c1 of the kept matrix
+    double Hg_q_norm_ = 0.0, Hg_v_norm_ = 0.0;  // their infinity norms (convergence test)
 };
 
 }  // namespace ga

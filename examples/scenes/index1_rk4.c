@@ -48,12 +48,18 @@ static int gauss(int N, double *A, double *x)
     return 0;
 }
 
-/* qdd and lambda at (t, q, v). */
+/* qdd and lambda at (t, q, v, y); ydot = rate(t, q, v, y) with first-order states. */
 static int accelerations(const rk4_model *md, work *w, double t, const double *q,
-                         const double *v, double *qdd, double *lambda)
+                         const double *v, const double *y, double *qdd, double *lambda,
+                         double *ydot)
 {
     const int n = md->n, m = md->m, N = w->N;
-    if (md->mass(t, q, w->M, md->user) || md->force(t, q, v, w->f, md->user))
+    const int forced = md->r > 0 && md->force_y ? md->force_y(t, q, v, y, w->f, md->user)
+                       : md->force             ? md->force(t, q, v, w->f, md->user)
+                                               : (memset(w->f, 0, sizeof(double) * n), 0);
+    if (md->mass(t, q, w->M, md->user) || forced)
+        return -1;
+    if (md->r > 0 && md->rate(t, q, v, y, ydot, md->user))
         return -1;
     if (m > 0 && (md->jacobian(t, q, w->J, md->user) || md->accel(t, q, v, w->c, md->user)))
         return -1;
@@ -82,9 +88,19 @@ static int accelerations(const rk4_model *md, work *w, double t, const double *q
 int index1_rk4(const rk4_model *md, double t0, double t_end, long steps, double *q, double *v,
                double *qdd_out, double *lambda_out)
 {
-    const int n = md->n, m = md->m, N = n + m;
+    if (md->r > 0)
+        return -1;
+    return index1_rk4_y(md, t0, t_end, steps, q, v, NULL, qdd_out, lambda_out, NULL);
+}
+
+int index1_rk4_y(const rk4_model *md, double t0, double t_end, long steps, double *q, double *v,
+                 double *y, double *qdd_out, double *lambda_out, double *ydot_out)
+{
+    const int n = md->n, m = md->m, N = n + m, r = md->r;
+    if (r > 0 && (!y || !md->rate))
+        return -1;
     work w = {n, m, N, NULL, NULL, NULL, NULL, NULL, NULL};
-    double *buf = calloc((size_t)(n * n + m * n + N * N + N + m + n + 12 * n + m + 1),
+    double *buf = calloc((size_t)(n * n + m * n + N * N + N + m + n + 12 * n + m + 1 + 6 * r),
                          sizeof(double));
     if (!buf)
         return -1;
@@ -94,10 +110,12 @@ int index1_rk4(const rk4_model *md, double t0, double t_end, long steps, double 
     w.rhs = w.A + N * N;
     w.c = w.rhs + N;
     w.f = w.c + m;
-    double *kq[4], *kv[4], *qs = w.f + n + 8 * n, *vs = qs + n, *lam = vs + n;
+    double *kq[4], *kv[4], *ky[4], *qs = w.f + n + 8 * n, *vs = qs + n, *lam = vs + n;
+    double *ys = lam + m + 1;
     for (int s = 0; s < 4; ++s) {
         kq[s] = w.f + n + 2 * s * n;
         kv[s] = kq[s] + n;
+        ky[s] = ys + r + s * r;
     }
     const double h = (t_end - t0) / (double)steps;
     static const double c[4] = {0.0, 0.5, 0.5, 1.0}, b[4] = {1.0, 2.0, 2.0, 1.0};
@@ -109,17 +127,22 @@ int index1_rk4(const rk4_model *md, double t0, double t_end, long steps, double 
                 qs[j] = q[j] + (s ? c[s] * h * kq[s - 1][j] : 0.0);
                 vs[j] = v[j] + (s ? c[s] * h * kv[s - 1][j] : 0.0);
             }
+            for (int j = 0; j < r; ++j)
+                ys[j] = y[j] + (s ? c[s] * h * ky[s - 1][j] : 0.0);
             memcpy(kq[s], vs, sizeof(double) * n);
-            status = accelerations(md, &w, t + c[s] * h, qs, vs, kv[s], NULL);
+            status = accelerations(md, &w, t + c[s] * h, qs, vs, ys, kv[s], NULL, ky[s]);
         }
         for (int j = 0; j < n && !status; ++j) {
             q[j] += h / 6.0 * (b[0] * kq[0][j] + b[1] * kq[1][j] + b[2] * kq[2][j] + b[3] * kq[3][j]);
             v[j] += h / 6.0 * (b[0] * kv[0][j] + b[1] * kv[1][j] + b[2] * kv[2][j] + b[3] * kv[3][j]);
         }
+        for (int j = 0; j < r && !status; ++j)
+            y[j] += h / 6.0 * (b[0] * ky[0][j] + b[1] * ky[1][j] + b[2] * ky[2][j] + b[3] * ky[3][j]);
     }
-    if (!status && (qdd_out || lambda_out)) {
+    if (!status && (qdd_out || lambda_out || ydot_out)) {
         double *qdd = qdd_out ? qdd_out : kv[0];
-        status = accelerations(md, &w, t_end, q, v, qdd, lambda_out ? lambda_out : lam);
+        status = accelerations(md, &w, t_end, q, v, y, qdd, lambda_out ? lambda_out : lam,
+                               ydot_out ? ydot_out : ky[0]);
     }
     free(buf);
     return status;

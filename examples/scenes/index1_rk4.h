@@ -18,6 +18,11 @@ typedef struct rk4_model {
     ga_jacobian_fn jacobian;
     ga_constraint_accel_fn accel; /* required: the exact constraint acceleration term */
     void *user;
+    /* optional first-order states y' = rate(t, q, v, y) (r of them); force_y then replaces
+     * force */
+    int r;
+    ga_force_y_fn force_y;
+    ga_rate_fn rate;
 } rk4_model;
 
 /* Integrates from (t0, q, v) over `steps` steps to t_end; q and v are updated in place;
@@ -25,6 +30,10 @@ typedef struct rk4_model {
  * if the saddle-point matrix was singular or a callback failed. */
 int index1_rk4(const rk4_model *model, double t0, double t_end, long steps, double *q, double *v,
                double *qdd, double *lambda);
+/* The same with first-order states: y (r) integrated with q and v, updated in place; ydot (r)
+ * receives y' at t_end (may be NULL). */
+int index1_rk4_y(const rk4_model *model, double t0, double t_end, long steps, double *q,
+                 double *v, double *y, double *qdd, double *lambda, double *ydot);
 
 #ifdef __cplusplus
 }
