@@ -49,17 +49,17 @@ static int gauss(int N, double *A, double *x)
 }
 
 /* qdd and lambda at (t, q, v, y); ydot = rate(t, q, v, y) with first-order states. */
-static int accelerations(const rk4_model *md, work *w, double t, const double *q,
-                         const double *v, const double *y, double *qdd, double *lambda,
-                         double *ydot)
+static int accelerations(const rk4_model *md, const rk4_first_order *fo, work *w, double t,
+                         const double *q, const double *v, const double *y, double *qdd,
+                         double *lambda, double *ydot)
 {
     const int n = md->n, m = md->m, N = w->N;
-    const int forced = md->r > 0 && md->force_y ? md->force_y(t, q, v, y, w->f, md->user)
+    const int forced = fo && fo->force_y ? fo->force_y(t, q, v, y, w->f, md->user)
                        : md->force             ? md->force(t, q, v, w->f, md->user)
                                                : (memset(w->f, 0, sizeof(double) * n), 0);
     if (md->mass(t, q, w->M, md->user) || forced)
         return -1;
-    if (md->r > 0 && md->rate(t, q, v, y, ydot, md->user))
+    if (fo && fo->rate(t, q, v, y, ydot, md->user))
         return -1;
     if (m > 0 && (md->jacobian(t, q, w->J, md->user) || md->accel(t, q, v, w->c, md->user)))
         return -1;
@@ -88,16 +88,15 @@ static int accelerations(const rk4_model *md, work *w, double t, const double *q
 int index1_rk4(const rk4_model *md, double t0, double t_end, long steps, double *q, double *v,
                double *qdd_out, double *lambda_out)
 {
-    if (md->r > 0)
-        return -1;
-    return index1_rk4_y(md, t0, t_end, steps, q, v, NULL, qdd_out, lambda_out, NULL);
+    return index1_rk4_y(md, NULL, t0, t_end, steps, q, v, NULL, qdd_out, lambda_out, NULL);
 }
 
-int index1_rk4_y(const rk4_model *md, double t0, double t_end, long steps, double *q, double *v,
-                 double *y, double *qdd_out, double *lambda_out, double *ydot_out)
+int index1_rk4_y(const rk4_model *md, const rk4_first_order *fo, double t0, double t_end,
+                 long steps, double *q, double *v, double *y, double *qdd_out, double *lambda_out,
+                 double *ydot_out)
 {
-    const int n = md->n, m = md->m, N = n + m, r = md->r;
-    if (r > 0 && (!y || !md->rate))
+    const int n = md->n, m = md->m, N = n + m, r = fo ? fo->r : 0;
+    if (fo && (r < 0 || !y || !fo->rate))
         return -1;
     work w = {n, m, N, NULL, NULL, NULL, NULL, NULL, NULL};
     double *buf = calloc((size_t)(n * n + m * n + N * N + N + m + n + 12 * n + m + 1 + 6 * r),
@@ -130,7 +129,7 @@ int index1_rk4_y(const rk4_model *md, double t0, double t_end, long steps, doubl
             for (int j = 0; j < r; ++j)
                 ys[j] = y[j] + (s ? c[s] * h * ky[s - 1][j] : 0.0);
             memcpy(kq[s], vs, sizeof(double) * n);
-            status = accelerations(md, &w, t + c[s] * h, qs, vs, ys, kv[s], NULL, ky[s]);
+            status = accelerations(md, fo, &w, t + c[s] * h, qs, vs, ys, kv[s], NULL, ky[s]);
         }
         for (int j = 0; j < n && !status; ++j) {
             q[j] += h / 6.0 * (b[0] * kq[0][j] + b[1] * kq[1][j] + b[2] * kq[2][j] + b[3] * kq[3][j]);
@@ -141,7 +140,7 @@ int index1_rk4_y(const rk4_model *md, double t0, double t_end, long steps, doubl
     }
     if (!status && (qdd_out || lambda_out || ydot_out)) {
         double *qdd = qdd_out ? qdd_out : kv[0];
-        status = accelerations(md, &w, t_end, q, v, y, qdd, lambda_out ? lambda_out : lam,
+        status = accelerations(md, fo, &w, t_end, q, v, y, qdd, lambda_out ? lambda_out : lam,
                                ydot_out ? ydot_out : ky[0]);
     }
     free(buf);

@@ -18,12 +18,15 @@ typedef struct rk4_model {
     ga_jacobian_fn jacobian;
     ga_constraint_accel_fn accel; /* required: the exact constraint acceleration term */
     void *user;
-    /* optional first-order states y' = rate(t, q, v, y) (r of them); force_y then replaces
-     * force */
+} rk4_model;
+
+/* First-order states y' = rate(t, q, v, y) (r of them), with force_y replacing the model's
+ * force; the user pointer is the model's. */
+typedef struct rk4_first_order {
     int r;
     ga_force_y_fn force_y;
     ga_rate_fn rate;
-} rk4_model;
+} rk4_first_order;
 
 /* Integrates from (t0, q, v) over `steps` steps to t_end; q and v are updated in place;
  * qdd (n) and lambda (m) receive the values at t_end (either may be NULL). Returns 0, or -1
@@ -32,8 +35,9 @@ int index1_rk4(const rk4_model *model, double t0, double t_end, long steps, doub
                double *qdd, double *lambda);
 /* The same with first-order states: y (r) integrated with q and v, updated in place; ydot (r)
  * receives y' at t_end (may be NULL). */
-int index1_rk4_y(const rk4_model *model, double t0, double t_end, long steps, double *q,
-                 double *v, double *y, double *qdd, double *lambda, double *ydot);
+int index1_rk4_y(const rk4_model *model, const rk4_first_order *states, double t0, double t_end,
+                 long steps, double *q, double *v, double *y, double *qdd, double *lambda,
+                 double *ydot);
 
 #ifdef __cplusplus
 }
