@@ -1,5 +1,6 @@
-"""The same scene in C, Fortran and Python gives the same numbers (to round-off); the impact
-scene (events and restarts) in C and Python.
+"""The same scene in C, Fortran and Python gives the same numbers (to round-off), the
+motor-driven slider-crank (first-order states) included; the impact scene (events and
+restarts) in C and Python.
 
 Usage: cross_language.py BIN_DIR PY_EXAMPLES_DIR  (ctest passes both)."""
 import os
@@ -17,6 +18,9 @@ SCENES = {
     "slider_crank": [("C", [os.path.join(bin_dir, "slider_crank_demo")]),
                      ("Fortran", [os.path.join(bin_dir, "slider_crank_fortran")]),
                      ("Python", [sys.executable, os.path.join(py_dir, "slider_crank.py")])],
+    "motor_crank": [("C", [os.path.join(bin_dir, "motor_crank_demo")]),
+                    ("Fortran", [os.path.join(bin_dir, "motor_crank_fortran")]),
+                    ("Python", [sys.executable, os.path.join(py_dir, "motor_crank.py")])],
     "impact": [("C", [os.path.join(bin_dir, "impact_demo")]),
                ("Python", [sys.executable, os.path.join(py_dir, "impact.py")])],
     "chain_200": [("C", [os.path.join(bin_dir, "chain_demo"), "200", "--print"]),
@@ -30,10 +34,11 @@ def final_state(cmd):
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
     values = {}
     for line in out.splitlines():
-        for key in ("final q =", "final lambda ="):
+        for key in ("final q =", "final lambda =", "final y ="):
             if line.startswith(key):
                 values[key] = np.array([float(x) for x in line[len(key):].split()])
-    return np.concatenate([values["final q ="], values["final lambda ="]])
+    return np.concatenate([values["final q ="], values["final lambda ="],
+                           values.get("final y =", np.zeros(0))])
 
 
 ok = True

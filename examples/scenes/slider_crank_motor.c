@@ -9,7 +9,7 @@ sc_motor sc_motor_default(void)
     p.crank = slider_crank_paper();
     p.crank.torque = 0.0; /* the motor drives it */
     p.Kt = 0.3, p.Ke = 0.3, p.R = 0.5, p.L = 2e-3;
-    p.Kp = 2.0, p.Ki = 10.0;
+    p.Kp = 20.0, p.Ki = 50.0;
     p.w_final = 4.0 * M_PI, p.tau = 0.1;
     return p;
 }

@@ -6,8 +6,8 @@
  * The speed reference rises smoothly, w_ref(t) = w_final (1 - exp(-t / tau)), so the solution
  * is smooth and convergence orders can be measured on it. Data chosen here (no published
  * source): a small motor with gearing folded into Kt = Ke = 0.3 N m / A, R = 0.5 Ohm,
- * L = 2 mH (electrical time constant 4 ms, stiff against the mechanism's motion), Kp = 2 V s,
- * Ki = 10 V, w_final = 4 pi rad/s (2 revolutions per second), tau = 0.1 s. */
+ * L = 2 mH (electrical time constant 4 ms, stiff against the mechanism's motion), Kp = 20 V s,
+ * Ki = 50 V, w_final = 4 pi rad/s (2 revolutions per second), tau = 0.1 s. */
 #ifndef GALPHA_SCENE_SLIDER_CRANK_MOTOR_H
 #define GALPHA_SCENE_SLIDER_CRANK_MOTOR_H
 
