@@ -271,6 +271,56 @@ static void dense_output_of_y(void **state)
     ga_free(s);
 }
 
+/* Adaptive steps: the global error of q, v, y and y' at T = 1 follows the tolerance (log-log
+ * slope in [0.85, 1.15] over rtol = atol = 1e-3 ... 1e-7, error / tol within a band of 30),
+ * y in the error estimate (first_order.cpp), both formulations. */
+static void adaptive_error_follows_the_tolerance(void **state)
+{
+    (void)state;
+    const double tols[5] = {1e-3, 1e-4, 1e-5, 1e-6, 1e-7};
+    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+        double e[4][5];
+        for (int k = 0; k < 5; ++k) {
+            ga_solver *s = NULL;
+            assert_int_equal(ga_create(EM_N, EM_M, &s), GA_OK);
+            assert_int_equal(ga_set_callbacks(s, em_mass, NULL, em_constraint, em_jacobian, NULL),
+                             GA_OK);
+            assert_int_equal(ga_set_first_order(s, EM_R, em_force, em_rate), GA_OK);
+            assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+            assert_int_equal(ga_set_tolerances(s, tols[k], tols[k]), GA_OK);
+            const double q0[EM_N] = {0, 0}, v0[EM_N] = {0, 0}, y0[EM_R] = {0, 0};
+            assert_int_equal(ga_init_y(s, 0.0, q0, v0, y0), GA_OK);
+            assert_int_equal(ga_advance(s, 1.0), GA_OK);
+            double q[EM_N], v[EM_N], y[EM_R], yd[EM_R];
+            assert_int_equal(ga_get_q(s, q), GA_OK);
+            assert_int_equal(ga_get_v(s, v), GA_OK);
+            assert_int_equal(ga_get_y(s, y, yd), GA_OK);
+            const em_exact x = em_reference(1.0);
+            /* relative to each quantity's size over the run (|x| < 1.1, |v| < 4, |i| < 30,
+             * |i'| < 600) */
+            e[0][k] = fabs(q[0] - x.x) / 1.1;
+            e[1][k] = fabs(v[0] - x.v) / 4.0;
+            e[2][k] = fmax(fabs(y[0] - x.i) / 30.0, fabs(y[1] - x.z));
+            e[3][k] = fmax(fabs(yd[0] - x.idot) / 600.0, fabs(yd[1] - x.zdot));
+            ga_free(s);
+        }
+        const char *names[4] = {"q", "v", "y", "y'"};
+        for (int j = 0; j < 4; ++j) {
+            const double slope = fit_order(tols, e[j], 5);
+            double lo = INFINITY, hi = 0.0;
+            for (int k = 0; k < 5; ++k) {
+                lo = fmin(lo, e[j][k] / tols[k]);
+                hi = fmax(hi, e[j][k] / tols[k]);
+            }
+            print_message("%s adaptive %-3s error/tol %.2f ... %.2f, slope %.3f\n",
+                          formulation == GA_INDEX3 ? "index 3" : "index 2", names[j], lo, hi,
+                          slope);
+            assert_true(slope > 0.85 && slope < 1.15);
+            assert_true(hi / lo <= 30.0);
+        }
+    }
+}
+
 /* ---- what the API refuses, and failures that leave the solver as it was ---- */
 static int g_fail_rate_after;
 static int failing_rate(double t, const double *q, const double *v, const double *y,
@@ -344,6 +394,7 @@ int main(void)
         cmocka_unit_test(exact_coupling_converges_in_one_update),
         cmocka_unit_test(checkpoint_continues_bit_for_bit),
         cmocka_unit_test(dense_output_of_y),
+        cmocka_unit_test(adaptive_error_follows_the_tolerance),
         cmocka_unit_test(refusals_and_failures),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
