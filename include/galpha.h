@@ -670,6 +670,15 @@ GA_API ga_status ga_get_y(const ga_solver *s, double *y, double *ydot);
 /** Dense output of y and y' inside the last step (as ga_interpolate): cubic Hermite from y and
  *  y' at both ends, and its derivative. Errors: as ga_interpolate. */
 GA_API ga_status ga_interpolate_y(const ga_solver *s, double t, double *y, double *ydot);
+
+/** Event functions that see the first-order states: g_k(t, q, v, y, lambda) (y of length r;
+ *  lambda as for ga_event_fn). */
+typedef int (*ga_event_y_fn)(double t, const double *q, const double *v, const double *y,
+                             const double *lambda, double *g, void *user);
+/** ga_set_events with functions of y as well (inside a step y comes from ga_interpolate_y);
+ *  replaces the functions of ga_set_events, and the reverse. Errors: as ga_set_events. */
+GA_API ga_status ga_set_events_y(ga_solver *s, int count, ga_event_y_fn fn, const int *direction,
+                                 const int *terminal, int with_multipliers);
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */

@@ -567,23 +567,43 @@ GA_API ga_status ga_advance(ga_solver *s, double t_out)
     });
 }
 
-GA_API ga_status ga_set_events(ga_solver *s, int count, ga_event_fn fn, const int *direction,
-                               const int *terminal, int with_multipliers)
+namespace {
+// ga_set_events and ga_set_events_y: one of fn, fn_y.
+ga_status set_events(ga_solver *s, const char *name, int count, ga_event_fn fn,
+                     ga_event_y_fn fn_y, const int *direction, const int *terminal,
+                     int with_multipliers)
 {
     return guarded(s, [&](ga::Solver &c) {
         if (count < 0)
-            return c.diag.fail(GA_ERR_ARG, "ga_set_events: count = %d is negative", count);
-        if (count > 0 && !fn)
-            return c.diag.fail(GA_ERR_ARG, "ga_set_events: %d functions but fn is NULL", count);
+            return c.diag.fail(GA_ERR_ARG, "%s: count = %d is negative", name, count);
+        if (count > 0 && !fn && !fn_y)
+            return c.diag.fail(GA_ERR_ARG, "%s: %d functions but fn is NULL", name, count);
+        if (count > 0 && fn_y && c.r() == 0)
+            return c.diag.fail(GA_ERR_STATE, "%s before ga_set_first_order: no first-order "
+                               "states to pass", name);
         for (int k = 0; direction && k < count; ++k)
             if (direction[k] < -1 || direction[k] > 1)
-                return c.diag.fail(GA_ERR_ARG,
-                                   "ga_set_events: direction[%d] = %d is not -1, 0 or 1", k,
-                                   direction[k]);
-        c.events().configure(count, fn, direction, terminal, with_multipliers != 0, c.n(),
-                             c.m());
+                return c.diag.fail(GA_ERR_ARG, "%s: direction[%d] = %d is not -1, 0 or 1", name,
+                                   k, direction[k]);
+        c.events().configure(count, fn, fn_y, direction, terminal, with_multipliers != 0, c.n(),
+                             c.m(), c.r());
         return GA_OK;
     });
+}
+}  // namespace
+
+GA_API ga_status ga_set_events(ga_solver *s, int count, ga_event_fn fn, const int *direction,
+                               const int *terminal, int with_multipliers)
+{
+    return set_events(s, "ga_set_events", count, fn, nullptr, direction, terminal,
+                      with_multipliers);
+}
+
+GA_API ga_status ga_set_events_y(ga_solver *s, int count, ga_event_y_fn fn, const int *direction,
+                                 const int *terminal, int with_multipliers)
+{
+    return set_events(s, "ga_set_events_y", count, nullptr, fn, direction, terminal,
+                      with_multipliers);
 }
 
 GA_API ga_status ga_get_event_count(const ga_solver *s, int *count)
@@ -647,6 +667,9 @@ GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga
         if (c.setup_done())
             return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after the solver was set up "
                                "(ga_init or ga_set_state): declare the states before");
+        if (c.events().fn_y())
+            return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after ga_set_events_y: the "
+                               "event functions take the states declared before them");
         c.set_first_order(r);  // may throw std::bad_alloc before anything below changed
         c.model.cb.force_y = r > 0 ? force : nullptr;
         c.model.cb.rate = r > 0 ? rate : nullptr;

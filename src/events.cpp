@@ -79,13 +79,14 @@ int EventLocator::locate(double t0, const double *g0, double t1, const double *g
     return 1;
 }
 
-void EventSet::configure(int count, ga_event_fn fn, const int *direction, const int *terminal,
-                         bool with_lambda, int n, int m)
+void EventSet::configure(int count, ga_event_fn fn, ga_event_y_fn fn_y, const int *direction,
+                         const int *terminal, bool with_lambda, int n, int m, int r)
 {
     // everything is allocated before anything changes: a failure leaves the old set
     std::vector<int> dir(count), term(count), fired(count);
     std::vector<double> lo(count), hi(count), slo(count), shi(count);
     std::vector<double> qs(count ? n : 0), vs(count ? n : 0), ls(count && with_lambda ? m : 0);
+    std::vector<double> ys(count && fn_y ? r : 0);
     // a whole root fits into an empty log, however many functions cross at it
     std::vector<Entry> log(count ? std::max(count, GA_EVENT_LOG) : 0);
     EventLocator locator_new;
@@ -94,7 +95,8 @@ void EventSet::configure(int count, ga_event_fn fn, const int *direction, const 
         dir[k] = direction ? direction[k] : GA_EVENT_BOTH;
         term[k] = terminal ? (terminal[k] != 0) : 1;
     }
-    fn_ = count ? fn : nullptr;
+    fn_ = count && !fn_y ? fn : nullptr;
+    fn_y_ = count ? fn_y : nullptr;
     with_lambda_ = count && with_lambda;
     direction_.swap(dir);
     terminal_.swap(term);
@@ -106,6 +108,7 @@ void EventSet::configure(int count, ga_event_fn fn, const int *direction, const 
     q.swap(qs);
     v.swap(vs);
     lambda.swap(ls);
+    y.swap(ys);
     log_.swap(log);
     locator = std::move(locator_new);
     log_count_ = 0;
@@ -145,7 +148,7 @@ ga_status Solver::event_values(double t, double *g)
 {
     EventSet &e = events_;
     double *lambda = e.with_lambda() ? e.lambda.data() : nullptr;
-    const double *q = accepted_.q.data(), *v = accepted_.v.data();
+    const double *q = accepted_.q.data(), *v = accepted_.v.data(), *y = accepted_.y.data();
     if (t == accepted_.t) {
         if (lambda)
             if (auto st = output_state(nullptr, lambda))
@@ -155,8 +158,13 @@ ga_status Solver::event_values(double t, double *g)
             return st;
         q = e.q.data();
         v = e.v.data();
+        if (e.fn_y()) {
+            if (auto st = interpolate_y(t, e.y.data(), nullptr))
+                return st;
+            y = e.y.data();
+        }
     }
-    return model.event_functions(e.fn(), t, q, v, lambda, g, e.count());
+    return model.event_functions(e.fn(), e.fn_y(), t, q, v, y, lambda, g, e.count());
 }
 
 // The rest (t_lo, t_hi] of the last step: what fires there is logged in time order. GA_EVENT
@@ -232,9 +240,9 @@ ga_status Solver::events_after_step()
     EventSet &e = events_;
     const ga_status st =
         e.with_lambda() ? event_values(accepted_.t, e.g_hi.data())
-                        : model.event_functions(e.fn(), accepted_.t, accepted_.q.data(),
-                                                accepted_.v.data(), nullptr, e.g_hi.data(),
-                                                e.count());
+                        : model.event_functions(e.fn(), e.fn_y(), accepted_.t, accepted_.q.data(),
+                                                accepted_.v.data(), accepted_.y.data(), nullptr,
+                                                e.g_hi.data(), e.count());
     if (st)
         return st;
     e.t_hi = accepted_.t;
@@ -294,8 +302,9 @@ ga_status Solver::step(double h)
     const StepUndo undo{previous_valid_, start_pending_, false};
     if (auto st = take_step(h))
         return st;
-    ga_status st = model.event_functions(e.fn(), accepted_.t, accepted_.q.data(),
-                                         accepted_.v.data(), nullptr, e.g_hi.data(), e.count());
+    ga_status st = model.event_functions(e.fn(), e.fn_y(), accepted_.t, accepted_.q.data(),
+                                         accepted_.v.data(), accepted_.y.data(), nullptr,
+                                         e.g_hi.data(), e.count());
     if (st == GA_OK) {
         e.t_hi = accepted_.t;
         if (!e.any_crossing(e.g_lo.data(), e.g_hi.data())) {

@@ -62,11 +62,13 @@ public:
     };
 
     // Allocates everything the search needs (count 0: no events); throws std::bad_alloc.
-    void configure(int count, ga_event_fn fn, const int *direction, const int *terminal,
-                   bool with_lambda, int n, int m);
+    // fn_y instead of fn: the functions see the first-order states (r of them) too.
+    void configure(int count, ga_event_fn fn, ga_event_y_fn fn_y, const int *direction,
+                   const int *terminal, bool with_lambda, int n, int m, int r);
     int count() const { return static_cast<int>(direction_.size()); }
     bool active() const { return count() > 0; }
     ga_event_fn fn() const { return fn_; }
+    ga_event_y_fn fn_y() const { return fn_y_; }
     bool with_lambda() const { return with_lambda_; }
     const int *direction() const { return direction_.data(); }
     bool terminal(int k) const { return terminal_[k] != 0; }
@@ -102,12 +104,13 @@ public:
     bool started = false;  // g_lo holds g at t_lo
     double t_lo = 0.0, t_hi = 0.0;
     std::vector<double> g_lo, g_hi;
-    std::vector<double> q, v, lambda;  // the interpolated state g is evaluated at
+    std::vector<double> q, v, lambda, y;  // the interpolated state g is evaluated at
     EventLocator locator;
     std::vector<int> fired;
 
 private:
     ga_event_fn fn_ = nullptr;
+    ga_event_y_fn fn_y_ = nullptr;
     bool with_lambda_ = false;
     std::vector<int> direction_, terminal_;
     std::vector<Entry> log_;

@@ -125,14 +125,19 @@ public:
     // Phi_t: the callback, or extrapolated central differences in t (exactly zero for
     // time-independent constraints).
     ga_status constraint_dt(double t, const Vec &q, Vec &out);
-    // The event functions of ga_set_events: `count` values into g (lambda may be null).
+    // The event functions of ga_set_events or ga_set_events_y: `count` values into g (lambda
+    // may be null).
     // Inline: called after every step, where a run with events that never fire should cost
     // no more than the call itself.
-    ga_status event_functions(ga_event_fn fn, double t, const double *q, const double *v,
-                              const double *lambda, double *g, int count)
+    // fn_y (ga_set_events_y), when set, takes the first-order states y as well.
+    ga_status event_functions(ga_event_fn fn, ga_event_y_fn fn_y, double t, const double *q,
+                              const double *v, const double *y, const double *lambda, double *g,
+                              int count)
     {
         count_event();
-        if (const int rc = user([&] { return fn(t, q, v, lambda, g, cb.user); }))
+        if (const int rc = user([&] {
+                return fn_y ? fn_y(t, q, v, y, lambda, g, cb.user) : fn(t, q, v, lambda, g, cb.user);
+            }))
             return callback_status(rc, "event", t);
         bool finite = true;
         for (int k = 0; k < count; ++k)

@@ -103,9 +103,17 @@ module galpha
        real(c_double), intent(out) :: g_q(*), g_v(*), g_y(*), f_y(*)
        type(c_ptr), value :: user
      end function ga_coupling_fn
+     ! events on the first-order states too (ga_set_events_y); lambda as for ga_event_fn
+     integer(c_int) function ga_event_y_fn(t, q, v, y, lambda, g, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*), v(*), y(*), lambda(*)
+       real(c_double), intent(out) :: g(*)
+       type(c_ptr), value :: user
+     end function ga_event_y_fn
   end interface
   public :: ga_mass_fn, ga_force_fn, ga_constraint_fn, ga_stiffness_fn, ga_event_fn, &
-       ga_force_y_fn, ga_coupling_fn
+       ga_force_y_fn, ga_coupling_fn, ga_event_y_fn
 
   ! ---- the C API, one to one ----------------------------------------------------------------
   interface
@@ -440,6 +448,15 @@ module galpha
        type(c_ptr), value :: s
        real(c_double), intent(out), optional :: y(*), ydot(*)  ! absent: NULL
      end function ga_get_y
+     integer(c_int) function ga_set_events_y(s, count, fn, direction, terminal, &
+          with_multipliers) bind(C, name="ga_set_events_y")
+       import :: c_int, c_ptr, c_funptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: count
+       type(c_funptr), value :: fn
+       integer(c_int), intent(in), optional :: direction(*), terminal(*)  ! absent: NULL
+       integer(c_int), value :: with_multipliers
+     end function ga_set_events_y
      integer(c_int) function ga_interpolate_y(s, t, y, ydot) bind(C, name="ga_interpolate_y")
        import :: c_int, c_ptr, c_double
        type(c_ptr), value :: s
@@ -466,7 +483,7 @@ module galpha
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
        ga_interpolate, ga_interpolate_qdd, ga_set_output, ga_set_events, ga_get_event_count, &
        ga_get_event, ga_set_first_order, ga_set_coupling, ga_set_coupling_exact, ga_init_y, &
-       ga_get_y, ga_interpolate_y
+       ga_get_y, ga_interpolate_y, ga_set_events_y
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
@@ -565,6 +582,9 @@ module galpha
      !> the last one (either optional)
      procedure :: get_y => solver_get_y
      procedure :: interpolate_y => solver_interpolate_y
+     !> set_events_y(fn, direction, terminal, with_multipliers): set_events with functions
+     !> fn(t, q, v, y, lambda, g, user) of the first-order states as well
+     procedure :: set_events_y => solver_set_events_y
   end type galpha_solver
   public :: galpha_strerror, galpha_version, galpha_version_number
 
@@ -685,6 +705,28 @@ contains
             direction, with_multipliers=lam)
     end if
   end function solver_set_events
+
+  integer(c_int) function solver_set_events_y(this, fn, direction, terminal, with_multipliers) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    procedure(ga_event_y_fn) :: fn
+    integer(c_int), intent(in) :: direction(:)
+    logical, intent(in), optional :: terminal(:), with_multipliers
+    integer(c_int) :: flags(max(size(direction), 1)), lam
+    status = GA_ERR_ARG
+    lam = 0
+    if (present(with_multipliers)) then
+       if (with_multipliers) lam = 1
+    end if
+    flags = 1  ! all terminal unless said
+    if (present(terminal)) then
+       if (size(terminal) /= size(direction)) return
+       flags = 0
+       where (terminal) flags(1:size(terminal)) = 1
+    end if
+    status = ga_set_events_y(this%handle, size(direction, kind=c_int), c_funloc(fn), &
+         direction, flags, lam)
+  end function solver_set_events_y
 
   integer(c_int) function solver_event_count(this) result(count)
     class(galpha_solver), intent(in) :: this

@@ -321,6 +321,67 @@ static void adaptive_error_follows_the_tolerance(void **state)
     }
 }
 
+/* Events on the first-order states (ga_set_events_y): the current reaches 20 A (rising) at a
+ * time found by bisection on the exact solution; located on the dense output, the error
+ * shrinks at order 2 with h. */
+static int current_limit(double t, const double *q, const double *v, const double *y,
+                         const double *lambda, double *g, void *u)
+{
+    (void)t, (void)q, (void)v, (void)lambda, (void)u;
+    g[0] = y[0] - 20.0;
+    return 0;
+}
+
+static void events_on_the_states(void **state)
+{
+    (void)state;
+    double lo = 0.0, hi = 0.095; /* i(0) = 0 < 20, i(0.095) = 24.9 > 20 */
+    assert_true(em_reference(hi).i > 20.0);
+    for (int k = 0; k < 200; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        if (em_reference(mid).i < 20.0)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    const double t_exact = 0.5 * (lo + hi);
+    const int steps[3] = {200, 400, 800};
+    double h[3], e[3];
+    for (int k = 0; k < 3; ++k) {
+        ga_solver *s = em_solver(GA_INDEX3, GA_OUTPUT_CONSISTENT, 1, 0);
+        const int rising = GA_EVENT_RISING;
+        assert_int_equal(ga_set_events_y(s, 1, current_limit, &rising, NULL, 0), GA_OK);
+        ga_status st = GA_OK;
+        int taken = 0;
+        while (st == GA_OK && taken < steps[k]) {
+            st = ga_step(s, 1.0 / steps[k]);
+            ++taken;
+        }
+        assert_int_equal(st, GA_EVENT);
+        double te = 0.0, y[EM_R];
+        assert_int_equal(ga_get_event(s, 0, &te, NULL, NULL), GA_OK);
+        assert_int_equal(ga_interpolate_y(s, te, y, NULL), GA_OK);
+        assert_true(fabs(y[0] - 20.0) < 1e-9);
+        h[k] = 1.0 / steps[k];
+        e[k] = fabs(te - t_exact);
+        ga_free(s);
+    }
+    const double p = fit_order(h, e, 3);
+    print_message("current reaches 20 A at t = %.9f; errors %.2e %.2e %.2e, order %.2f\n",
+                  t_exact, e[0], e[1], e[2], p);
+    assert_true(p > 1.8 && p < 2.2);
+
+    /* functions of y need the states declared first, and then fix them */
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(EM_N, EM_M, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, em_mass, NULL, em_constraint, em_jacobian, NULL), GA_OK);
+    assert_int_equal(ga_set_events_y(s, 1, current_limit, NULL, NULL, 0), GA_ERR_STATE);
+    assert_int_equal(ga_set_first_order(s, EM_R, em_force, em_rate), GA_OK);
+    assert_int_equal(ga_set_events_y(s, 1, current_limit, NULL, NULL, 0), GA_OK);
+    assert_int_equal(ga_set_first_order(s, 1, em_force, em_rate), GA_ERR_STATE);
+    ga_free(s);
+}
+
 /* ---- what the API refuses, and failures that leave the solver as it was ---- */
 static int g_fail_rate_after;
 static int failing_rate(double t, const double *q, const double *v, const double *y,
@@ -395,6 +456,7 @@ int main(void)
         cmocka_unit_test(checkpoint_continues_bit_for_bit),
         cmocka_unit_test(dense_output_of_y),
         cmocka_unit_test(adaptive_error_follows_the_tolerance),
+        cmocka_unit_test(events_on_the_states),
         cmocka_unit_test(refusals_and_failures),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

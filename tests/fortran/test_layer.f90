@@ -52,6 +52,15 @@ contains
     f_y(1) = 1.0d0
     blocks = 0
   end function blocks
+  ! y falls through 1/2 at t = ln(2) / 2
+  integer(c_int) function half(t, q, v, y, lambda, g, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*), y(*), lambda(*)
+    real(c_double), intent(out) :: g(*)
+    type(c_ptr), value :: user
+    g(1) = y(1) - 0.5d0
+    half = 0
+  end function half
 end module layer_events
 
 program test_layer
@@ -216,6 +225,15 @@ program test_layer
   call expect(abs(q2(1) - exp(-1.999d0)) < 1d-6, 'interpolated y')
   call expect(r%counter(GA_COUNT_RATE_EVALS) > 0 .and. r%counter(GA_COUNT_COUPLING_EVALS) > 0, &
               'rate and coupling counters')
+  call ok(r%init_y(0.0d0, [0.0d0], [0.0d0], [1.0d0]), 'init_y again')
+  call ok(r%set_events_y(half, [GA_EVENT_FALLING]), 'set_events_y')
+  i = GA_OK
+  do while (i == GA_OK)
+     i = r%step(1d-3)
+  end do
+  call expect(i == GA_EVENT, 'an event on y stops ga_step')
+  call ok(r%get_event(1, te, index, direction), 'get_event (y)')
+  call expect(abs(te - 0.5d0 * log(2.0d0)) < 1d-6, 'y = 1/2 at t = ln(2) / 2')
 
   call s%free()
   call r%free()

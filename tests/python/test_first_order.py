@@ -141,3 +141,33 @@ def test_refusals():
         with pytest.raises(ZeroDivisionError):
             s2.init(0.0, np.zeros(2), np.zeros(2), np.zeros(2))
         s2.close()
+
+
+def test_integrate_with_states_and_an_event_on_them():
+    # the current reaches 20 A (rising): the time from the exact solution by bisection
+    lo, hi = 0.0, 0.095
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if exact(mid)[2][0] < 20.0 else (lo, mid)
+
+    def limit(t, q, v, lam, y):
+        return y[0] - 20.0
+    limit.terminal, limit.direction = True, 1
+    res = galpha.integrate(mass, None, constraint, jacobian, (0.0, 1.0), np.zeros(2),
+                           np.zeros(2), m=1, y0=np.zeros(2), r=2, rate=rate, force_y=force_y,
+                           events=limit, tolerances=(1e-8, 1e-8),
+                           formulation=galpha.GA_INDEX2_STABILIZED)
+    assert res.status == 1 and res.states.shape == (len(res.t), 2)
+    assert abs(res.t_events[0][0] - 0.5 * (lo + hi)) < 1e-6
+    assert res.states_events[0][0][0] == pytest.approx(20.0, abs=1e-9)
+    assert res.states[-1][0] == pytest.approx(20.0, abs=1e-9)
+    # the recorded states against the exact solution along the run
+    worst = max(np.abs(x - exact(t)[2]).max() for t, x in zip(res.t, res.states))
+    assert worst < 1e-5
+
+    # at fixed outputs
+    res = galpha.integrate(mass, None, constraint, jacobian, (0.0, 0.5), np.zeros(2),
+                           np.zeros(2), 1e-3, m=1, y0=np.zeros(2), r=2, rate=rate,
+                           force_y=force_y, t_eval=[0.0, 0.25, 0.5])
+    assert res.states.shape == (3, 2)
+    assert np.abs(res.states[1] - exact(0.25)[2]).max() < 1e-3 * np.abs(exact(0.25)[2]).max()

@@ -98,6 +98,8 @@ EVENT_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_
                             c_double_p, ctypes.c_void_p)
 FORCE_Y_FN = EVENT_FN  # (t, q, v, y, f, user)
 RATE_FN = EVENT_FN     # (t, q, v, y, ydot, user)
+EVENT_Y_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
+                              c_double_p, c_double_p, ctypes.c_void_p)
 COUPLING_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
                                c_double_p, c_double_p, c_double_p, c_double_p, ctypes.c_void_p)
 
@@ -204,6 +206,7 @@ _SIGNATURES = {
     "ga_init_y": (_I, [_S, _D, c_double_p, c_double_p, c_double_p]),
     "ga_get_y": (_I, [_S, c_double_p, c_double_p]),
     "ga_interpolate_y": (_I, [_S, _D, c_double_p, c_double_p]),
+    "ga_set_events_y": (_I, [_S, _I, EVENT_Y_FN, _P(_I), _P(_I), _I]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():

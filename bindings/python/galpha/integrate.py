@@ -8,8 +8,9 @@ from .solver import Solver
 class IntegrateResult(dict):
     """Attributes: t (N,), q, v, qdd (N, n), lam (N, m), stats (dict), success (bool),
     status (0 or the failing ga_status, 1 when a terminal event ended the run), message (str);
-    with events: t_events, y_events ([q, v] stacked), q_events, v_events, lam_events (lists,
-    one array per event function); with dense_output: sol (OdeSolution)."""
+    with first-order states (y0): states (N, r); with events: t_events, y_events ([q, v]
+    stacked), q_events, v_events, lam_events (and states_events) (lists, one array per event
+    function); with dense_output: sol (OdeSolution)."""
 
     def __getattr__(self, name):
         try:
@@ -66,7 +67,7 @@ class OdeSolution:
 
 
 def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=None, t_eval=None,
-              events=None, dense_output=False, **options):
+              events=None, dense_output=False, y0=None, **options):
     """Integrate from t_span[0] to t_span[1] and record every accepted step, or the states at
     the times t_eval (by dense output, without shortening steps).
 
@@ -85,7 +86,11 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
     v_events and lam_events, and a terminal event ends the run at its time (status 1), the last
     recorded point being the event's state.
 
-    dense_output: the result's `sol` is the whole run's interpolant (OdeSolution).
+    dense_output: the result's `sol` is the whole run's interpolant (OdeSolution) of q and v.
+
+    y0: the initial first-order states, with the options r, rate, force_y (and coupling) of
+    Solver; the result's `states` holds their history, and event functions are then
+    g(t, q, v, lam, y).
 
     `options` go to Solver (rho_inf, newton, stiffness, constraint_accel, ...). A failure of
     the method (no convergence, singular matrix, ...) ends the integration with success=False
@@ -130,10 +135,19 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
     v_ev = [[] for _ in events]
     l_ev = [[] for _ in events]
     ts, qs, vs, as_, ls = [], [], [], [], []
+    with_states = y0 is not None
+    xs, x_ev = [], [[] for _ in events]  # first-order states
     knots = ([], [], [], [])  # dense output: t, q, v, qdd at every accepted step
     status, message = 0, "reached t_span[1]"
     with Solver(n, m, mass, force, constraint, jacobian, **options) as s:
-        s.init(t0, q0, v0)
+        if with_states:
+            s.init(t0, q0, v0, y0)
+        else:
+            s.init(t0, q0, v0)
+
+        def states_at(te):
+            if with_states:
+                xs.append(s.y if te == s.t else s.interpolate_y(te)[0])
         if events:
             # all logged, none terminal in C: the run ends here, after the terminal one's
             # occurrence, and every event of a step lies in the step just taken
@@ -141,10 +155,11 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
                 def __init__(self, g):
                     self.g, self.direction = g, getattr(g, "direction", 0)
 
-                def __call__(self, t, q, v, lam):
-                    return self.g(t, q, v, lam)
+                def __call__(self, t, q, v, lam, *y):
+                    return self.g(t, q, v, lam, *y)
             s.set_events([_Logged(g) for g in events],
-                         multipliers=any(getattr(g, "multipliers", False) for g in events))
+                         multipliers=any(getattr(g, "multipliers", False) for g in events),
+                         states=with_states)
 
         def knot():
             knots[0].append(s.t)
@@ -160,6 +175,8 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
                 q_ev[k].append(qi)
                 v_ev[k].append(vi)
                 l_ev[k].append(li)
+                if with_states:
+                    x_ev[k].append(s.interpolate_y(te)[0])
                 if left[k] is not None:
                     left[k] -= 1
                     if left[k] == 0:
@@ -167,6 +184,7 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
             return None
 
         def record():
+            states_at(s.t)
             ts.append(s.t)
             qs.append(s.q)
             vs.append(s.v)
@@ -181,6 +199,7 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
                     ts[-1] = te
                 else:
                     qi, vi, li = s.interpolate(te)
+                    states_at(te)
                     ts.append(te)
                     qs.append(qi)
                     vs.append(vi)
@@ -213,6 +232,8 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
                 while pending and pending[0] < t_end:
                     te = pending.pop(0)
                     qi, vi, li = s.interpolate(te) if te > t_prev else (qs[-1], vs[-1], ls[-1])
+                    if with_states:
+                        xs.append(s.interpolate_y(te)[0] if te > t_prev else xs[-1])
                     ts.append(te)
                     qs.append(qi)
                     vs.append(vi)
@@ -220,6 +241,7 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
                     ls.append(li)
                 qi, vi, li = s.interpolate(t_end)
                 ai = s.interpolate_qdd(t_end)
+                states_at(t_end)
                 ts.append(t_end)
                 qs.append(qi)
                 vs.append(vi)
@@ -240,8 +262,13 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
     result = IntegrateResult(t=np.array(ts), q=np.array(qs), v=np.array(vs),
                              qdd=np.array(as_), lam=np.array(ls).reshape(len(ts), m),
                              stats=stats, success=status >= 0, status=status, message=message)
+    if with_states:
+        result["states"] = np.array(xs).reshape(len(ts), len(np.atleast_1d(y0)))
     if events:
         result["t_events"] = [np.array(x) for x in t_ev]
+        if with_states:
+            result["states_events"] = [np.array(x).reshape(len(x), len(np.atleast_1d(y0)))
+                                       for x in x_ev]
         result["q_events"] = [np.array(x).reshape(len(x), n) for x in q_ev]
         result["v_events"] = [np.array(x).reshape(len(x), n) for x in v_ev]
         result["lam_events"] = [np.array(x).reshape(len(x), m) for x in l_ev]

@@ -32,6 +32,7 @@ _CONSTRAINT = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp)
 _STIFFNESS = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp)
 _EVENT = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp)
 _COUPLING = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp)
+_EVENT_Y = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp)
 
 
 def _cast(fn, ctype):
@@ -529,23 +530,24 @@ class Solver:
         return self._check(_ffi.ga_advance(self._handle(), float(t_out)))
 
     @_serialized
-    def set_events(self, functions, multipliers=False):
+    def set_events(self, functions, multipliers=False, states=False):
         """Watch event functions g(t, q, v, lam) -> float (see ga_set_events), each with the
         optional attributes of scipy's solve_ivp: `direction` (> 0 rising, < 0 falling, 0
         either; default 0) and `terminal` (true: step, step_adaptive and advance stop there
         and return True; default False). lam is None unless `multipliers` (then the
-        multipliers at the located state, consistent with q and v). An empty list removes
-        them. The events found by the last stepping call: `events`."""
+        multipliers at the located state, consistent with q and v). With `states`, the
+        functions are g(t, q, v, lam, y) with the first-order states y (ga_set_events_y). An
+        empty list removes them. The events found by the last stepping call: `events`."""
         functions = tuple(functions)
         for g in functions:
             if not callable(g):
                 raise TypeError("event functions must be callable, got %r" % (g,))
-        count, n, m = len(functions), self.n, self.m
+        count, n, m, r = len(functions), self.n, self.m, self.r
         call = self._call
 
-        def evaluate(t, q, v, lam, g):
+        def evaluate(t, q, v, lam, g, y=None):
             for k, fn in enumerate(functions):
-                g[k] = fn(t, q, v, lam)
+                g[k] = fn(t, q, v, lam, y) if states else fn(t, q, v, lam)
 
         def trampoline(t, q, v, lam, g, u):
             if lam:
@@ -553,13 +555,25 @@ class Solver:
             return call(lambda t, q, v, g: evaluate(t, q, v, None, g), g, (count,), t,
                         (q, n), (v, n))
 
-        cb = _EVENT(trampoline) if count else None
+        def trampoline_y(t, q, v, y, lam, g, u):
+            if lam:
+                return call(lambda t, q, v, y, lam, g: evaluate(t, q, v, lam, g, y), g,
+                            (count,), t, (q, n), (v, n), (y, r), (lam, m))
+            return call(lambda t, q, v, y, g: evaluate(t, q, v, None, g, y), g, (count,), t,
+                        (q, n), (v, n), (y, r))
+
         direction = (_i * max(count, 1))(*[int(np.sign(getattr(g, "direction", 0)))
                                             for g in functions])
         terminal = (_i * max(count, 1))(*[int(bool(getattr(g, "terminal", False)))
                                            for g in functions])
-        self._check(_ffi.ga_set_events(self._handle(), count, _cast(cb, _ffi.EVENT_FN),
-                                       direction, terminal, int(bool(multipliers))))
+        if states:
+            cb = _EVENT_Y(trampoline_y) if count else None
+            self._check(_ffi.ga_set_events_y(self._handle(), count, _cast(cb, _ffi.EVENT_Y_FN),
+                                             direction, terminal, int(bool(multipliers))))
+        else:
+            cb = _EVENT(trampoline) if count else None
+            self._check(_ffi.ga_set_events(self._handle(), count, _cast(cb, _ffi.EVENT_FN),
+                                           direction, terminal, int(bool(multipliers))))
         self._event_cb, self._event_fns = cb, functions
 
     @property
