@@ -131,8 +131,9 @@ ga_status Solver::adaptive_step(double t_stop)
     }
     if (control.h_max > 0.0)
         h = std::min(h, control.h_max);
-    const double h_min = control.h_min > 0.0 ? control.h_min
-                                             : 16.0 * kEps * std::max(std::fabs(t), 1.0);
+    // The user's minimum, but never below what moves t: at t = -1e300 with h_max = 1 a step
+    // of 1 was accepted with t unchanged (and its checkpoint refused).
+    const double h_min = std::max(control.h_min, 16.0 * kEps * std::max(std::fabs(t), 1.0));
     const double tol = newton_tolerance(true);
     bool rejected = false;
     for (;;) {

@@ -572,6 +572,7 @@ ga_status Solver::sliver_step(double h)
     x.h_last = s.h_last;
     x.sliver_span = s.sliver_span + h;
     a_start_ = &x.a;  // for the error estimate of adaptive steps: none from this step
+    w_start_ = &x.w;  // (likewise for the first-order states)
     last_newton_iters_ = 0;
     return GA_OK;
 }

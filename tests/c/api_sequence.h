@@ -19,11 +19,11 @@
  * masses at the links' ends), m = L constraints |p_k - p_(k-1)|^2 = 1 (p_(-1) = 0), or L + 1
  * with the first stated twice (redundant), or none (free particles). */
 enum { MAX_LINKS = 3, NMAX = 2 * MAX_LINKS, MMAX = MAX_LINKS + 1, MAX_OPS = 64,
-       STATE_MAX = 1 + 4 * NMAX + MMAX, CKPT_MAX = 1024 };
+       STATE_MAX = 1 + 4 * NMAX + MMAX + 2, CKPT_MAX = 1024 };
 
 typedef enum fault_kind { NONE, RETURN_RETRY, RETURN_FATAL, WRITE_NAN, WRITE_INF, WRITE_HUGE,
                           REENTER, FAULT_KINDS } fault_kind;
-enum { MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS, ACCEL, DT, CALLBACKS };
+enum { MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS, ACCEL, DT, RATE, CALLBACKS };
 
 typedef struct model {
     uint64_t rng;
@@ -31,6 +31,7 @@ typedef struct model {
     size_t size, pos;
     int exhausted;         /* the bytes ran out: the sequence ends after this call */
     int links, n, m;       /* m = links, links + 1 (redundant) or 0 */
+    int r;                 /* first-order states: 0, or 1 (y' = v_0 - y, a force y on q_0) */
     fault_kind fault;      /* armed failure */
     int fault_callback;    /* which callback fails */
     long calls, fault_at;  /* it fails from its fault_at-th call on */
@@ -142,6 +143,21 @@ static int force(double t, const double *q, const double *v, double *f, void *us
     for (int i = 0; i < md->n; ++i)
         f[i] = i % 2 ? -9.81 : 0.0;
     return misbehave(md, FORCE, f, md->n);
+}
+static int force_y(double t, const double *q, const double *v, const double *y, double *f,
+                   void *user)
+{
+    const int rc = force(t, q, v, f, user);
+    f[0] += y[0];
+    return rc;
+}
+static int rate(double t, const double *q, const double *v, const double *y, double *ydot,
+                void *user)
+{
+    model *md = user;
+    (void)t, (void)q;
+    ydot[0] = v[0] - y[0];
+    return misbehave(md, RATE, ydot, 1);
 }
 static int constraint(double t, const double *q, double *phi, void *user)
 {
@@ -329,7 +345,7 @@ static double step_size(model *md)
     return values[pick(md, 13)];
 }
 
-/* t, q, v, qdd, a, lambda; 0 before ga_init */
+/* t, q, v, qdd, a, lambda (and y, y'); 0 before ga_init */
 static int snapshot(const model *md, ga_solver *s, double *x)
 {
     const int n = md->n;
@@ -340,7 +356,9 @@ static int snapshot(const model *md, ga_solver *s, double *x)
     SEQ_REQUIRE(ga_get_qdd(s, x + 1 + 2 * n) == GA_OK);
     SEQ_REQUIRE(ga_get_a(s, x + 1 + 3 * n) == GA_OK);
     SEQ_REQUIRE(ga_get_lambda(s, md->m ? x + 1 + 4 * n : NULL) == GA_OK);
-    return 1 + 4 * n + md->m;
+    if (md->r)
+        SEQ_REQUIRE(ga_get_y(s, x + 1 + 4 * n + md->m, x + 2 + 4 * n + md->m) == GA_OK);
+    return 1 + 4 * n + md->m + 2 * md->r;
 }
 
 static void check(ga_solver *s, ga_status st, int changes_solver, const char *call, int seq)
@@ -479,6 +497,9 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
                                        md.k_cols) == GA_OK);
         }
         SEQ_REQUIRE(ga_set_linear_solver(s, GA_LINEAR_SPARSE) == GA_OK);
+    } else if (pick(&md, 3) == 0) {  /* a first-order state in a third of the dense runs */
+        md.r = 1;
+        SEQ_REQUIRE(ga_set_first_order(s, 1, force_y, rate) == GA_OK);
     }
     const int ops = data ? MAX_OPS : 5 + pick(&md, MAX_OPS - 5);
     for (int op = 0; op < ops && !md.exhausted; ++op) {
@@ -492,7 +513,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         ga_status st = GA_OK;
         int changes = 1;
         const char *call = "";
-        switch (pick(&md, 36)) {
+        switch (pick(&md, 38)) {
         case 0: call = "ga_set_rho_inf"; st = ga_set_rho_inf(s, edge_value(&md)); break;
         case 1: {
             const double am = edge_value(&md), af = edge_value(&md), b = edge_value(&md);
@@ -546,6 +567,12 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             if (pick(&md, 4) == 0)
                 v0[pick(&md, md.n)] += edge_value(&md);
             const double t0 = pick(&md, 5) == 0 ? edge_value(&md) : 0.0;
+            if (md.r && pick(&md, 4)) {
+                const double y0[1] = {pick(&md, 4) == 0 ? edge_value(&md) : 0.3};
+                call = "ga_init_y";
+                st = ga_init_y(s, t0, q0, v0, y0);
+                break;
+            }
             call = "ga_init";
             st = ga_init(s, t0, q0, v0);
             break;
@@ -601,7 +628,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             long long value;
             call = "ga_get_counter";
             changes = 0;
-            st = ga_get_counter(s, pick(&md, 16) - 1, &value);
+            st = ga_get_counter(s, pick(&md, GA_COUNTER_COUNT + 2) - 1, &value);
             if (pick(&md, 3) == 0) {
                 check(s, st, changes, call, seq);
                 call = "ga_reset_counters";
@@ -616,6 +643,23 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             st = declare_pattern(&md, s, &must_fail);
             if (must_fail && st == GA_OK)
                 SEQ_FAIL("sequence %d: an invalid pattern was accepted", seq);
+            break;
+        }
+        case 36: {  /* first-order states: reads, the coupling option, a late declaration */
+            double t = 0.0, y[1], yd[1];
+            ga_get_t(s, &t);
+            switch (pick(&md, 4)) {
+            case 0: call = "ga_get_y"; changes = 0; st = ga_get_y(s, y, yd); break;
+            case 1:
+                call = "ga_interpolate_y";
+                changes = 0;
+                st = ga_interpolate_y(s, t - 1e-4 * uniform(&md), y, yd);
+                break;
+            case 2: call = "ga_set_coupling_exact"; st = ga_set_coupling_exact(s, pick(&md, 2)); break;
+            default:
+                call = "ga_set_first_order";
+                st = ga_set_first_order(s, md.r, force_y, rate);  /* the same, or refused */
+            }
             break;
         }
         case 30: {
@@ -666,7 +710,13 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         }
         check(s, st, changes, call, seq);
 #ifdef SEQ_TRACE
-        fprintf(stderr, "%s: %d %s\n", call, st, st ? ga_last_error(s) : "");
+        {
+            double t_now = NAN, h_now = NAN;
+            ga_get_t(s, &t_now);
+            ga_get_h_last(s, &h_now);
+            fprintf(stderr, "%s: %d %s (t %.17g, h_last %g)\n", call, st,
+                    st ? ga_last_error(s) : "", t_now, h_now);
+        }
 #endif
         ++stats->calls;
     }

@@ -619,6 +619,33 @@ static void step_size_floor_is_reported(void **state)
     ga_free(s);
 }
 
+/* A step too short to move t is refused whatever minimum the user set (found by the random
+ * call sequences: at t = -1e300 with h_max = 1 a step of 1 was accepted with t unchanged, and
+ * the solver then refused its own checkpoint). */
+static void a_step_that_does_not_move_t_is_refused(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = NULL; /* a free particle under gravity: every step solves at once */
+    assert_int_equal(ga_create(2, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, NULL, NULL, &p), GA_OK);
+    const double q[2] = {0.5, -0.8}, v[2] = {0.0, 0.0};
+    assert_int_equal(ga_init(s, -1e300, q, v), GA_OK);
+    assert_int_equal(ga_set_step_limits(s, 1e-3, 1.0), GA_OK);
+    assert_int_equal(ga_set_initial_step(s, 1.0), GA_OK);
+    size_t len = 0;
+    assert_int_equal(ga_state_size(s, &len), GA_OK);
+    double before[512], after[512];
+    assert_true(len <= 512);
+    assert_int_equal(ga_get_state(s, before, len), GA_OK);
+    assert_int_equal(ga_step_adaptive(s, 1e300), GA_ERR_STEP_SIZE);
+    assert_non_null(strstr(ga_last_error(s), "fell below the minimum"));
+    assert_int_equal(ga_get_state(s, after, len), GA_OK);
+    assert_true(ckpt_same_state(before, after));
+    assert_int_equal(ga_set_state(s, after, len), GA_OK);
+    ga_free(s);
+}
+
 /* ---- failures inside adaptive steps: retried smaller, or reported with the state kept ----- */
 /* The pendulum with a force callback that refuses (returns > 0, recoverable) to evaluate
  * positions further than max_move from the last accepted ones, as a material model refuses
@@ -1117,6 +1144,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(rescaling_keeps_order_two_under_random_steps),
+        cmocka_unit_test(a_step_that_does_not_move_t_is_refused),
         cmocka_unit_test(without_rescaling_alternating_steps_lose_an_order),
         cmocka_unit_test(index2_multipliers_stay_second_order_across_step_changes),
         cmocka_unit_test(corrected_start_removes_the_first_order_transient),
