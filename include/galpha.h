@@ -646,8 +646,8 @@ typedef int (*ga_coupling_fn)(double t, const double *q, const double *v, const 
  *  r > 0), GA_ERR_STATE (after the solver was set up by ga_init or ga_set_state). */
 GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga_rate_fn rate);
 
-/** The coupling blocks by a callback (NULL: finite differences, r + 1 force and 2 n + r rate
- *  calls per iteration matrix). Errors: GA_ERR_ARG, GA_ERR_STATE. */
+/** The coupling blocks by a callback (NULL: forward differences, r force and 2 n + r rate calls
+ *  per iteration matrix). Errors: GA_ERR_STATE (from a callback). */
 GA_API ga_status ga_set_coupling(ga_solver *s, ga_coupling_fn fn);
 
 /** exact nonzero (default): the coupling blocks g_q, g_v and f_y are in the iteration matrix;
