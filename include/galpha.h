@@ -625,8 +625,9 @@ GA_API ga_status ga_get_event(const ga_solver *s, int i, double *t, int *index, 
  *  from the same rho_inf (its spectral radius at infinity is rho_inf; with ga_set_params,
  *  rho_inf = alpha_f / (1 - alpha_f)), second order in y and y'. The coupling blocks enter
  *  the iteration matrix exactly (docs/algorithms.md sec. 11). Without them (r = 0, the
- *  default) the solver is the one it was before they existed, bit for bit. They run on the
- *  dense linear algebra (GA_LINEAR_SPARSE is refused). */
+ *  default) the solver is the one it was before they existed, bit for bit. The mechanical
+ *  iteration matrix stays as it is (dense or sparse): the Newton system is solved by block
+ *  elimination onto y, r more solves with each matrix. */
 /**@{*/
 /** Applied forces that depend on the first-order states: f(t, q, v, y), length n. */
 typedef int (*ga_force_y_fn)(double t, const double *q, const double *v, const double *y,

@@ -284,7 +284,7 @@ ga_status Solver::rebuild_matrix()
     if (!st && r.Z)
         st = model.velocity_constraint_tangent(r.t, x.q, x.v, J_, Z_);
     if (!st && this->r() > 0)
-        st = first_order_matrix(r.t, x, r.h, r.K, r.C);
+        st = first_order_matrix(r.t, x);
     if (!st)
         st = factorize(r.t, x, r.h, r.K, r.C, r.Z, 0);
     return st;

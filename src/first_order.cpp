@@ -2,16 +2,16 @@
 // the generalized-alpha of Jansen, Whiting and Hulbert in the paper's non-weighted form,
 //     (1 - alpha_m1) w_{n+1} + alpha_m1 w_n = (1 - alpha_f1) y'_{n+1} + alpha_f1 y'_n,
 //     y_{n+1} = y_n + h ((1 - gamma1) w_n + gamma1 w_{n+1}),   y'_{n+1} = g(t_{n+1}, ...),
-// with y the Newton unknown beside q and lambda. dy is eliminated from the Newton system
-// (sec. 11, "Solve"): with H = c1 I - g_y,
-//     dy = H^-1 (-r^y + g_q dq + gamma' g_v dw),
-// and the mechanical system keeps its form with K_t - f_y H^-1 g_q, C_t - f_y H^-1 g_v and
-// r^q + f_y H^-1 r^y, so that its solvers and its scaling (eq. 10) stay as they are.
+// with y the Newton unknown beside q and lambda. The Newton system is solved by block
+// elimination onto y (sec. 11, "Solve"): with the mechanical solve x = Sol(r) (S x = -r, the
+// step's own, dense or sparse, either formulation) and its responses Z = Sol(f_y) to the
+// columns of f_y, the r x r Schur complement C = c1 I - g_y + G Z (G x = g_q dq + gamma' g_v dw)
+// gives dy = C^-1 (-r^y + G x0) and the mechanical update x0 - Z dy. The mechanical matrix,
+// its scaling (eq. 10) and its factorization stay exactly as they are without the states.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "linear/assemble.hpp"
 #include "solver.hpp"
 
 namespace ga {
@@ -90,81 +90,105 @@ void Solver::predict_first_order(double h)
     x.y = s.y + h * w_n;
 }
 
-// The coupling blocks at the iterate x (f_, rate_ from the residual there), H = c1 I - g_y
-// and its LU, H^-1 g_q, H^-1 g_v, and K_t, C_t with the coupling folded in (Keff_, Ceff_)
-// when the forces depend on y. Without coupling_exact the fold is left out, and the update of
-// y leaves out g_q, g_v.
-ga_status Solver::first_order_matrix(double t, const State &x, double h, bool tangents_K,
-                                     bool tangents_C)
+// The coupling blocks at the iterate x where the iteration matrix is built (f_, rate_ from the
+// residual there); the Schur complement follows at the first solve with that matrix.
+ga_status Solver::first_order_matrix(double t, const State &x)
 {
     if (auto st = model.coupling(t, x.q, x.v, x.y, f_, rate_, blocks_))
         return st;
-    const double c1 = first_order_newton_coefficient(params1, h);
-    H_ = -blocks_.g_y;
-    H_.diagonal().array() += c1;
-    H_lu_.compute(H_);
-    // The pivots' spread as the test of singularity: Eigen's rcond() allocates.
-    const auto pivots = H_lu_.matrixLU().diagonal().cwiseAbs();
-    const double spread = pivots.minCoeff() / pivots.maxCoeff();
-    if (!(spread > std::numeric_limits<double>::epsilon()))
-        return diag.fail(GA_ERR_SINGULAR,
-                         "the first-order block H = c1 I - g_y (c1 = %g) is singular (pivot "
-                         "ratio %.3g) in the step from t = %.17g with h = %g",
-                         c1, spread, accepted_.t, h);
-    c1_matrix_ = c1;
-    coupling_in_matrix_ = coupling_exact && model.cb.force_y != nullptr;
-    // (without coupling_exact, H^-1 g_q and H^-1 g_v still give the convergence test its scale)
-    Hg_q_ = H_lu_.solve(blocks_.g_q);
-    Hg_v_ = H_lu_.solve(blocks_.g_v);
-    Hg_q_norm_ = Hg_q_.cwiseAbs().rowwise().sum().maxCoeff();
-    Hg_v_norm_ = Hg_v_.cwiseAbs().rowwise().sum().maxCoeff();
-    if (!coupling_in_matrix_)
-        return GA_OK;
-    // Keff = K - f_y H^-1 g_q, Ceff = C - f_y H^-1 g_v: rank-r updates, column by column.
-    const int r1 = r();
-    for (int pass = 0; pass < 2; ++pass) {
-        ModelMatrix &E = pass == 0 ? Keff_ : Ceff_;
-        const bool with = pass == 0 ? tangents_K : tangents_C;
-        const Mat &G = pass == 0 ? Hg_q_ : Hg_v_;
-        E.set_zero();
-        if (with)
-            add_block(E.data(), n_, 0, 0, 1.0, pass == 0 ? K_ : C_);
-        auto e = E.as_dense();
-        for (int j = 0; j < n_; ++j)
-            for (int k = 0; k < r1; ++k)
-                e.col(j) -= G(k, j) * blocks_.f_y.col(k);
-    }
+    schur_valid_ = false;
     return GA_OK;
 }
 
-// Before the mechanical solve: hry_ = H^-1 r^y, and r^q += f_y H^-1 r^y where the matrix
-// holds the fold.
-void Solver::eliminate_first_order_rhs()
+// G x = g_q x_q + gamma' g_v x_w into out (r).
+namespace {
+void apply_G(const CouplingBlocks &B, double gamma_prime, const Vec &xq, const Vec &xw, Vec &out)
 {
-    hry_ = H_lu_.solve(ry_);
-    if (coupling_in_matrix_)
-        for (int k = 0; k < r(); ++k)
-            rq_ += hry_[k] * blocks_.f_y.col(k);
+    out.noalias() = B.g_q * xq;
+    out.noalias() += gamma_prime * (B.g_v * xw);
+}
+}  // namespace
+
+// Z = Sol(f_y) column by column with the mechanical solve of this step (as kept: the kept
+// factorization, the row scale of h, in index 2 this step's B), C = c1 I - g_y + G Z and its LU.
+// Without coupling_exact, Z = 0 and G = 0: C = c1 I - g_y. Also the norms of C^-1 g_q, C^-1 g_v
+// for the convergence test's scale of y.
+ga_status Solver::first_order_schur(double h, const NewtonCoefficients &c)
+{
+    const int r1 = r();
+    const bool index2 = formulation == GA_INDEX2_STABILIZED;
+    const double c1 = first_order_newton_coefficient(params1, h);
+    C1_ = -blocks_.g_y;
+    C1_.diagonal().array() += c1;
+    const bool coupled = coupling_exact && model.cb.force_y != nullptr;
+    for (int k = 0; k < r1 && coupled; ++k) {
+        z_rhs_ = blocks_.f_y.col(k);
+        if (index2)
+            S2_.solve(z_rhs_, z_zero_, z_zero_, params, h, B_, z_d_, z_w_, z_l_, z_e_);
+        else
+            S_.solve(z_rhs_, z_zero_, z_d_, z_l_, step_row_scale(params, h, scaling));
+        Zq_.col(k) = z_d_;
+        Zw_.col(k) = index2 ? z_w_ : z_d_;
+        Zl_.col(k) = z_l_;
+        if (index2)
+            Ze_.col(k) = z_e_;
+        if (coupling_exact) {
+            apply_G(blocks_, c.gamma_prime, z_d_, index2 ? z_w_ : z_d_, z_y_);
+            C1_.col(k) += z_y_;
+        }
+    }
+    C1_lu_.compute(C1_);
+    // The pivots' spread as the test of singularity: Eigen's rcond() allocates.
+    const auto pivots = C1_lu_.matrixLU().diagonal().cwiseAbs();
+    const double spread = pivots.minCoeff() / pivots.maxCoeff();
+    if (!(spread > std::numeric_limits<double>::epsilon()))
+        return diag.fail(GA_ERR_SINGULAR,
+                         "the first-order block c1 I - g_y + G Z (c1 = %g) is singular (pivot "
+                         "ratio %.3g) in the step from t = %.17g with h = %g",
+                         c1, spread, accepted_.t, h);
+    Cg_ = C1_lu_.solve(blocks_.g_q);  // into storage of its own: no temporary
+    Cg_q_norm_ = Cg_.cwiseAbs().rowwise().sum().maxCoeff();
+    Cg_ = C1_lu_.solve(blocks_.g_v);
+    Cg_v_norm_ = Cg_.cwiseAbs().rowwise().sum().maxCoeff();
+    schur_valid_ = true;
+    schur_h_ = h;
+    return GA_OK;
 }
 
-// After it: dy = -H^-1 r^y + H^-1 g_q dq + gamma' H^-1 g_v dw; y += dy, y' += c1 dy (c1 of
-// this step's h: the relation between them is exact, whatever matrix is kept).
-void Solver::update_first_order(const NewtonCoefficients &c, double h, const Vec &dw, State &x,
+// After the mechanical solve x0 = Sol(r^q, ...) in dq_, dw_, dlambda_, deta_:
+// dy = C^-1 (-r^y + G x0), and the mechanical update x0 - Z dy.
+void Solver::first_order_correction(const NewtonCoefficients &c, Vec &dw)
+{
+    const bool index2 = formulation == GA_INDEX2_STABILIZED;
+    z_y_ = -ry_;
+    if (coupling_exact) {
+        apply_G(blocks_, c.gamma_prime, dq_, dw, hry_);
+        z_y_ += hry_;
+    }
+    dy_ = C1_lu_.solve(z_y_);
+    if (!(coupling_exact && model.cb.force_y != nullptr))
+        return;
+    dq_.noalias() -= Zq_ * dy_;
+    dlambda_.noalias() -= Zl_ * dy_;
+    if (index2) {
+        dw.noalias() -= Zw_ * dy_;
+        deta_.noalias() -= Ze_ * dy_;
+    }
+}
+
+// y += dy, y' += c1 dy (c1 of this step's h: the relation between them is exact, whatever
+// matrix is kept), and what the stopping test reads.
+void Solver::update_first_order(const NewtonCoefficients &c, double h, State &x,
                                 UpdateSizes &size)
 {
-    dy_ = -hry_;
-    if (coupling_exact) {
-        dy_.noalias() += Hg_q_ * dq_;
-        dy_.noalias() += c.gamma_prime * (Hg_v_ * dw);
-    }
     const double c1 = first_order_newton_coefficient(params1, h);
     x.y += dy_;
     x.ydot += c1 * dy_;
     // The scale y is measured against: |y|, and the y that a change of q by its own size
-    // makes through the coupling, |H^-1 g_q| |q| + gamma' |H^-1 g_v| |q|: a state that starts
+    // makes through the coupling, |C^-1 g_q| |q| + gamma' |C^-1 g_v| |q|: a state that starts
     // from 0 (a current at rest) converges to the accuracy of q instead of to a relative
     // accuracy its round-off, carried over from q, never reaches.
-    const double through_q = (Hg_q_norm_ + c.gamma_prime * Hg_v_norm_) * size.q;
+    const double through_q = (Cg_q_norm_ + c.gamma_prime * Cg_v_norm_) * size.q;
     size.dy = dy_.cwiseAbs().maxCoeff();
     size.y = x.y.cwiseAbs().maxCoeff() + through_q;
     size.ydot = x.ydot.cwiseAbs().maxCoeff() + c1 * through_q;

@@ -178,15 +178,12 @@ ga_status Solver::setup_workspace()
 {
     // Which linear algebra: sparse needs declared patterns of M and Phi_q, and K_t, C_t either
     // declared (possibly empty), not needed, or neglected.
-    const bool sparse_possible = r() == 0 && !M_.dense() && (m_ == 0 || !J_.dense()) &&
+    const bool sparse_possible = !M_.dense() && (m_ == 0 || !J_.dense()) &&
                                  (!model.stiffness_needed(K_) || !K_.dense()) &&
                                  (!model.damping_needed(C_) || !C_.dense());
     bool sparse = false;
     switch (linear_solver) {
     case GA_LINEAR_SPARSE:
-        if (r() > 0)
-            return diag.fail(GA_ERR_ARG, "first-order states run on the dense linear algebra "
-                             "only: GA_LINEAR_SPARSE is refused with r = %d", r());
         if (!sparse_possible)
             return diag.fail(GA_ERR_ARG,
                              "the sparse solver needs the patterns of M and Phi_q, and of K_t "
@@ -236,16 +233,20 @@ ga_status Solver::setup_workspace()
     if (r() > 0) {
         const int r1 = r();
         blocks_.allocate(n_, r1);
-        H_.setZero(r1, r1);
-        H_lu_ = Eigen::PartialPivLU<Mat>(r1);
-        Hg_q_.setZero(r1, n_);
-        Hg_v_.setZero(r1, n_);
-        Keff_.set_dense(n_, n_);
-        Keff_.allocate();
-        Ceff_.set_dense(n_, n_);
-        Ceff_.allocate();
-        for (Vec *x : {&rate_, &ry_, &hry_, &dy_, &w_n_, &y_tmp_})
+        for (Mat *Z : {&Zq_, &Zw_})
+            Z->setZero(n_, r1);
+        for (Mat *Z : {&Zl_, &Ze_})
+            Z->setZero(m_, r1);
+        C1_.setZero(r1, r1);
+        Cg_.setZero(r1, n_);
+        C1_lu_ = Eigen::PartialPivLU<Mat>(r1);
+        for (Vec *x : {&z_rhs_, &z_d_, &z_w_})
+            x->setZero(n_);
+        for (Vec *x : {&z_zero_, &z_l_, &z_e_})
+            x->setZero(m_);
+        for (Vec *x : {&rate_, &ry_, &hry_, &dy_, &w_n_, &y_tmp_, &z_y_})
             x->setZero(r1);
+        schur_valid_ = false;
     }
     model.allocate_workspace(M_, J_, K_, C_);
     sparse_backend_ = sparse && backend;
@@ -617,10 +618,6 @@ ga_status Solver::factorize(double t, const State &x, double h, bool tangents_K,
     count(counters, GA_COUNT_FACTORIZATIONS);
     jacobian_valid_ = false;
     const ModelMatrix *C = tangents_C ? &C_ : nullptr, *K = tangents_K ? &K_ : nullptr;
-    if (coupling_in_matrix_) {  // first_order_matrix folded the coupling into copies
-        K = &Keff_;
-        C = &Ceff_;
-    }
     const bool ok = formulation == GA_INDEX2_STABILIZED
                         ? S2_.factorize(M_, C, K, J_, B_, tangent_Z ? &Z_ : nullptr, params, h)
                         : S_.factorize_step(M_, C, K, J_, params, h, scaling);
@@ -642,6 +639,7 @@ ga_status Solver::factorize(double t, const State &x, double h, bool tangents_K,
         return GA_ERR_SINGULAR;
     }
     jacobian_valid_ = true;
+    schur_valid_ = false;  // first-order states: Z and C belong to a matrix
     jacobian_h_ = h;
     theta_prev_ = -1.0;
     convergence_.matrix_changed();
@@ -736,6 +734,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
             return st;
         b_t_ = s.t;
         b_q_ = &s.q;
+        schur_valid_ = false;  // Z of the first-order states is that of the solve with B
     }
 
     // Tangents the user gives are always in the matrix. Missing ones (GA_TANGENT_AUTO) cost
@@ -771,7 +770,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         if (!st && refresh && tangent_Z)
             st = model.velocity_constraint_tangent(t1, x.q, x.v, J_, Z_);
         if (!st && refresh && r() > 0)
-            st = first_order_matrix(t1, x, h, tangents_K, tangents_C);
+            st = first_order_matrix(t1, x);
         if (!st && refresh) {
             st = factorize(t1, x, h, tangents_K, tangents_C, tangent_Z, iter);
             refresh = false;
@@ -786,8 +785,12 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
             return st;
         }
         // [dq; dlambda] = -S_t^{-1} [r^q; r^lambda], in the scaled form (9)-(10)
-        if (r() > 0)
-            eliminate_first_order_rhs();
+        if (r() > 0 && (!schur_valid_ || schur_h_ != h)) {  // first-order states
+            if (auto st2 = first_order_schur(h, c)) {
+                diag.append(" (Newton iteration %d)", iter);
+                return st2;
+            }
+        }
         const Vec *dw = &dq_;
         if (index2) {
             // dw_: the Newmark part of the update, dq + B^T deta
@@ -796,11 +799,13 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         } else {
             S_.solve(rq_, phi_, dq_, dlambda_, row_scale);
         }
+        if (r() > 0)
+            first_order_correction(c, index2 ? dw_ : dq_);
         count(counters, GA_COUNT_NEWTON_ITERS);
         UpdateSizes size;
         apply_update(dq_, *dw, dlambda_, c.gamma_prime, c.beta_prime, x, size);
         if (r() > 0)
-            update_first_order(c, h, *dw, x, size);
+            update_first_order(c, h, x, size);
         if (!size.increments_finite || !size.iterate_finite)
             return diag.fail(GA_ERR_NONFINITE,
                              "Newton %s is not finite in iteration %d of the step from "

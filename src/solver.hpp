@@ -203,11 +203,10 @@ private:
     // first_order.cpp: the parts of a step that concern first-order states.
     void first_order_start(double h);
     void predict_first_order(double h);
-    ga_status first_order_matrix(double t, const State &x, double h, bool tangents_K,
-                                 bool tangents_C);
-    void eliminate_first_order_rhs();
-    void update_first_order(const NewtonCoefficients &c, double h, const Vec &dw, State &x,
-                            UpdateSizes &size);
+    ga_status first_order_matrix(double t, const State &x);
+    ga_status first_order_schur(double h, const NewtonCoefficients &c);
+    void first_order_correction(const NewtonCoefficients &c, Vec &dw);
+    void update_first_order(const NewtonCoefficients &c, double h, State &x, UpdateSizes &size);
     void finish_first_order(State &x);
     ga_status start_first_order(double t0, State &x);
     ga_status first_order_starting_values(double h);
@@ -309,21 +308,22 @@ private:
 
     EventSet events_;
 
-    // First-order states (first_order.cpp): the coupling blocks, the LU of H = c1 I - g_y, and
-    // H^-1 g_q, H^-1 g_v for the elimination of dy; K_t and C_t with the coupling folded in
-    // (Keff_, Ceff_, dense); the residual r^y = y' - g and scratch. w_n_ is the w the step
-    // starts from when it is rescaled or corrected.
+    // First-order states (first_order.cpp): the coupling blocks (evaluated with the iteration
+    // matrix); the responses Z of the mechanical solve to the columns of f_y (dq, dw, dlambda,
+    // deta) and the Schur complement C = c1 I - g_y + G Z with its LU, valid for the kept
+    // matrix, its h and (index 2) its step's B; the residual r^y = y' - g and scratch. w_n_ is
+    // the w the step starts from when it is rescaled or corrected.
     bool y_started_ = false;
-    bool coupling_in_matrix_ = false;  // the kept matrix holds Keff_, Ceff_
     CouplingBlocks blocks_;
-    Eigen::PartialPivLU<Mat> H_lu_;
-    Mat H_, Hg_q_, Hg_v_;
-    ModelMatrix Keff_, Ceff_;
+    bool schur_valid_ = false;
+    double schur_h_ = 0.0;
+    Mat Zq_, Zw_, Zl_, Ze_, C1_, Cg_;
+    Eigen::PartialPivLU<Mat> C1_lu_;
+    Vec z_rhs_, z_zero_, z_d_, z_w_, z_l_, z_e_, z_y_;
     Vec rate_, ry_, hry_, dy_, w_n_, y_tmp_;
     Vec out_y_;  // y at an interpolated time, for consistent output
     const Vec *w_start_ = nullptr;
-    double c1_matrix_ = 0.0;  // c1 of the kept matrix
-    double Hg_q_norm_ = 0.0, Hg_v_norm_ = 0.0;  // their infinity norms (convergence test)
+    double Cg_q_norm_ = 0.0, Cg_v_norm_ = 0.0;  // |C^-1 g_q|, |C^-1 g_v| (convergence test)
 };
 
 }  // namespace ga

@@ -497,7 +497,8 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
                                        md.k_cols) == GA_OK);
         }
         SEQ_REQUIRE(ga_set_linear_solver(s, GA_LINEAR_SPARSE) == GA_OK);
-    } else if (pick(&md, 3) == 0) {  /* a first-order state in a third of the dense runs */
+    }
+    if (pick(&md, 3) == 0) {  /* a first-order state in a third of the runs */
         md.r = 1;
         SEQ_REQUIRE(ga_set_first_order(s, 1, force_y, rate) == GA_OK);
     }

@@ -406,7 +406,7 @@ static void no_allocation_with_events(void **state)
 }
 
 /* First-order states: coupling blocks by differences and by callback, both formulations, fixed
- * and adaptive steps, rate callbacks that fail now and then. */
+ * and adaptive steps, dense and sparse, rate callbacks that fail now and then. */
 static int rate_failure;
 static int sometimes_failing_rate(double t, const double *q, const double *v, const double *y,
                                   double *ydot, void *u)
@@ -417,10 +417,14 @@ static int sometimes_failing_rate(double t, const double *q, const double *v, co
 static void no_allocation_with_first_order_states(void **state)
 {
     (void)state;
-    for (int mode = 0; mode < 4; ++mode) {
+    for (int mode = 0; mode < 6; ++mode) {  /* modes 4, 5: the sparse path */
         ga_solver *s = NULL;
+        const int sparse = mode >= 4;
         assert_int_equal(ga_create(EM_N, EM_M, &s), GA_OK);
-        assert_int_equal(ga_set_callbacks(s, em_mass, NULL, em_constraint, em_jacobian, NULL),
+        if (sparse)
+            assert_int_equal(em_declare_sparse(s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, sparse ? em_mass_diag : em_mass, NULL, em_constraint,
+                                          sparse ? em_jacobian_values : em_jacobian, NULL),
                          GA_OK);
         assert_int_equal(ga_set_first_order(s, EM_R, em_force, sometimes_failing_rate), GA_OK);
         if (mode & 1)

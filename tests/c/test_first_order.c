@@ -498,15 +498,44 @@ static void refusals_and_failures(void **state)
     free(before);
     free(after);
     ga_free(s);
+}
 
-    /* the sparse linear algebra is refused with first-order states */
-    assert_int_equal(ga_create(EM_N, EM_M, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, em_mass, NULL, em_constraint, em_jacobian, NULL), GA_OK);
-    assert_int_equal(ga_set_first_order(s, EM_R, em_force, em_rate), GA_OK);
-    assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
-    assert_int_equal(ga_init_y(s, 0.0, q0, v0, y0), GA_ERR_ARG);
-    assert_non_null(strstr(ga_last_error(s), "dense"));
-    ga_free(s);
+/* The sparse path (declared patterns, KLU) gives the dense path's solution: the first-order
+ * states leave the mechanical matrix as it is, in both formulations. */
+static void sparse_path_gives_the_dense_solution(void **state)
+{
+    (void)state;
+    for (int formulation = GA_INDEX3; formulation <= GA_INDEX2_STABILIZED; ++formulation) {
+        double q[2][EM_N], l[2][EM_M], y[2][EM_R];
+        for (int sparse = 0; sparse < 2; ++sparse) {
+            ga_solver *s = NULL;
+            assert_int_equal(ga_create(EM_N, EM_M, &s), GA_OK);
+            if (sparse)
+                assert_int_equal(em_declare_sparse(s), GA_OK);
+            assert_int_equal(ga_set_callbacks(s, sparse ? em_mass_diag : em_mass, NULL,
+                                              em_constraint,
+                                              sparse ? em_jacobian_values : em_jacobian, NULL),
+                             GA_OK);
+            assert_int_equal(ga_set_first_order(s, EM_R, em_force, em_rate), GA_OK);
+            assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+            assert_int_equal(ga_set_tangent_mode(s, GA_TANGENT_FD), GA_OK);
+            const double q0[EM_N] = {0, 0}, v0[EM_N] = {0, 0}, y0[EM_R] = {0, 0};
+            assert_int_equal(ga_init_y(s, 0.0, q0, v0, y0), GA_OK);
+            if (sparse)
+                assert_non_null(strstr(ga_linear_solver_name(s), "sparse"));
+            for (int k = 0; k < 200; ++k)
+                assert_int_equal(ga_step(s, 5e-3), GA_OK);
+            assert_int_equal(ga_get_q(s, q[sparse]), GA_OK);
+            assert_int_equal(ga_get_lambda(s, l[sparse]), GA_OK);
+            assert_int_equal(ga_get_y(s, y[sparse], NULL), GA_OK);
+            ga_free(s);
+        }
+        const double dq = max_abs_diff(q[0], q[1], EM_N), dl = fabs(l[0][0] - l[1][0]),
+                     dy = max_abs_diff(y[0], y[1], EM_R);
+        print_message("%s: sparse against dense: q %.1e, lambda %.1e, y %.1e\n",
+                      formulation == GA_INDEX3 ? "index 3" : "index 2", dq, dl, dy);
+        assert_true(dq < 1e-12 && dl < 1e-10 && dy < 1e-10);
+    }
 }
 
 int main(void)
@@ -521,6 +550,7 @@ int main(void)
         cmocka_unit_test(adaptive_error_follows_the_tolerance),
         cmocka_unit_test(events_on_the_states),
         cmocka_unit_test(refusals_and_failures),
+        cmocka_unit_test(sparse_path_gives_the_dense_solution),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
