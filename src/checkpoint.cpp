@@ -213,7 +213,6 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
             *x = Eigen::Map<const Vec>(py, x->size());
             py += x->size();
         }
-    y_started_ = y_started_ || r() > 0;
     invalidate_jacobian();
     previous_valid_ = false;
     events_.restart();

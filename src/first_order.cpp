@@ -34,7 +34,6 @@ void Solver::set_first_order(int r)
     recipe_.ydot.swap(recipe_ydot);
     out_y_.swap(out_y);
     model.set_first_order_count(r);
-    y_started_ = false;
     invalidate_jacobian();
 }
 
@@ -67,14 +66,14 @@ ga_status Solver::first_order_starting_values(double h)
         x.q = s.q + sh * s.v + (0.5 * sh * sh) * *qdd_start_;
         x.v = s.v + sh * *qdd_start_;
         x.y = s.y + sh * s.ydot;
-        Vec &out = side == 0 ? hry_ : dy_;
+        Vec &out = side == 0 ? gx_ : dy_;
         if (auto st = model.rate(s.t + sh, x.q, x.v, x.y, out)) {
             diag.append(" (corrected starting values of the first-order states, h = %g)", h);
             return st;
         }
     }
     const double delta = params1.alpha_m - params1.alpha_f;
-    w_n_ = s.ydot + (0.5 * delta) * (hry_ - dy_);
+    w_n_ = s.ydot + (0.5 * delta) * (gx_ - dy_);
     return GA_OK;
 }
 
@@ -132,10 +131,8 @@ ga_status Solver::first_order_schur(double h, const NewtonCoefficients &c)
         Zl_.col(k) = z_l_;
         if (index2)
             Ze_.col(k) = z_e_;
-        if (coupling_exact) {
-            apply_G(blocks_, c.gamma_prime, z_d_, index2 ? z_w_ : z_d_, z_y_);
-            C1_.col(k) += z_y_;
-        }
+        apply_G(blocks_, c.gamma_prime, z_d_, index2 ? z_w_ : z_d_, z_y_);
+        C1_.col(k) += z_y_;
     }
     C1_lu_.compute(C1_);
     // The pivots' spread as the test of singularity: Eigen's rcond() allocates.
@@ -162,8 +159,8 @@ void Solver::first_order_correction(const NewtonCoefficients &c, Vec &dw)
     const bool index2 = formulation == GA_INDEX2_STABILIZED;
     z_y_ = -ry_;
     if (coupling_exact) {
-        apply_G(blocks_, c.gamma_prime, dq_, dw, hry_);
-        z_y_ += hry_;
+        apply_G(blocks_, c.gamma_prime, dq_, dw, gx_);
+        z_y_ += gx_;
     }
     dy_ = C1_lu_.solve(z_y_);
     if (!(coupling_exact && model.cb.force_y != nullptr))

@@ -43,7 +43,7 @@ Eigen::Index argmax_abs(const Vec &x)
 // stepped on without a constraint it needed (issue 17).
 ga_status Solver::init(double t0, const double *q0, const double *v0)
 {
-    if (r() > 0 && !y_started_)
+    if (r() > 0 && !initialized_)  // (r is fixed once the solver is set up)
         return diag.fail(GA_ERR_STATE, "%d first-order states declared: the first start "
                          "needs their initial values (ga_init_y)", r());
     if (auto st = setup())
@@ -125,7 +125,6 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
     accepted_.swap(trial_);
     ++state_id_;
     initialized_ = true;
-    y_started_ = y_started_ || r() > 0;
     previous_valid_ = false;
     events_.restart();
     start_pending_ = true;  // corrected starting values need the h of the first step

@@ -244,7 +244,7 @@ ga_status Solver::setup_workspace()
             x->setZero(n_);
         for (Vec *x : {&z_zero_, &z_l_, &z_e_})
             x->setZero(m_);
-        for (Vec *x : {&rate_, &ry_, &hry_, &dy_, &w_n_, &y_tmp_, &z_y_})
+        for (Vec *x : {&rate_, &ry_, &gx_, &dy_, &w_n_, &y_tmp_, &z_y_})
             x->setZero(r1);
         schur_valid_ = false;
     }

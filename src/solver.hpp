@@ -87,9 +87,8 @@ public:
     int r() const { return model.first_order_count(); }
     // Declares r first-order states (before setup; allocates the states' vectors).
     void set_first_order(int r);
-    // ga_init_y: ga_init with y0; first_order_started(): y holds states to start from.
+    // ga_init_y: ga_init with y0.
     ga_status init_y(double t0, const double *q0, const double *v0, const double *y0);
-    bool first_order_started() const { return y_started_; }
     ga_status interpolate_y(double t, double *y, double *ydot);
 
     Counters counters{};
@@ -208,7 +207,6 @@ private:
     void first_order_correction(const NewtonCoefficients &c, Vec &dw);
     void update_first_order(const NewtonCoefficients &c, double h, State &x, UpdateSizes &size);
     void finish_first_order(State &x);
-    ga_status start_first_order(double t0, State &x);
     ga_status first_order_starting_values(double h);
     double first_order_error_sum(double h, double scale);
     ga_status factorize(double t, const State &x, double h, bool tangents_K, bool tangents_C,
@@ -313,14 +311,13 @@ private:
     // deta) and the Schur complement C = c1 I - g_y + G Z with its LU, valid for the kept
     // matrix, its h and (index 2) its step's B; the residual r^y = y' - g and scratch. w_n_ is
     // the w the step starts from when it is rescaled or corrected.
-    bool y_started_ = false;
     CouplingBlocks blocks_;
     bool schur_valid_ = false;
     double schur_h_ = 0.0;
     Mat Zq_, Zw_, Zl_, Ze_, C1_, Cg_;
     Eigen::PartialPivLU<Mat> C1_lu_;
     Vec z_rhs_, z_zero_, z_d_, z_w_, z_l_, z_e_, z_y_;
-    Vec rate_, ry_, hry_, dy_, w_n_, y_tmp_;
+    Vec rate_, ry_, gx_, dy_, w_n_, y_tmp_;  // gx_: G x0, or scratch of the start
     Vec out_y_;  // y at an interpolated time, for consistent output
     const Vec *w_start_ = nullptr;
     double Cg_q_norm_ = 0.0, Cg_v_norm_ = 0.0;  // |C^-1 g_q|, |C^-1 g_v| (convergence test)
