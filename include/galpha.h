@@ -651,6 +651,23 @@ GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga
  *  per iteration matrix). Errors: GA_ERR_STATE (from a callback). */
 GA_API ga_status ga_set_coupling(ga_solver *s, ga_coupling_fn fn);
 
+/** Blocks of the first-order coupling with a declared sparsity pattern (ga_set_coupling_pattern). */
+typedef enum ga_coupling_block {
+    GA_COUPLING_G_Q = 0, /**< dg/dq, r x n */
+    GA_COUPLING_G_V = 1  /**< dg/dv, r x n */
+} ga_coupling_block;
+
+/** Declare where g_q or g_v can be nonzero (nnz >= 0 entries (rows[k], cols[k]), 0-based; an
+ *  empty pattern declares the block zero), after ga_set_first_order and before the first
+ *  ga_init_y or ga_set_state. Their finite differences then perturb structurally independent
+ *  columns together: one rate call per group of columns instead of one per column (a motor
+ *  whose rate depends on one velocity: 1 call instead of n). The blocks the coupling callback
+ *  writes are dense whatever the pattern. Errors: GA_ERR_ARG (unknown block, NULL arrays with
+ *  nnz > 0, an index out of range), GA_ERR_STATE (before ga_set_first_order with r > 0, or
+ *  after the solver was set up). */
+GA_API ga_status ga_set_coupling_pattern(ga_solver *s, int which, int nnz, const int *rows,
+                                         const int *cols);
+
 /** exact nonzero (default): the coupling blocks g_q, g_v and f_y are in the iteration matrix;
  *  zero: they are left out (only g_y, in the rows of y), as codes that couple such states
  *  loosely do -- the same solution, at the price of more Newton iterations (a measurement

@@ -686,6 +686,30 @@ GA_API ga_status ga_set_coupling(ga_solver *s, ga_coupling_fn fn)
     });
 }
 
+GA_API ga_status ga_set_coupling_pattern(ga_solver *s, int which, int nnz, const int *rows,
+                                         const int *cols)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (which != GA_COUPLING_G_Q && which != GA_COUPLING_G_V)
+            return c.diag.fail(GA_ERR_ARG, "unknown coupling block %d", which);
+        if (c.r() == 0)
+            return c.diag.fail(GA_ERR_STATE, "ga_set_coupling_pattern before ga_set_first_order "
+                               "with r > 0");
+        if (c.setup_done())
+            return c.diag.fail(GA_ERR_STATE, "coupling patterns are declared before ga_init_y");
+        if (nnz < 0 || (nnz > 0 && (!rows || !cols)))
+            return c.diag.fail(GA_ERR_ARG, "pattern with nnz = %d needs rows and cols", nnz);
+        for (int k = 0; k < nnz; ++k)
+            if (rows[k] < 0 || rows[k] >= c.r() || cols[k] < 0 || cols[k] >= c.n())
+                return c.diag.fail(GA_ERR_ARG, "pattern entry %d = (%d, %d) is outside the "
+                                   "%d x %d block", k, rows[k], cols[k], c.r(), c.n());
+        (which == GA_COUPLING_G_Q ? c.model.g_q_pattern : c.model.g_v_pattern)
+            .set_pattern(c.r(), c.n(), rows, cols, nnz);
+        c.invalidate_jacobian();
+        return GA_OK;
+    });
+}
+
 GA_API ga_status ga_set_coupling_exact(ga_solver *s, int exact)
 {
     return guarded(s, [&](ga::Solver &c) {

@@ -112,6 +112,10 @@ void Model::allocate_workspace(const ModelMatrix &M, const ModelMatrix &J, const
     J_pert_.copy_layout(J);  // also serves the constraint acceleration term
     y_pert_.setZero(r_);
     rate_pert_.setZero(r_);
+    if (!g_q_pattern.dense() && g_q_pattern.nnz() > 0 && g_q_groups_.count() == 0)
+        g_q_groups_.build(g_q_pattern);
+    if (!g_v_pattern.dense() && g_v_pattern.nnz() > 0 && g_v_groups_.count() == 0)
+        g_v_groups_.build(g_v_pattern);
     prepare_differences(M, K, C);
 }
 
@@ -447,8 +451,9 @@ ga_status Model::rate(double t, const Vec &q, const Vec &v, const Vec &y, Vec &y
     return check_finite(ydot.data(), r_, 0, "rate g", t);
 }
 
-// Forward differences with fd_increment: column j of g_q from g at q + e_j, of g_v from v + e_j,
-// of g_y and f_y from y + e_j (the force sees the perturbed y through y_now).
+// Forward differences with fd_increment: column j of g_q from g at q + e_j, of g_v from v + e_j
+// (a group of columns at once where a pattern is declared), of g_y and f_y from y + e_j (the
+// force sees the perturbed y through y_now).
 ga_status Model::coupling(double t, const Vec &q, const Vec &v, const Vec &y, const Vec &f,
                           const Vec &ydot, CouplingBlocks &B)
 {
@@ -466,21 +471,10 @@ ga_status Model::coupling(double t, const Vec &q, const Vec &v, const Vec &y, co
                 return check_finite(X->data(), X->size(), X->rows(), "coupling block", t);
         return GA_OK;
     }
-    for (int pass = 0; pass < 2; ++pass) {  // columns of q, then of v
-        Vec &x = pass == 0 ? q_pert_ : v_pert_;
-        x = pass == 0 ? q : v;
-        Mat &G = pass == 0 ? B.g_q : B.g_v;
-        for (int j = 0; j < n_; ++j) {
-            const double e = fd_increment(x[j]), keep = x[j];
-            x[j] += e;
-            const ga_status st = pass == 0 ? rate(t, q_pert_, v, y, rate_pert_)
-                                           : rate(t, q, v_pert_, y, rate_pert_);
-            x[j] = keep;
-            if (st)
-                return st;
-            G.col(j) = (rate_pert_ - ydot) / e;
-        }
-    }
+    for (const bool of_q : {true, false})
+        if (auto st = coupling_block(t, q, v, y, ydot, of_q, of_q ? g_q_pattern : g_v_pattern,
+                                     of_q ? g_q_groups_ : g_v_groups_, of_q ? B.g_q : B.g_v))
+            return st;
     const Vec *y_before = y_now;
     y_pert_ = y;
     y_now = &y_pert_;
@@ -502,6 +496,53 @@ ga_status Model::coupling(double t, const Vec &q, const Vec &v, const Vec &y, co
             B.f_y.col(j).setZero();
     }
     y_now = y_before;
+    return GA_OK;
+}
+
+}  // namespace ga
+
+namespace ga {
+
+ga_status Model::coupling_block(double t, const Vec &q, const Vec &v, const Vec &y,
+                                const Vec &ydot, bool of_q, const ModelMatrix &pattern,
+                                const ColumnGroups &groups, Mat &G)
+{
+    Vec &x = of_q ? q_pert_ : v_pert_;
+    x = of_q ? q : v;
+    const auto evaluate = [&] {
+        return of_q ? rate(t, q_pert_, v, y, rate_pert_) : rate(t, q, v_pert_, y, rate_pert_);
+    };
+    if (pattern.dense()) {
+        for (int j = 0; j < n_; ++j) {
+            const double e = fd_increment(x[j]), keep = x[j];
+            x[j] += e;
+            const ga_status st = evaluate();
+            x[j] = keep;
+            if (st)
+                return st;
+            G.col(j) = (rate_pert_ - ydot) / e;
+        }
+        return GA_OK;
+    }
+    G.setZero();
+    const auto &rows = pattern.row_index();
+    const auto &cols = pattern.col_index();
+    for (int g = 0; g < groups.count(); ++g) {
+        for (int k = groups.start[g]; k < groups.start[g + 1]; ++k) {
+            const int j = groups.cols[k];
+            step_[j] = fd_increment(x[j]);
+            x[j] += step_[j];
+        }
+        const ga_status st = evaluate();
+        for (int k = groups.start[g]; k < groups.start[g + 1]; ++k)
+            x[groups.cols[k]] = of_q ? q[groups.cols[k]] : v[groups.cols[k]];
+        if (st)
+            return st;
+        for (int k = groups.entry_start[g]; k < groups.entry_start[g + 1]; ++k) {
+            const int e = groups.entries[k], i = rows[e], j = cols[e];
+            G(i, j) = (rate_pert_[i] - ydot[i]) / step_[j];
+        }
+    }
     return GA_OK;
 }
 

@@ -79,7 +79,17 @@ public:
     // callback sees. The solver points y_now at the states that belong with each (t, q, v) it
     // evaluates f at; with r = 0 the force is that of ga_set_callbacks and y_now is unused.
     int first_order_count() const { return r_; }
-    void set_first_order_count(int r) { r_ = r; }
+    // r first-order states; their coupling patterns (declared by ga_set_coupling_pattern)
+    // start dense.
+    void set_first_order_count(int r)
+    {
+        r_ = r;
+        g_q_pattern.set_dense(r, n_);
+        g_v_pattern.set_dense(r, n_);
+    }
+    // Where g_q, g_v may be nonzero (dense: anywhere): their differences perturb the columns
+    // of a group together (ColumnGroups, built at setup).
+    ModelMatrix g_q_pattern, g_v_pattern;
     const Vec *y_now = nullptr;
     // y' = g(t, q, v, y) into ydot (length r).
     ga_status rate(double t, const Vec &q, const Vec &v, const Vec &y, Vec &ydot);
@@ -176,6 +186,11 @@ private:
     Vec q_pert_, v_pert_, f_pert_, r_pert_, phi_plus_, phi_minus_, g_plus_, g_minus_, step_;
     int r_ = 0;
     Vec y_pert_, rate_pert_;  // first-order differences
+    ColumnGroups g_q_groups_, g_v_groups_;
+    // one block of g_q or g_v (column j from the states perturbed in x) by differences
+    ga_status coupling_block(double t, const Vec &q, const Vec &v, const Vec &y, const Vec &ydot,
+                             bool of_q, const ModelMatrix &pattern, const ColumnGroups &groups,
+                             Mat &G);
     ModelMatrix M_pert_, J_pert_;
     ColumnGroups k_groups_, c_groups_;
 };

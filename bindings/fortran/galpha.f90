@@ -37,6 +37,7 @@ module galpha
   integer(c_int), parameter, public :: GA_REDUNDANT_REFUSE = 0, GA_REDUNDANT_DROP = 1
   integer(c_int), parameter, public :: GA_INIT_PROJECT = 0, GA_INIT_REFUSE = 1
   integer(c_int), parameter, public :: GA_OUTPUT_CONSISTENT = 0, GA_OUTPUT_STEP = 1
+  integer(c_int), parameter, public :: GA_COUPLING_G_Q = 0, GA_COUPLING_G_V = 1
   integer(c_int), parameter, public :: GA_EVENT_BOTH = 0, GA_EVENT_RISING = 1, &
        GA_EVENT_FALLING = -1, GA_EVENT_LOG = 64
   integer(c_int), parameter, public :: GA_COUNT_STEPS = 0, GA_COUNT_FAILED_STEPS = 1, &
@@ -431,6 +432,13 @@ module galpha
        type(c_ptr), value :: s
        type(c_funptr), value :: fn
      end function ga_set_coupling
+     integer(c_int) function ga_set_coupling_pattern(s, which, nnz, rows, cols) &
+          bind(C, name="ga_set_coupling_pattern")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), value :: which, nnz
+       integer(c_int), intent(in) :: rows(*), cols(*)
+     end function ga_set_coupling_pattern
      integer(c_int) function ga_set_coupling_exact(s, exact) &
           bind(C, name="ga_set_coupling_exact")
        import :: c_int, c_ptr
@@ -483,7 +491,7 @@ module galpha
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
        ga_interpolate, ga_interpolate_qdd, ga_set_output, ga_set_events, ga_get_event_count, &
        ga_get_event, ga_set_first_order, ga_set_coupling, ga_set_coupling_exact, ga_init_y, &
-       ga_get_y, ga_interpolate_y, ga_set_events_y
+       ga_get_y, ga_interpolate_y, ga_set_events_y, ga_set_coupling_pattern
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
@@ -576,6 +584,9 @@ module galpha
      !> g_q, g_v, f_y out of the iteration matrix
      procedure :: set_coupling => solver_set_coupling
      procedure :: set_coupling_exact => solver_set_coupling_exact
+     !> set_coupling_pattern(GA_COUPLING_G_Q or _G_V, rows, cols): where that block may be
+     !> nonzero, Fortran (1-based) numbers (GA_ERR_ARG, without a message, if the sizes differ)
+     procedure :: set_coupling_pattern => solver_set_coupling_pattern
      !> init_y(t0, q0, v0, y0): init with the initial first-order states
      procedure :: init_y => solver_init_y
      !> get_y(y, ydot) and interpolate_y(t, y, ydot): y, y' at the accepted step or inside
@@ -759,6 +770,19 @@ contains
     procedure(ga_coupling_fn) :: fn
     status = ga_set_coupling(this%handle, c_funloc(fn))
   end function solver_set_coupling
+
+  integer(c_int) function solver_set_coupling_pattern(this, which, rows, cols) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: which, rows(:), cols(:)
+    integer(c_int) :: r0(max(size(rows), 1)), c0(max(size(cols), 1))
+    if (size(rows) /= size(cols)) then
+       status = GA_ERR_ARG
+       return
+    end if
+    r0(1:size(rows)) = rows - 1
+    c0(1:size(cols)) = cols - 1
+    status = ga_set_coupling_pattern(this%handle, which, size(rows, kind=c_int), r0, c0)
+  end function solver_set_coupling_pattern
 
   integer(c_int) function solver_set_coupling_exact(this, exact) result(status)
     class(galpha_solver), intent(inout) :: this

@@ -649,7 +649,15 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         case 36: {  /* first-order states: reads, the coupling option, a late declaration */
             double t = 0.0, y[1], yd[1];
             ga_get_t(s, &t);
-            switch (pick(&md, 4)) {
+            switch (pick(&md, 5)) {
+            case 4: {  /* the rate's own patterns (g_q zero, g_v at (0, 0)), or an index too far */
+                static const int zero[1] = {0}, far[1] = {NMAX};
+                const int which = pick(&md, 3);  /* 2: unknown, refused */
+                call = "ga_set_coupling_pattern";
+                st = ga_set_coupling_pattern(s, which, which == 0 ? 0 : 1, zero,
+                                             pick(&md, 4) ? zero : far);
+                break;
+            }
             case 0: call = "ga_get_y"; changes = 0; st = ga_get_y(s, y, yd); break;
             case 1:
                 call = "ga_interpolate_y";

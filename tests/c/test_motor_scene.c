@@ -142,11 +142,56 @@ static void newton_quadratic_with_the_coupling_blocks(void **state)
     assert_true(loose[2] >= 2.0 * exact[2]);
 }
 
+/* Declared coupling patterns (g_q zero, g_v nonzero in the column of the crank speed only):
+ * the finite differences of the blocks cost one rate call for g_q and g_v instead of 2 n, and
+ * the run is the one with dense differences (the columns left out are exactly zero in those). */
+static void coupling_patterns_cut_the_rate_calls(void **state)
+{
+    (void)state;
+    g_motor = sc_motor_default();
+    double y[2][SCM_R], q[2][SC_N];
+    long long rates[2], blocks[2];
+    for (int declared = 0; declared < 2; ++declared) {
+        ga_solver *s = motor_solver(GA_INDEX3);
+        if (declared) {
+            const int rows[2] = {SCM_I, SCM_Z}, cols[2] = {SC_TH1, SC_TH1};
+            assert_int_equal(ga_set_coupling_pattern(s, GA_COUPLING_G_Q, 0, NULL, NULL), GA_OK);
+            assert_int_equal(ga_set_coupling_pattern(s, GA_COUPLING_G_V, 2, rows, cols), GA_OK);
+            assert_int_equal(ga_set_coupling_pattern(s, 2, 0, NULL, NULL), GA_ERR_ARG);
+            const int bad = SC_N;
+            assert_int_equal(ga_set_coupling_pattern(s, GA_COUPLING_G_V, 1, rows, &bad),
+                             GA_ERR_ARG);
+        }
+        start(s);
+        if (declared)
+            assert_int_equal(ga_set_coupling_pattern(s, GA_COUPLING_G_Q, 0, NULL, NULL),
+                             GA_ERR_STATE);
+        for (int i = 0; i < 200; ++i)
+            assert_int_equal(ga_step(s, 1e-3), GA_OK);
+        assert_int_equal(ga_get_y(s, y[declared], NULL), GA_OK);
+        assert_int_equal(ga_get_q(s, q[declared]), GA_OK);
+        assert_int_equal(ga_get_counter(s, GA_COUNT_RATE_EVALS, &rates[declared]), GA_OK);
+        assert_int_equal(ga_get_counter(s, GA_COUNT_COUPLING_EVALS, &blocks[declared]), GA_OK);
+        ga_free(s);
+    }
+    print_message("rate calls: %lld with dense differences, %lld with patterns (%lld and %lld "
+                  "coupling evaluations); y differs by %.1e\n",
+                  rates[0], rates[1], blocks[0], blocks[1],
+                  fmax(fabs(y[0][0] - y[1][0]), fabs(y[0][1] - y[1][1])));
+    /* the same run: the same coupling evaluations, each 2 n - 1 rate calls cheaper (g_q none,
+     * g_v one group instead of 2 n columns; g_y by r calls either way) */
+    assert_true(blocks[0] == blocks[1] && blocks[0] > 0);
+    assert_true(rates[0] - rates[1] == blocks[0] * (2 * SC_N - 1));
+    assert_memory_equal(y[0], y[1], sizeof y[0]);
+    assert_memory_equal(q[0], q[1], sizeof q[0]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(order_two_against_runge_kutta),
         cmocka_unit_test(newton_quadratic_with_the_coupling_blocks),
+        cmocka_unit_test(coupling_patterns_cut_the_rate_calls),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

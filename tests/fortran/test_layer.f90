@@ -212,6 +212,10 @@ program test_layer
   call ok(r%set_callbacks(unit_mass), 'callbacks')
   call ok(r%set_first_order(1, decay, driven), 'set_first_order')
   call ok(r%set_coupling(blocks), 'set_coupling')
+  call ok(r%set_coupling_pattern(GA_COUPLING_G_Q, [integer(c_int) ::], [integer(c_int) ::]), &
+          'set_coupling_pattern: g_q zero')
+  call expect(r%set_coupling_pattern(GA_COUPLING_G_V, [1, 1], [1]) == GA_ERR_ARG, &
+              'set_coupling_pattern checks the sizes')
   call ok(r%set_coupling_exact(.true.), 'set_coupling_exact')
   call expect(r%init(0.0d0, [0.0d0], [0.0d0]) == GA_ERR_STATE, 'init needs y0 first')
   call ok(r%init_y(0.0d0, [0.0d0], [0.0d0], [1.0d0]), 'init_y')

@@ -171,3 +171,19 @@ def test_integrate_with_states_and_an_event_on_them():
                            force_y=force_y, t_eval=[0.0, 0.25, 0.5])
     assert res.states.shape == (3, 2)
     assert np.abs(res.states[1] - exact(0.25)[2]).max() < 1e-3 * np.abs(exact(0.25)[2]).max()
+
+
+def test_coupling_patterns_give_the_same_run_with_fewer_rate_calls():
+    runs = []
+    for patterns in (None, {"g_q": ([0, 1], [1, 1]), "g_v": ([0], [1])}):
+        with solver(coupling_patterns=patterns) as s:
+            s.init(0.0, np.zeros(2), np.zeros(2), np.zeros(2))
+            for _ in range(50):
+                s.step(0.01)
+            runs.append((s.y.copy(), s.stats["rate_evals"], s.stats["coupling_evals"]))
+    (y0, rates0, blocks0), (y1, rates1, blocks1) = runs
+    assert np.array_equal(y0, y1) and blocks0 == blocks1
+    # each evaluation: 2 n = 4 columns by differences, 2 with the patterns
+    assert rates0 - rates1 == 2 * blocks0
+    with pytest.raises(ValueError, match="coupling block"):
+        solver(coupling_patterns={"f_y": ([0], [0])})

@@ -131,6 +131,7 @@ GA_INIT_PROJECT, GA_INIT_REFUSE = 0, 1
 GA_OUTPUT_CONSISTENT, GA_OUTPUT_STEP = 0, 1
 GA_EVENT_BOTH, GA_EVENT_RISING, GA_EVENT_FALLING = 0, 1, -1
 GA_EVENT_LOG = 64
+GA_COUPLING_G_Q, GA_COUPLING_G_V = 0, 1
 (GA_INFO_RCOND, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_ERROR_ESTIMATE,
  GA_INFO_H_NEXT) = 0, 1, 2, 3, 4
 COUNTERS = ("steps", "failed_steps", "newton_iters", "factorizations", "residuals",
@@ -207,6 +208,7 @@ _SIGNATURES = {
     "ga_get_y": (_I, [_S, c_double_p, c_double_p]),
     "ga_interpolate_y": (_I, [_S, _D, c_double_p, c_double_p]),
     "ga_set_events_y": (_I, [_S, _I, EVENT_Y_FN, _P(_I), _P(_I), _I]),
+    "ga_set_coupling_pattern": (_I, [_S, _I, _I, _P(_I), _P(_I)]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():

@@ -144,13 +144,15 @@ class Solver:
         ga_set_step_limits((h_min, h_max)), ga_set_formulation(galpha.GA_INDEX2_STABILIZED),
         ...).
     r, rate(t, q, v, y, ydot), force_y(t, q, v, y, f), coupling(t, q, v, y, g_q, g_v, g_y, f_y),
-    coupling_exact
+    coupling_exact, coupling_patterns
         First-order states y' = g(t, q, v, y) (ga_set_first_order): r of them, `rate` fills
         ydot (length r); `force_y`, if given, replaces `force` so that the applied forces see
         y. `coupling` optionally fills the blocks dg/dq, dg/dv (r x n), dg/dy (r x r), df/dy
         (n x r) (finite differences otherwise); coupling_exact=False leaves g_q, g_v, f_y out
-        of the iteration matrix (a measurement aid). Start with init(t0, q0, v0, y0); read
-        `y`, `ydot` and interpolate_y(t).
+        of the iteration matrix (a measurement aid); coupling_patterns={"g_q" | "g_v": (rows,
+        cols)} declares where those blocks may be nonzero (0-based; empty: zero), so that their
+        finite differences take one rate call per group of columns (ga_set_coupling_pattern).
+        Start with init(t0, q0, v0, y0); read `y`, `ydot` and interpolate_y(t).
     zero_copy : bool
         False (default): callbacks get copies of their inputs and an array of their own to
         fill, so what they keep stays valid and unchanged after the call. True: views of the
@@ -169,7 +171,7 @@ class Solver:
                  constant_mass=None, linear_solver=None, rescale=None, corrected_start=None,
                  step_limits=None, initial_step=None, output=None, patterns=None,
                  r=0, rate=None, force_y=None, coupling=None, coupling_exact=None,
-                 zero_copy=False):
+                 coupling_patterns=None, zero_copy=False):
         self._ptr = None
         self._lock = threading.RLock()  # see _serialized
         self._pending = None          # exception raised inside a callback
@@ -329,6 +331,17 @@ class Solver:
                                                 _cast(fo[1], _ffi.RATE_FN)))
             if coupling:
                 self._check(_ffi.ga_set_coupling(self._ptr, _cast(fo[2], _ffi.COUPLING_FN)))
+        for name, pattern in (coupling_patterns or {}).items():
+            blocks = {"g_q": _ffi.GA_COUPLING_G_Q, "g_v": _ffi.GA_COUPLING_G_V}
+            if name not in blocks:
+                raise ValueError(f"unknown coupling block {name!r} (g_q or g_v)")
+            rows, cols = (np.ascontiguousarray(x, dtype=np.intc).ravel() for x in pattern)
+            if rows.size != cols.size:
+                raise ValueError(f"pattern of {name}: {rows.size} rows but {cols.size} cols")
+            ip = ctypes.POINTER(ctypes.c_int)
+            self._check(_ffi.ga_set_coupling_pattern(self._ptr, blocks[name], rows.size,
+                                                     rows.ctypes.data_as(ip),
+                                                     cols.ctypes.data_as(ip)))
         if coupling_exact is not None:
             self._check(_ffi.ga_set_coupling_exact(self._ptr, int(bool(coupling_exact))))
         if rho_inf is not None:
