@@ -239,15 +239,10 @@ double Solver::first_order_error_sum(double h, double scale)
 // Cubic Hermite from y, y' at both ends of the last step, and its derivative.
 ga_status Solver::interpolate_y(double t, double *y, double *ydot)
 {
-    if (!previous_valid_)
-        return diag.fail(GA_ERR_STATE, "dense output: no step since ga_init or ga_set_state");
+    double th = 0.0, h = 0.0;
+    if (auto st = dense_output_place(t, th, h))
+        return st;
     const State &a = previous_, &b = accepted_;
-    const double h = b.t - a.t;
-    const double slack = 1e-12 * std::max(std::fabs(b.t), 1.0);
-    if (!(t >= a.t - slack && t <= b.t + slack))
-        return diag.fail(GA_ERR_ARG, "dense output: t = %.17g is outside the last step [%.17g, "
-                         "%.17g]", t, a.t, b.t);
-    const double th = std::clamp((t - a.t) / h, 0.0, 1.0);
     for (int k = 0; k < r(); ++k) {
         const double y0 = a.y[k], y1 = b.y[k], d0 = h * a.ydot[k], d1 = h * b.ydot[k];
         if (y)

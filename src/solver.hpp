@@ -120,6 +120,8 @@ public:
     // They evaluate callbacks in GA_OUTPUT_CONSISTENT, and do not touch what steps reuse.
     ga_status output_state(double *qdd, double *lambda);
     ga_status interpolate(double t, double *q, double *v, double *qdd, double *lambda);
+    // where t lies in the last step (fraction th of its size h), or the failure to report
+    ga_status dense_output_place(double t, double &th, double &h);
     // Allocates the workspace of consistent output if the solver's workspace exists and it
     // does not yet; throws std::bad_alloc.
     void setup_output();

@@ -693,6 +693,27 @@ contains
     status = ga_set_tangents(this%handle, k, d)
   end function solver_set_tangents
 
+  ! The C arrays of set_events and set_events_y: terminal flags (all terminal when absent) and
+  ! the multipliers flag; ok false if terminal and direction differ in size.
+  subroutine event_flags(direction, terminal, with_multipliers, flags, lam, ok)
+    integer(c_int), intent(in) :: direction(:)
+    logical, intent(in), optional :: terminal(:), with_multipliers
+    integer(c_int), intent(out) :: flags(:), lam
+    logical, intent(out) :: ok
+    lam = 0
+    if (present(with_multipliers)) then
+       if (with_multipliers) lam = 1
+    end if
+    flags = 1
+    ok = .true.
+    if (present(terminal)) then
+       ok = size(terminal) == size(direction)
+       if (.not. ok) return
+       flags = 0
+       where (terminal) flags(1:size(terminal)) = 1
+    end if
+  end subroutine event_flags
+
   integer(c_int) function solver_set_events(this, fn, direction, terminal, with_multipliers) &
        result(status)
     class(galpha_solver), intent(inout) :: this
@@ -700,21 +721,11 @@ contains
     integer(c_int), intent(in) :: direction(:)
     logical, intent(in), optional :: terminal(:), with_multipliers
     integer(c_int) :: flags(max(size(direction), 1)), lam
+    logical :: ok
     status = GA_ERR_ARG
-    lam = 0
-    if (present(with_multipliers)) then
-       if (with_multipliers) lam = 1
-    end if
-    if (present(terminal)) then
-       if (size(terminal) /= size(direction)) return
-       flags = 0
-       where (terminal) flags(1:size(terminal)) = 1
-       status = ga_set_events(this%handle, size(direction, kind=c_int), c_funloc(fn), &
-            direction, flags, lam)
-    else
-       status = ga_set_events(this%handle, size(direction, kind=c_int), c_funloc(fn), &
-            direction, with_multipliers=lam)
-    end if
+    call event_flags(direction, terminal, with_multipliers, flags, lam, ok)
+    if (ok) status = ga_set_events(this%handle, size(direction, kind=c_int), c_funloc(fn), &
+         direction, flags, lam)
   end function solver_set_events
 
   integer(c_int) function solver_set_events_y(this, fn, direction, terminal, with_multipliers) &
@@ -724,18 +735,10 @@ contains
     integer(c_int), intent(in) :: direction(:)
     logical, intent(in), optional :: terminal(:), with_multipliers
     integer(c_int) :: flags(max(size(direction), 1)), lam
+    logical :: ok
     status = GA_ERR_ARG
-    lam = 0
-    if (present(with_multipliers)) then
-       if (with_multipliers) lam = 1
-    end if
-    flags = 1  ! all terminal unless said
-    if (present(terminal)) then
-       if (size(terminal) /= size(direction)) return
-       flags = 0
-       where (terminal) flags(1:size(terminal)) = 1
-    end if
-    status = ga_set_events_y(this%handle, size(direction, kind=c_int), c_funloc(fn), &
+    call event_flags(direction, terminal, with_multipliers, flags, lam, ok)
+    if (ok) status = ga_set_events_y(this%handle, size(direction, kind=c_int), c_funloc(fn), &
          direction, flags, lam)
   end function solver_set_events_y
 
