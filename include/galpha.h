@@ -643,8 +643,9 @@ typedef int (*ga_coupling_fn)(double t, const double *q, const double *v, const 
 /** Declare r >= 0 first-order states, before the first ga_init or ga_init_y (they size the
  *  workspace). rate is required when r > 0; force (may be NULL) then replaces the force
  *  callback of ga_set_callbacks, so that the applied forces see y. Both receive the user
- *  pointer of ga_set_callbacks. r = 0 removes them. Errors: GA_ERR_ARG (r < 0, rate NULL with
- *  r > 0), GA_ERR_STATE (after the solver was set up by ga_init or ga_set_state). */
+ *  pointer of ga_set_callbacks. r = 0 removes them; coupling patterns declared before are
+ *  dropped. Errors: GA_ERR_ARG (r < 0, rate NULL with r > 0), GA_ERR_STATE (after the solver
+ *  was set up by ga_init or ga_set_state, or after ga_set_events_y). */
 GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga_rate_fn rate);
 
 /** The coupling blocks by a callback (NULL: forward differences, r force and 2 n + r rate calls
@@ -694,7 +695,8 @@ GA_API ga_status ga_interpolate_y(const ga_solver *s, double t, double *y, doubl
 typedef int (*ga_event_y_fn)(double t, const double *q, const double *v, const double *y,
                              const double *lambda, double *g, void *user);
 /** ga_set_events with functions of y as well (inside a step y comes from ga_interpolate_y);
- *  replaces the functions of ga_set_events, and the reverse. Errors: as ga_set_events. */
+ *  replaces the functions of ga_set_events, and the reverse. Errors: as ga_set_events;
+ *  GA_ERR_STATE (functions given before ga_set_first_order with r > 0). */
 GA_API ga_status ga_set_events_y(ga_solver *s, int count, ga_event_y_fn fn, const int *direction,
                                  const int *terminal, int with_multipliers);
 /**@}*/
