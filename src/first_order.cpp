@@ -119,8 +119,7 @@ ga_status Solver::first_order_schur(double h, const NewtonCoefficients &c)
     const double c1 = first_order_newton_coefficient(params1, h);
     C1_ = -blocks_.g_y;
     C1_.diagonal().array() += c1;
-    const bool coupled = coupling_exact && model.cb.force_y != nullptr;
-    for (int k = 0; k < r1 && coupled; ++k) {
+    for (int k = 0; k < r1 && forces_see_y(); ++k) {
         z_rhs_ = blocks_.f_y.col(k);
         if (index2)
             S2_.solve(z_rhs_, z_zero_, z_zero_, params, h, B_, z_d_, z_w_, z_l_, z_e_);
@@ -163,7 +162,7 @@ void Solver::first_order_correction(const NewtonCoefficients &c, Vec &dw)
         z_y_ += gx_;
     }
     dy_ = C1_lu_.solve(z_y_);
-    if (!(coupling_exact && model.cb.force_y != nullptr))
+    if (!forces_see_y())
         return;
     dq_.noalias() -= Zq_ * dy_;
     dlambda_.noalias() -= Zl_ * dy_;

@@ -205,6 +205,8 @@ private:
     void first_order_start(double h);
     void predict_first_order(double h);
     ga_status first_order_matrix(double t, const State &x);
+    // The mechanical update depends on dy: f_y is in the Newton system (Z = Sol(f_y) != 0).
+    bool forces_see_y() const { return coupling_exact && model.cb.force_y != nullptr; }
     ga_status first_order_schur(double h, const NewtonCoefficients &c);
     void first_order_correction(const NewtonCoefficients &c, Vec &dw);
     void update_first_order(const NewtonCoefficients &c, double h, State &x, UpdateSizes &size);
