@@ -702,6 +702,56 @@ GA_API ga_status ga_set_events_y(ga_solver *s, int count, ga_event_y_fn fn, cons
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */
+/** @name Forward sensitivities
+ *  Derivatives of the discrete solution with respect to np parameters p (docs/algorithms.md
+ *  sec. 13): after each accepted step, dq/dp_j, dv/dp_j, dqdd/dp_j and dlambda/dp_j of that
+ *  step's own q, v, qdd and lambda -- the derivative of what galpha computes (with the step
+ *  sizes held fixed as inputs), not of the exact solution. The iteration matrix is factorized
+ *  again at each converged step (the next step's Newton iteration starts with it); each
+ *  parameter then costs one solve and the parameter derivatives of the residual. Exact to
+ *  round-off with exact tangents (ga_set_tangents); with finite-difference tangents, to their
+ *  precision. */
+/**@{*/
+/** What depends on the parameters (flags, or-ed). The others are taken as independent of p:
+ *  their derivatives are not evaluated. */
+typedef enum ga_depends {
+    GA_DEPENDS_FORCE = 1, /**< the applied forces f */
+    GA_DEPENDS_MASS = 2   /**< the mass matrix M (not with ga_set_constant_mass) */
+} ga_depends;
+
+/** df/dp_j at (t, q, v) into f_p (length n), for parameter j (0-based). */
+typedef int (*ga_force_p_fn)(double t, const double *q, const double *v, int j, double *f_p,
+                             void *user);
+/** (dM/dp_j)(q) a into out (length n). */
+typedef int (*ga_mass_p_fn)(double t, const double *q, int j, const double *a, double *out,
+                            void *user);
+
+/** Forward sensitivities with respect to p[0 .. np-1], before ga_init (they start there: q0
+ *  and v0 are taken as independent of p, qdd0 and lambda0 follow from them). p is the array
+ *  the callbacks read through their user pointer: without derivative callbacks galpha
+ *  perturbs its entries in place (central differences, restored bit for bit before any call
+ *  returns), and it must stay valid while the solver lives. p_scale (may be NULL: |p_j|, or 1
+ *  where p_j = 0) sets the size of those perturbations, cbrt(eps) p_scale[j]. depends is an
+ *  or of ::ga_depends. np = 0 turns sensitivities off. Errors: GA_ERR_ARG (np < 0, p NULL
+ *  with np > 0, a p_scale entry not positive and finite, unknown flags, GA_DEPENDS_MASS with
+ *  a constant mass), GA_ERR_STATE (after ga_init; with first-order states), GA_ERR_NOMEM. */
+GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const double *p_scale,
+                                    int depends);
+
+/** Derivative callbacks (either may be NULL: central differences in p). Errors: GA_ERR_STATE
+ *  (from a callback). */
+GA_API ga_status ga_set_parameter_derivatives(ga_solver *s, ga_force_p_fn force_p,
+                                              ga_mass_p_fn mass_p);
+
+/** The sensitivities of the accepted step with respect to p_j (lengths n, n, n, m; any pointer
+ *  may be NULL). qdd and lambda are the step's own (GA_OUTPUT_STEP), whatever ga_set_output
+ *  says. Errors: GA_ERR_ARG (j out of range), GA_ERR_STATE (before ga_init, or no
+ *  sensitivities). */
+GA_API ga_status ga_get_sensitivity(const ga_solver *s, int j, double *dq, double *dv,
+                                    double *dqdd, double *dlambda);
+/**@}*/
+
+/* ------------------------------------------------------------------------------------------ */
 /** @name Consistent start */
 /**@{*/
 /** Optional callback for the constraint acceleration term (finite differences of Phi_q and Phi

@@ -374,6 +374,9 @@ GA_API ga_status ga_set_constant_mass(ga_solver *s, int on)
     return guarded(s, [&](ga::Solver &c) {
         if (on != 0 && on != 1)
             return c.diag.fail(GA_ERR_ARG, "constant mass must be 0 or 1, got %d", on);
+        if (on == 1 && c.sens.active() && (c.sens.depends & GA_DEPENDS_MASS))
+            return c.diag.fail(GA_ERR_STATE, "the mass matrix depends on the sensitivity "
+                               "parameters (GA_DEPENDS_MASS): it is not constant");
         return change_tangents(c, [&] { c.model.constant_mass = on == 1; });
     });
 }
@@ -670,6 +673,9 @@ GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga
         if (c.events().fn_y())
             return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after ga_set_events_y: the "
                                "event functions take the states declared before them");
+        if (r > 0 && c.sens.active())
+            return c.diag.fail(GA_ERR_STATE, "first-order states with sensitivities are not "
+                               "built yet (ga_set_sensitivity)");
         c.set_first_order(r);  // may throw std::bad_alloc before anything below changed
         c.model.cb.force_y = r > 0 ? force : nullptr;
         c.model.cb.rate = r > 0 ? rate : nullptr;
@@ -730,6 +736,59 @@ GA_API ga_status ga_init_y(ga_solver *s, double t0, const double *q0, const doub
         if (!c.model.ready())
             return c.diag.fail(GA_ERR_STATE, "ga_init_y before ga_set_callbacks");
         return c.init_y(t0, q0, v0, y0);
+    });
+}
+
+GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const double *p_scale,
+                                    int depends)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (np < 0)
+            return c.diag.fail(GA_ERR_ARG, "np = %d parameters: must be >= 0", np);
+        if (np > 0 && !p)
+            return c.diag.fail(GA_ERR_ARG, "np = %d parameters and p is NULL", np);
+        if ((depends & ~(GA_DEPENDS_FORCE | GA_DEPENDS_MASS)) != 0)
+            return c.diag.fail(GA_ERR_ARG, "unknown dependence flags 0x%x", static_cast<unsigned>(depends));
+        for (int j = 0; p && j < np; ++j)
+            if (!std::isfinite(p[j]))
+                return c.diag.fail(GA_ERR_ARG, "p[%d] is not finite", j);
+        for (int j = 0; p_scale && j < np; ++j)
+            if (!(p_scale[j] > 0.0) || !std::isfinite(p_scale[j]))
+                return c.diag.fail(GA_ERR_ARG, "p_scale[%d] = %g: must be positive and finite", j,
+                                   p_scale[j]);
+        if ((depends & GA_DEPENDS_MASS) && c.model.constant_mass)
+            return c.diag.fail(GA_ERR_ARG, "a mass matrix that depends on the parameters is not "
+                               "constant (ga_set_constant_mass)");
+        if (c.initialized())
+            return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity after ga_init: sensitivities "
+                               "start at ga_init");
+        if (c.r() > 0 && np > 0)
+            return c.diag.fail(GA_ERR_STATE, "sensitivities with first-order states are not "
+                               "built yet");
+        return c.set_sensitivity(np, p, p_scale, depends);
+    });
+}
+
+GA_API ga_status ga_set_parameter_derivatives(ga_solver *s, ga_force_p_fn force_p,
+                                              ga_mass_p_fn mass_p)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        c.model.cb.force_p = force_p;
+        c.model.cb.mass_p = mass_p;
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_get_sensitivity(const ga_solver *s, int j, double *dq, double *dv,
+                                    double *dqdd, double *dlambda)
+{
+    return reading(s, "ga_get_sensitivity", "j is not the index of a parameter",
+                   [&](const ga::Solver &c) {
+        if (!c.initialized() || !c.sens.active())
+            return GA_ERR_STATE;
+        if (j < 0 || j >= c.sens.np)
+            return GA_ERR_ARG;
+        return c.get_sensitivity(j, dq, dv, dqdd, dlambda);
     });
 }
 

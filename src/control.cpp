@@ -165,6 +165,11 @@ ga_status Solver::adaptive_step(double t_stop)
             const double err = error_norm(h);
             control.err_last = err;
             if (err <= 1.0) {
+                if (auto st2 = sensitivity_step(h)) {  // of the accepted step only
+                    count(counters, GA_COUNT_FAILED_STEPS);
+                    invalidate_jacobian();
+                    return st2;
+                }
                 const double h_prev = accepted_.h_last;  // the accepted step before this one
                 commit(land, t_stop);
                 // Predictive controller (Gustafsson, as in Radau5 and SciPy's Radau; k = 3 for

@@ -107,6 +107,9 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
 
     if (r() > 0)
         model.y_now = &x.y;  // start() callers put y0 into trial_.y
+    if (sens.active())  // first: differences leave the matrices at a perturbed p
+        if (auto st = sensitivity_start(x))
+            return st;
     if (auto st = consistent_accelerations(t0, x.q, x.v, x.qdd, x.lambda)) {
         diag.append(" (consistent initial accelerations at t0 = %.17g)", t0);
         return st;
@@ -123,6 +126,7 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
     x.a_prev = x.a;
 
     accepted_.swap(trial_);
+    sens.accepted.swap(sens.trial);
     ++state_id_;
     initialized_ = true;
     previous_valid_ = false;

@@ -23,6 +23,14 @@ double fd_increment(double x)
     const double xp = x + e;
     return xp - x;
 }
+
+// Central differences: error O(e^2) + O(eps / e), smallest near e = eps^(1/3).
+double central_increment(double x)
+{
+    const double e = std::cbrt(kEps) * std::max(std::fabs(x), 1.0);
+    const double xp = x + e;
+    return xp - x;
+}
 }  // namespace
 
 // Built aside and moved in at the end: out of memory half way must not leave a grouping that
@@ -104,6 +112,8 @@ void Model::allocate_workspace(const ModelMatrix &M, const ModelMatrix &J, const
     v_pert_.setZero(n_);
     f_pert_.setZero(n_);
     r_pert_.setZero(n_);
+    r_minus_.setZero(n_);
+    f_minus_.setZero(n_);
     step_.setZero(n_);
     phi_plus_.setZero(m_);
     phi_minus_.setZero(m_);
@@ -197,6 +207,26 @@ ga_status Model::force(double t, const Vec &q, const Vec &v, Vec &f, Check check
     return check == Check::Now ? check_finite(f.data(), n_, 0, "force f", t) : GA_OK;
 }
 
+ga_status Model::force_p(double t, const Vec &q, const Vec &v, int j, Vec &out)
+{
+    count(counters_, GA_COUNT_FORCE_EVALS);
+    if (auto st = callback_status(
+            user([&] { return cb.force_p(t, q.data(), v.data(), j, out.data(), cb.user); }),
+            "force_p", t))
+        return st;
+    return check_finite(out.data(), n_, 0, "df/dp", t);
+}
+
+ga_status Model::mass_p(double t, const Vec &q, int j, const Vec &a, Vec &out)
+{
+    count(counters_, GA_COUNT_MASS_EVALS);
+    if (auto st = callback_status(
+            user([&] { return cb.mass_p(t, q.data(), j, a.data(), out.data(), cb.user); }),
+            "mass_p", t))
+        return st;
+    return check_finite(out.data(), n_, 0, "(dM/dp) a", t);
+}
+
 ga_status Model::constraint(double t, const Vec &q, Vec &phi)
 {
     if (m_ == 0)
@@ -234,18 +264,25 @@ ga_status Model::check_deferred(double t, const Vec &f, const ModelMatrix &J)
 // the whole block is one directional difference of Phi_q along (v, 1) in (q, t), which also
 // takes in Phi_qt = d(Phi_t)/dq for rheonomic constraints.
 ga_status Model::velocity_constraint_tangent(double t, const Vec &q, const Vec &v,
-                                             const ModelMatrix &J, ModelMatrix &Z)
+                                             const ModelMatrix &J, ModelMatrix &Z,
+                                             bool central)
 {
     const double q_scale = std::max(q.lpNorm<Eigen::Infinity>(), 1.0);
-    const double e = std::sqrt(std::numeric_limits<double>::epsilon()) * q_scale /
+    const double e = (central ? std::cbrt(kEps) : std::sqrt(kEps)) * q_scale /
                      std::max(v.lpNorm<Eigen::Infinity>(), 1.0);
     q_pert_ = q + e * v;
     if (auto st = jacobian(t + e, q_pert_, Z))
         return st;
-    const double *j = J.data();
+    if (central) {
+        q_pert_ = q - e * v;
+        if (auto st = jacobian(t - e, q_pert_, J_pert_))
+            return st;
+    }
+    const double *j = central ? J_pert_.data() : J.data();
+    const double span = central ? 2.0 * e : e;
     double *z = Z.data();
     for (Eigen::Index k = 0; k < Z.size(); ++k)
-        z[k] = (z[k] - j[k]) / e;
+        z[k] = (z[k] - j[k]) / span;
     return GA_OK;
 }
 
@@ -278,7 +315,8 @@ ga_status Model::perturbed_residual(double t, const Vec &qp, const Vec &v, const
 }
 
 ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
-                           const Vec &lambda, const Vec &rq, const ModelMatrix &M, ModelMatrix &K)
+                           const Vec &lambda, const Vec &rq, const ModelMatrix &M, ModelMatrix &K,
+                           bool central)
 {
     count(counters_, GA_COUNT_STIFFNESS_EVALS);
     if (cb.stiffness && tangent_mode == GA_TANGENT_AUTO) {
@@ -294,11 +332,18 @@ ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
     if (K.dense()) {
         auto Kd = K.as_dense();
         for (int j = 0; j < n_; ++j) {
-            const double e = fd_increment(q[j]);
+            const double e = central ? central_increment(q[j]) : fd_increment(q[j]);
             q_pert_[j] = q[j] + e;
             if (auto st = perturbed_residual(t, q_pert_, v, qdd, lambda, M, r_pert_))
                 return st;
-            Kd.col(j) = (r_pert_ - rq) / e;
+            if (central) {
+                q_pert_[j] = q[j] - e;
+                if (auto st = perturbed_residual(t, q_pert_, v, qdd, lambda, M, r_minus_))
+                    return st;
+                Kd.col(j) = (r_pert_ - r_minus_) / (2.0 * e);
+            } else {
+                Kd.col(j) = (r_pert_ - rq) / e;
+            }
             q_pert_[j] = q[j];
         }
         return GA_OK;
@@ -311,14 +356,22 @@ ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
     for (int g = 0; g < k_groups_.count(); ++g) {
         for (int p = k_groups_.start[g]; p < k_groups_.start[g + 1]; ++p) {
             const int j = k_groups_.cols[p];
-            step_[j] = fd_increment(q[j]);
+            step_[j] = central ? central_increment(q[j]) : fd_increment(q[j]);
             q_pert_[j] = q[j] + step_[j];
         }
         if (auto st = perturbed_residual(t, q_pert_, v, qdd, lambda, M, r_pert_))
             return st;
+        if (central) {
+            for (int p = k_groups_.start[g]; p < k_groups_.start[g + 1]; ++p)
+                q_pert_[k_groups_.cols[p]] = q[k_groups_.cols[p]] - step_[k_groups_.cols[p]];
+            if (auto st = perturbed_residual(t, q_pert_, v, qdd, lambda, M, r_minus_))
+                return st;
+        }
+        const Vec &base = central ? r_minus_ : rq;
+        const double span = central ? 2.0 : 1.0;
         for (int p = k_groups_.entry_start[g]; p < k_groups_.entry_start[g + 1]; ++p) {
             const int k = k_groups_.entries[p];
-            K.data()[k] = (r_pert_[ri[k]] - rq[ri[k]]) / step_[ci[k]];
+            K.data()[k] = (r_pert_[ri[k]] - base[ri[k]]) / (span * step_[ci[k]]);
         }
         for (int p = k_groups_.start[g]; p < k_groups_.start[g + 1]; ++p)
             q_pert_[k_groups_.cols[p]] = q[k_groups_.cols[p]];
@@ -326,7 +379,8 @@ ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
     return GA_OK;
 }
 
-ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, ModelMatrix &C)
+ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, ModelMatrix &C,
+                         bool central)
 {
     count(counters_, GA_COUNT_DAMPING_EVALS);
     if (cb.damping && tangent_mode == GA_TANGENT_AUTO) {
@@ -343,11 +397,18 @@ ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, Mod
     if (C.dense()) {
         auto Cd = C.as_dense();
         for (int j = 0; j < n_; ++j) {
-            const double e = fd_increment(v[j]);
+            const double e = central ? central_increment(v[j]) : fd_increment(v[j]);
             v_pert_[j] = v[j] + e;
             if (auto st = force(t, q, v_pert_, f_pert_))
                 return st;
-            Cd.col(j) = -(f_pert_ - f) / e;
+            if (central) {
+                v_pert_[j] = v[j] - e;
+                if (auto st = force(t, q, v_pert_, f_minus_))
+                    return st;
+                Cd.col(j) = -(f_pert_ - f_minus_) / (2.0 * e);
+            } else {
+                Cd.col(j) = -(f_pert_ - f) / e;
+            }
             v_pert_[j] = v[j];
         }
         return GA_OK;
@@ -360,14 +421,22 @@ ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, Mod
     for (int g = 0; g < c_groups_.count(); ++g) {
         for (int p = c_groups_.start[g]; p < c_groups_.start[g + 1]; ++p) {
             const int j = c_groups_.cols[p];
-            step_[j] = fd_increment(v[j]);
+            step_[j] = central ? central_increment(v[j]) : fd_increment(v[j]);
             v_pert_[j] = v[j] + step_[j];
         }
         if (auto st = force(t, q, v_pert_, f_pert_))
             return st;
+        if (central) {
+            for (int p = c_groups_.start[g]; p < c_groups_.start[g + 1]; ++p)
+                v_pert_[c_groups_.cols[p]] = v[c_groups_.cols[p]] - step_[c_groups_.cols[p]];
+            if (auto st = force(t, q, v_pert_, f_minus_))
+                return st;
+        }
+        const Vec &base = central ? f_minus_ : f;
+        const double span = central ? 2.0 : 1.0;
         for (int p = c_groups_.entry_start[g]; p < c_groups_.entry_start[g + 1]; ++p) {
             const int k = c_groups_.entries[p];
-            C.data()[k] = -(f_pert_[ri[k]] - f[ri[k]]) / step_[ci[k]];
+            C.data()[k] = -(f_pert_[ri[k]] - base[ri[k]]) / (span * step_[ci[k]]);
         }
         for (int p = c_groups_.start[g]; p < c_groups_.start[g + 1]; ++p)
             v_pert_[c_groups_.cols[p]] = v[c_groups_.cols[p]];

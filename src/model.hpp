@@ -28,6 +28,9 @@ struct Callbacks {
     ga_force_y_fn force_y = nullptr;
     ga_rate_fn rate = nullptr;
     ga_coupling_fn coupling = nullptr;
+    // parameter derivatives (ga_set_parameter_derivatives)
+    ga_force_p_fn force_p = nullptr;
+    ga_mass_p_fn mass_p = nullptr;
     void *user = nullptr;
 };
 
@@ -121,15 +124,23 @@ public:
     ga_status check_deferred(double t, const Vec &f, const ModelMatrix &J);
     // Z = d/dq (Phi_q(q, t) v + Phi_t(q, t)), the curvature block of the index-2 velocity
     // constraint, from J = Phi_q(q, t) and one more Jacobian evaluation (layout of J).
+    // central: differences on both sides (error O(eps^(2/3)) instead of O(eps^(1/2)), twice
+    // the evaluations), here and for K_t and C_t below.
     ga_status velocity_constraint_tangent(double t, const Vec &q, const Vec &v,
-                                          const ModelMatrix &J, ModelMatrix &Z);
+                                          const ModelMatrix &J, ModelMatrix &Z,
+                                          bool central = false);
 
     // K_t = d r^q / dq at fixed v, qdd, lambda. rq is r^q at q, M the mass matrix at q (both
     // used by finite differences; with a constant mass M is not evaluated again).
     ga_status stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd, const Vec &lambda,
-                        const Vec &rq, const ModelMatrix &M, ModelMatrix &K);
+                        const Vec &rq, const ModelMatrix &M, ModelMatrix &K,
+                        bool central = false);
     // C_t = -df/dv. f is f(q, v, t) (used by finite differences).
-    ga_status damping(double t, const Vec &q, const Vec &v, const Vec &f, ModelMatrix &C);
+    ga_status damping(double t, const Vec &q, const Vec &v, const Vec &f, ModelMatrix &C,
+                      bool central = false);
+    // df/dp_j, and (dM/dp_j) a, by the callbacks of ga_set_parameter_derivatives.
+    ga_status force_p(double t, const Vec &q, const Vec &v, int j, Vec &out);
+    ga_status mass_p(double t, const Vec &q, int j, const Vec &a, Vec &out);
     // Phi_qq(v, v) + 2 Phi_qt v + Phi_tt.
     ga_status constraint_accel(double t, const Vec &q, const Vec &v, Vec &out);
     // Phi_t: the callback, or extrapolated central differences in t (exactly zero for
@@ -183,7 +194,8 @@ private:
     Counters &counters_;
     Diagnostics &diag_;
     // finite-difference scratch
-    Vec q_pert_, v_pert_, f_pert_, r_pert_, phi_plus_, phi_minus_, g_plus_, g_minus_, step_;
+    Vec q_pert_, v_pert_, f_pert_, r_pert_, r_minus_, f_minus_, phi_plus_, phi_minus_, g_plus_,
+        g_minus_, step_;
     int r_ = 0;
     Vec y_pert_, rate_pert_;  // first-order differences
     ColumnGroups g_q_groups_, g_v_groups_;

@@ -230,6 +230,9 @@ ga_status Solver::setup_workspace()
     c_.setZero(m_);
     qdd_tmp_.setZero(n_);
     lambda_tmp_.setZero(m_);
+    eta_total_.setZero(m_);
+    if (sens.active())
+        sens.allocate_matrices(M_, J_);
     if (r() > 0) {
         const int r1 = r();
         blocks_.allocate(n_, r1);
@@ -327,7 +330,9 @@ ga_status Solver::take_step(double h)
                 count(c, GA_COUNT_FAILED_STEPS);
         }
     } failed{counters};
-    const ga_status st = attempt_step(h, newton_tolerance(false), true);
+    ga_status st = attempt_step(h, newton_tolerance(false), true);
+    if (!st)
+        st = sensitivity_step(h);
     if (st != GA_OK) {
         // Whatever went wrong, the next attempt starts from a fresh iteration matrix.
         invalidate_jacobian();
@@ -351,6 +356,7 @@ void Solver::undo_step(const StepUndo &u)
 {
     previous_.swap(trial_);  // commit's swaps, backwards
     accepted_.swap(trial_);
+    sens.accepted.swap(sens.trial);
     previous_valid_ = u.previous_valid;
     start_pending_ = u.start_pending;
     if (u.adaptive)
@@ -364,6 +370,7 @@ void Solver::undo_step(const StepUndo &u)
 
 void Solver::commit(bool land_on, double t_land)
 {
+    sens.accepted.swap(sens.trial);  // (empty without sensitivities)
     accepted_.swap(trial_);    // the new step becomes the state ...
     previous_.swap(trial_);    // ... and the old one the start of the interval for dense output
     if (land_on)
@@ -384,44 +391,26 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     const State &s = accepted_;
     const double short_limit = s.h_last / kShortStepRatio;
     const bool short_step = s.h_last > 0.0 && h < short_limit;
-    if (sliver_allowed && short_step && s.sliver_span + h <= short_limit)
+    if (sliver_allowed && short_step && s.sliver_span + h <= short_limit) {
+        if (sens.active()) {
+            sens.step_done = false;
+            if (auto st = sensitivity_by_differences(h, true, false))
+                return st;
+        }
         return sliver_step(h);
+    }
     // Short steps beyond a sliver's span are the caller's new step size: Algorithm 1 again,
     // started afresh from the consistent state the slivers left (Taylor steps do not last).
     const bool restart_short = short_step && s.sliver_span > 0.0;
-    // The start of the step. a_n carries the shift delta_alpha h_last; rescaled to the h of
-    // this step the scheme stays second order under any sequence of step sizes (docs/algorithms.md
-    // sec. 1.2): a_n <- qdd_n + (h / h_last) (a_n - qdd_n).
-    a_start_ = &s.a;
-    v_start_ = &s.v;
-    qdd_start_ = &s.qdd;
-    lambda_start_ = &s.lambda;
-    const bool long_after_short = s.h_last > 0.0 && h > kShortStepRatio * s.h_last;
-    fresh_start_ = start_pending_ || long_after_short || restart_short;
-    model.y_now = &s.y;  // the forces the start's own evaluations see
-    if (long_after_short) {
-        if (auto st = consistent_accelerations(s.t, s.q, s.v, qdd_n_, lambda_n_)) {
-            diag.append(" (start of a step %g times longer than the one before)", h / s.h_last);
-            return st;
-        }
-        qdd_start_ = &qdd_n_;
-        lambda_start_ = &lambda_n_;
-    }
-    if (fresh_start_ && corrected_start) {
-        if (auto st = starting_values(h))  // sets a_start_ and, in index 3, v_start_
-            return st;
-    } else if (fresh_start_) {
-        a_start_ = qdd_start_;
-    } else if (rescale_a && s.h_last > 0.0 && h != s.h_last) {
-        a_n_ = s.qdd + (h / s.h_last) * (s.a - s.qdd);
-        a_start_ = &a_n_;
-    }
-    if (r() > 0) {
-        if (fresh_start_ && corrected_start)
-            if (auto st = first_order_starting_values(h))
+    if (sens.active()) {  // sensitivity.cpp: starts that are not the linear map, by differences
+        sens.start_given = false;
+        sens.step_done = false;
+        if (start_pending_ || long_after_short(h) || restart_short)
+            if (auto st = sensitivity_by_differences(h, false, restart_short))
                 return st;
-        first_order_start(h);
     }
+    if (auto st = prepare_start(h, restart_short))
+        return st;
 
     // After a reused matrix was too slow, the next steps start with a fresh one; how many
     // doubles with every failed attempt to reuse (up to 32) and resets when reuse works.
@@ -515,6 +504,45 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     x.sliver_span = 0.0;
     if (convergence_.rate() >= 0.0)
         theta_prev_ = convergence_.rate();
+    return GA_OK;
+}
+
+ga_status Solver::prepare_start(double h, bool restart_short)
+{
+    const State &s = accepted_;
+    // The start of the step. a_n carries the shift delta_alpha h_last; rescaled to the h of
+    // this step the scheme stays second order under any sequence of step sizes (docs/algorithms.md
+    // sec. 1.2): a_n <- qdd_n + (h / h_last) (a_n - qdd_n).
+    a_start_ = &s.a;
+    v_start_ = &s.v;
+    qdd_start_ = &s.qdd;
+    lambda_start_ = &s.lambda;
+    const bool long_after_short = this->long_after_short(h);
+    fresh_start_ = start_pending_ || long_after_short || restart_short;
+    model.y_now = &s.y;  // the forces the start's own evaluations see
+    if (long_after_short) {
+        if (auto st = consistent_accelerations(s.t, s.q, s.v, qdd_n_, lambda_n_)) {
+            diag.append(" (start of a step %g times longer than the one before)", h / s.h_last);
+            return st;
+        }
+        qdd_start_ = &qdd_n_;
+        lambda_start_ = &lambda_n_;
+    }
+    if (fresh_start_ && corrected_start) {
+        if (auto st = starting_values(h))  // sets a_start_ and, in index 3, v_start_
+            return st;
+    } else if (fresh_start_) {
+        a_start_ = qdd_start_;
+    } else if (rescale_a && s.h_last > 0.0 && h != s.h_last) {
+        a_n_ = s.qdd + (h / s.h_last) * (s.a - s.qdd);
+        a_start_ = &a_n_;
+    }
+    if (r() > 0) {
+        if (fresh_start_ && corrected_start)
+            if (auto st = first_order_starting_values(h))
+                return st;
+        first_order_start(h);
+    }
     return GA_OK;
 }
 
@@ -728,6 +756,8 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
                          "predicted Newton iterate is not finite in the step from t = %.17g "
                          "with h = %g",
                          s.t, h);
+    if (index2 && sens.active())
+        eta_total_.setZero();  // the predictor's eta_bar
     if (index2 && m_ > 0) {
         // B = Phi_q(q_n): the direction of the position correction -h B^T eta (sec. 2.1)
         if (auto st = model.jacobian(s.t, s.q, B_))
@@ -796,6 +826,8 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
             // dw_: the Newmark part of the update, dq + B^T deta
             S2_.solve(rq_, phi_, phi_v_, p, h, B_, dq_, dw_, dlambda_, deta_);
             dw = &dw_;
+            if (sens.active())
+                eta_total_ += deta_;
         } else {
             S_.solve(rq_, phi_, dq_, dlambda_, row_scale);
         }

@@ -12,6 +12,7 @@
 #include "model.hpp"
 #include "newton.hpp"
 #include "params.hpp"
+#include "sensitivity.hpp"
 
 namespace ga {
 
@@ -126,6 +127,12 @@ public:
     // does not yet; throws std::bad_alloc.
     void setup_output();
 
+    // Forward sensitivities (sensitivity.cpp): the C API validated the arguments; allocates
+    // (std::bad_alloc leaves the set before).
+    Sensitivities sens;
+    ga_status set_sensitivity(int np, double *p, const double *p_scale, int depends);
+    ga_status get_sensitivity(int j, double *dq, double *dv, double *dqdd, double *dlambda) const;
+
     // Events (events.cpp): the functions watched, where their search stands, the last log.
     EventSet &events() { return events_; }
     const EventSet &events() const { return events_; }
@@ -213,6 +220,24 @@ private:
     void finish_first_order(State &x);
     ga_status first_order_starting_values(double h);
     double first_order_error_sum(double h, double scale);
+    // The start of a step from accepted_ (a_start_, v_start_, qdd_start_, lambda_start_ and
+    // fresh_start_): rescaled, corrected, or consistent again after short steps.
+    ga_status prepare_start(double h, bool restart_short);
+    bool long_after_short(double h) const
+    {
+        return accepted_.h_last > 0.0 && h > kShortStepRatio * accepted_.h_last;
+    }
+    // sensitivity.cpp
+    template <class Perturb, class Evaluate>
+    ga_status central_difference(int j, Perturb &&perturb, Evaluate &&evaluate, double &span);
+    ga_status sensitivity_start(const State &x);
+    static void shift_state(const State &from, const StateDerivative &s, double shift, State &to);
+    ga_status sensitivity_by_differences(double h, bool taylor_step, bool restart_short);
+    ga_status parameter_residual(int j, double t, const State &x);
+    ga_status correction_derivative(const Vec &s);
+    ga_status sensitivity_step(double h);
+    State sens_scratch_;  // the accepted state while a perturbed one takes its place
+    Vec eta_total_;       // index 2: the converged step's eta_bar (sum of its increments)
     ga_status factorize(double t, const State &x, double h, bool tangents_K, bool tangents_C,
                         bool tangent_Z, int iter);
     ga_status rebuild_matrix();  // checkpoint.cpp: the kept matrix again, from recipe_

@@ -1,0 +1,370 @@
+// Forward sensitivities: the derivative of the discrete map of one step (docs/algorithms.md
+// sec. 13). A converged step solves R(x_{n+1}, x_n, p) = 0; its derivative
+//     R_{x_{n+1}} s_{n+1} = -R_{x_n} s_n - R_p
+// is one more Newton iteration of Algorithm 1 on a linear problem: the predictor (eqs. 3-5
+// with qdd_{n+1} = 0) applied to s_n, the residual linearized at the converged step, one solve
+// with the exact iteration matrix there, and the update of eq. (7). Starts that are not this
+// linear map (the consistent start, corrected starting values, Taylor steps) are
+// differentiated by central differences of their own computation.
+#include <cmath>
+#include <limits>
+
+#include "solver.hpp"
+
+namespace ga {
+
+namespace {
+const double kEps = std::numeric_limits<double>::epsilon();
+}
+
+void Sensitivities::allocate(int n, int m)
+{
+    for (auto *set : {&accepted, &trial, &start}) {
+        set->resize(np);
+        for (StateDerivative &x : *set)
+            x.allocate(n, m);
+    }
+    for (Vec *x : {&rq, &d, &w, &f_plus, &f_minus, &bt, &a0})
+        x->setZero(n);
+    for (Vec *x : {&rl, &rv, &dl, &e})
+        x->setZero(m);
+}
+
+void Sensitivities::allocate_matrices(const ModelMatrix &M, const ModelMatrix &J)
+{
+    M_pert.copy_layout(M);
+    J_pert.copy_layout(J);
+}
+
+double Sensitivities::increment(int j) const
+{
+    return std::cbrt(kEps) * scale[j];
+}
+
+ga_status Solver::set_sensitivity(int np, double *p, const double *p_scale, int depends)
+{
+    Sensitivities s;  // built aside: a failed allocation leaves the old set
+    s.np = np;
+    s.p = np > 0 ? p : nullptr;
+    s.depends = depends;
+    s.scale.resize(np);
+    for (int j = 0; j < np; ++j)
+        s.scale[j] = p_scale ? p_scale[j] : (p[j] != 0.0 ? std::fabs(p[j]) : 1.0);
+    if (np > 0) {
+        s.allocate(n_, m_);
+        if (workspace_ready_)
+            s.allocate_matrices(M_, J_);
+        sens_scratch_.allocate(n_, m_);
+    }
+    sens = std::move(s);
+    return GA_OK;
+}
+
+ga_status Solver::get_sensitivity(int j, double *dq, double *dv, double *dqdd,
+                                  double *dlambda) const
+{
+    const StateDerivative &x = sens.accepted[j];
+    const auto put = [](const Vec &from, double *to) {
+        if (to)
+            Eigen::Map<Vec>(to, from.size()) = from;
+    };
+    put(x.q, dq);
+    put(x.v, dv);
+    put(x.qdd, dqdd);
+    put(x.lambda, dlambda);
+    return GA_OK;
+}
+
+// Runs `evaluate` with p_j at p_j + e and at p_j - e (and, through `perturb`, the state moved
+// by the same multiple of its derivative); p_j is restored bit for bit whatever happens.
+// Returns the divisor of the central difference in `span`.
+template <class Perturb, class Evaluate>
+ga_status Solver::central_difference(int j, Perturb &&perturb, Evaluate &&evaluate,
+                                     double &span)
+{
+    double &pj = sens.p[j];
+    const double p0 = pj, e = sens.increment(j);
+    const double plus = p0 + e, minus = p0 - e;
+    span = plus - minus;
+    ga_status st = GA_OK;
+    for (int side = 0; side < 2 && !st; ++side) {
+        pj = side == 0 ? plus : minus;
+        perturb(true, pj - p0);
+        st = evaluate(side);
+        perturb(false, 0.0);
+        pj = p0;
+    }
+    pj = p0;
+    return st;
+}
+
+// At ga_init: q0 and v0 do not depend on p; qdd0 and lambda0 do, through the acceleration-level
+// system they solve (differences of that solve: it is linear, and cheap once).
+ga_status Solver::sensitivity_start(const State &x)
+{
+    // Exact derivatives need every tangent in the matrix (sensitivity_step): on the sparse
+    // path a tangent without a pattern has no place there.
+    const bool damped = model.has_force() || model.cb.damping;
+    if (sparse_backend_ && ((!K_.zero() && K_.dense()) || (damped && !C_.zero() && C_.dense())))
+        return diag.fail(GA_ERR_ARG, "sensitivities on the sparse path need the patterns of K_t "
+                         "and C_t (ga_set_pattern; an empty pattern declares a zero matrix)");
+    for (int j = 0; j < sens.np; ++j) {
+        StateDerivative &s = sens.trial[j];
+        s.q.setZero();
+        s.v.setZero();
+        double span = 0.0;
+        const auto evaluate = [&](int side) {
+            SaddleWorkspace w{S_, M_, J_, f_, c_, rq_};
+            Vec &qdd = side == 0 ? s.qdd : sens.d;
+            Vec &lambda = side == 0 ? s.lambda : sens.dl;
+            return acceleration_level(x.t, x.q, x.v, w, qdd, lambda);
+        };
+        const ga_status st = central_difference(j, [](bool, double) {}, evaluate, span);
+        jacobian_valid_ = false;  // S_ holds another matrix now
+        mass_valid_ = false;      // and M_ was evaluated with p perturbed
+        if (st) {
+            diag.append(" (sensitivity of the consistent start to parameter %d)", j);
+            return st;
+        }
+        s.qdd = (s.qdd - sens.d) / span;
+        s.lambda = (s.lambda - sens.dl) / span;
+        s.a = s.qdd;  // a_0 = qdd_0
+    }
+    return GA_OK;
+}
+
+// The state moved by `shift` times the derivative of parameter j (the quantities a step reads).
+void Solver::shift_state(const State &from, const StateDerivative &s, double shift, State &to)
+{
+    to.t = from.t;
+    to.h_last = from.h_last;
+    to.sliver_span = from.sliver_span;
+    to.q = from.q + shift * s.q;
+    to.v = from.v + shift * s.v;
+    to.qdd = from.qdd + shift * s.qdd;
+    to.lambda = from.lambda + shift * s.lambda;
+    to.a = from.a + shift * s.a;
+    to.a_prev = from.a_prev;
+}
+
+// A fresh start (the first step's corrected starting values, a step after Taylor steps, a
+// step far longer than the one before) or a Taylor step: their computations differenced along
+// the derivative of the state and p_j. A Taylor step's derivative is that of the step; a
+// start's is that of (v_n, a_n, qdd_n) as the step uses them.
+ga_status Solver::sensitivity_by_differences(double h, bool taylor_step, bool restart_short)
+{
+    for (int j = 0; j < sens.np; ++j) {
+        StateDerivative &out = taylor_step ? sens.trial[j] : sens.start[j];
+        const StateDerivative &s = sens.accepted[j];
+        // The perturbed state takes accepted_'s place while the computation runs (the
+        // accepted one waits in sens_scratch_).
+        const auto perturb = [&](bool on, double shift) {
+            if (on)
+                shift_state(accepted_, s, shift, sens_scratch_);
+            accepted_.swap(sens_scratch_);
+        };
+        const auto evaluate = [&](int side) {
+            if (auto st = taylor_step ? sliver_step(h) : prepare_start(h, restart_short))
+                return st;
+            const auto take = [side](Vec &to, const Vec &from) {
+                if (side == 0)
+                    to = from;
+                else
+                    to -= from;
+            };
+            if (taylor_step) {
+                take(out.q, trial_.q);
+                take(out.v, trial_.v);
+                take(out.qdd, trial_.qdd);
+                take(out.lambda, trial_.lambda);
+                take(out.a, trial_.a);
+            } else {
+                take(out.v, *v_start_);
+                take(out.a, *a_start_);
+                take(out.qdd, *qdd_start_);
+            }
+            return GA_OK;
+        };
+        double span = 0.0;
+        if (auto st = central_difference(j, perturb, evaluate, span)) {
+            diag.append(" (sensitivity of the %s to parameter %d)",
+                        taylor_step ? "short step" : "start of the step", j);
+            return st;
+        }
+        out.v /= span;
+        out.a /= span;
+        out.qdd /= span;
+        if (taylor_step) {
+            out.q /= span;
+            out.lambda /= span;
+        }
+    }
+    if (taylor_step)
+        sens.step_done = true;
+    else
+        sens.start_given = true;
+    return GA_OK;
+}
+
+// R_p: the derivative of r^q = M qdd - f + Phi_q^T lambda in p_j at the converged step x,
+// into sens.rq (added).
+ga_status Solver::parameter_residual(int j, double t, const State &x)
+{
+    Sensitivities &z = sens;
+    if (z.depends & GA_DEPENDS_FORCE) {
+        if (model.cb.force_p) {
+            if (auto st = model.force_p(t, x.q, x.v, j, z.f_plus))
+                return st;
+            z.rq -= z.f_plus;
+        } else if (model.has_force()) {
+            double span = 0.0;
+            const auto evaluate = [&](int side) {
+                return model.force(t, x.q, x.v, side == 0 ? z.f_plus : z.f_minus);
+            };
+            if (auto st = central_difference(j, [](bool, double) {}, evaluate, span))
+                return st;
+            z.rq -= (z.f_plus - z.f_minus) / span;
+        }
+    }
+    if (z.depends & GA_DEPENDS_MASS) {
+        if (model.cb.mass_p) {
+            if (auto st = model.mass_p(t, x.q, j, x.qdd, z.f_plus))
+                return st;
+            z.rq += z.f_plus;
+        } else {
+            double span = 0.0;
+            z.f_plus.setZero();
+            const auto evaluate = [&](int side) {
+                if (auto st = model.mass(t, x.q, z.M_pert))
+                    return st;
+                z.M_pert.multiply_add(side == 0 ? 1.0 : -1.0, x.qdd, z.f_plus);
+                return GA_OK;
+            };
+            if (auto st = central_difference(j, [](bool, double) {}, evaluate, span))
+                return st;
+            z.rq += z.f_plus / span;
+        }
+    }
+    return GA_OK;
+}
+
+// d/dq_n of -B(q_n)^T eta_bar along s (index 2: the position correction uses Phi_q at the
+// start of the step), into sens.bt: central differences of Phi_q.
+ga_status Solver::correction_derivative(const Vec &s)
+{
+    Sensitivities &z = sens;
+    z.bt.setZero();
+    const double s_max = s.lpNorm<Eigen::Infinity>();
+    if (s_max == 0.0)
+        return GA_OK;
+    const State &x0 = accepted_;
+    const double e = std::cbrt(kEps) * std::max(x0.q.lpNorm<Eigen::Infinity>(), 1.0) / s_max;
+    for (int side = 0; side < 2; ++side) {
+        z.d = x0.q + (side == 0 ? e : -e) * s;
+        if (auto st = model.jacobian(b_t_, z.d, z.J_pert))
+            return st;
+        z.J_pert.multiply_transpose_add(side == 0 ? -0.5 / e : 0.5 / e, eta_total_, z.bt);
+    }
+    return GA_OK;
+}
+
+// After a step converged (trial_ holds it), the derivatives of its state.
+ga_status Solver::sensitivity_step(double h)
+{
+    if (!sens.active() || sens.step_done)
+        return GA_OK;
+    const State &s = accepted_;
+    const State &x = trial_;
+    const Params &p = params;
+    const NewtonCoefficients c = newton_coefficients(p, h);
+    const bool index2 = formulation == GA_INDEX2_STABILIZED;
+    const double t1 = x.t;
+
+    // The exact iteration matrix at the converged step: every tangent, whatever the option,
+    // and where they come by differences, central ones (their error enters dqdd and dlambda
+    // at full size; a kept matrix is of an older iterate). The next step's Newton iteration
+    // starts with it.
+    ga_status st = residual(t1, x);
+    const ga_tangent_mode mode = model.tangent_mode;
+    model.tangent_mode = GA_TANGENT_AUTO;
+    const bool K = !K_.zero() && K_.size() > 0;
+    const bool C = !C_.zero() && C_.size() > 0 && (model.has_force() || model.cb.damping);
+    const bool Z = index2 && m_ > 0;
+    if (!st && K)
+        st = model.stiffness(t1, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_, true);
+    if (!st && C)
+        st = model.damping(t1, x.q, x.v, f_, C_, true);
+    if (!st && Z)
+        st = model.velocity_constraint_tangent(t1, x.q, x.v, J_, Z_, true);
+    model.tangent_mode = mode;
+    if (!st)
+        st = factorize(t1, x, h, K, C, Z, 0);
+    if (st) {
+        diag.append(" (the exact iteration matrix for the sensitivities)");
+        return st;
+    }
+    const double row_scale = step_row_scale(p, h, scaling);
+    Sensitivities &z = sens;
+    for (int j = 0; j < z.np; ++j) {
+        const StateDerivative &sn = z.accepted[j];
+        StateDerivative &s1 = z.trial[j];
+        // the start of the step as the step used it (attempt_step)
+        const Vec &sv = z.start_given ? z.start[j].v : sn.v;
+        const Vec &sqdd = z.start_given ? z.start[j].qdd : sn.qdd;
+        const Vec *sa = &sn.a;
+        if (z.start_given) {
+            sa = &z.start[j].a;
+        } else if (a_start_ != &s.a) {  // a_n rescaled to h
+            z.a0 = sn.qdd + (h / s.h_last) * (sn.a - sn.qdd);
+            sa = &z.a0;
+        }
+        // predictor, eqs. (3)-(5) with qdd_{n+1} = 0
+        s1.qdd.setZero();
+        s1.lambda.setZero();
+        s1.a = (p.alpha_f * sqdd - p.alpha_m * *sa) / (1.0 - p.alpha_m);
+        s1.q = sn.q + h * sv + (h * h) * ((0.5 - p.beta) * *sa + p.beta * s1.a);
+        s1.v = sv + h * ((1.0 - p.gamma) * *sa + p.gamma * s1.a);
+        if (index2 && m_ > 0) {
+            if ((st = correction_derivative(sn.q)))
+                return st;
+            s1.q += z.bt;
+        }
+        // the residual linearized at the converged step
+        z.rq.setZero();
+        if ((st = parameter_residual(j, t1, x))) {
+            diag.append(" (derivative of the residual in parameter %d)", j);
+            return st;
+        }
+        if (K)
+            K_.multiply_add(1.0, s1.q, z.rq);
+        if (C)
+            C_.multiply_add(1.0, s1.v, z.rq);
+        z.rl.setZero();
+        J_.multiply_add(1.0, s1.q, z.rl);
+        if (index2) {
+            z.rv.setZero();
+            if (Z)
+                Z_.multiply_add(1.0, s1.q, z.rv);
+            J_.multiply_add(1.0, s1.v, z.rv);
+            S2_.solve(z.rq, z.rl, z.rv, p, h, B_, z.d, z.w, z.dl, z.e);
+        } else {
+            S_.solve(z.rq, z.rl, z.d, z.dl, row_scale);
+        }
+        const Vec &dw = index2 ? z.w : z.d;
+        s1.q += z.d;
+        s1.v += c.gamma_prime * dw;
+        s1.qdd += c.beta_prime * dw;
+        s1.lambda = z.dl;
+        s1.a = (p.alpha_f * sqdd - p.alpha_m * *sa + (1.0 - p.alpha_f) * s1.qdd) /
+               (1.0 - p.alpha_m);
+        if (!all_finite(s1.q) || !all_finite(s1.v) || !all_finite(s1.qdd) ||
+            !all_finite(s1.lambda))
+            return diag.fail(GA_ERR_NONFINITE,
+                             "the sensitivity to parameter %d is not finite after the step "
+                             "from t = %.17g with h = %g",
+                             j, s.t, h);
+    }
+    return GA_OK;
+}
+
+}  // namespace ga

@@ -1,0 +1,55 @@
+// Forward sensitivities of the discrete solution (docs/algorithms.md sec. 13): what they are
+// taken with respect to, their values at the accepted step and the step being computed, and
+// the scratch of their step. The mathematics is in sensitivity.cpp (Solver members).
+#pragma once
+
+#include <vector>
+
+#include "galpha.h"
+#include "matrix.hpp"
+#include "types.hpp"
+
+namespace ga {
+
+// d/dp_j of the quantities a step carries from one state to the next.
+struct StateDerivative {
+    Vec q, v, qdd, lambda, a;
+    void allocate(int n, int m)
+    {
+        q.setZero(n);
+        v.setZero(n);
+        qdd.setZero(n);
+        lambda.setZero(m);
+        a.setZero(n);
+    }
+};
+
+struct Sensitivities {
+    int np = 0;
+    double *p = nullptr;       // the user's parameters, perturbed in place by differences
+    std::vector<double> scale;  // of those perturbations (p_scale)
+    int depends = GA_DEPENDS_FORCE;
+    ga_force_p_fn force_p = nullptr;
+    ga_mass_p_fn mass_p = nullptr;
+
+    std::vector<StateDerivative> accepted, trial;
+    // The step's start (v_n, a_n, qdd_n as the step uses them) when it is not the accepted
+    // state's own: fresh starts and their corrected values, by differences.
+    std::vector<StateDerivative> start;
+    bool start_given = false;  // start holds this step's
+    bool step_done = false;    // a Taylor step (sliver): trial holds its derivative already
+
+    // scratch of one step
+    Vec rq, rl, rv, d, w, dl, e, f_plus, f_minus, bt, a0;
+    ModelMatrix M_pert, J_pert;
+
+    bool active() const { return np > 0; }
+    // Sizes the vectors, and the matrices in the layouts of M and Phi_q (at setup, when the
+    // patterns are known); throw std::bad_alloc.
+    void allocate(int n, int m);
+    void allocate_matrices(const ModelMatrix &M, const ModelMatrix &J);
+    // The perturbation of p_j for central differences.
+    double increment(int j) const;
+};
+
+}  // namespace ga
