@@ -1,6 +1,7 @@
 // Checkpoint and restart (ga_get_state, ga_set_state). Layout 3, in doubles:
 //   header   [magic, 3, n, m, t, h_last, h_next, err_prev, grew, sliver_span,
-//             matrix kept (0/1), its t, its h, t of its B, tangents (K + 2 C + 4 Z),
+//             matrix kept (0/1), its t, its h, t of its B, tangents (K + 2 C + 4 Z + 8 if
+//             they were central differences, as for sensitivities),
 //             theta_prev, refresh_steps_left, reuse_backoff, fd_tangents]
 //   state    q, v, qdd (n each), lambda (m), a, a_prev (n each)
 //   matrix   the iterate it was factorized at: q, v, qdd (n), lambda (m); q of its B (n)
@@ -9,6 +10,7 @@
 //            P_ and O_ (n + m each)
 //   y        with r first-order states only: y, y', w, w_prev and the kept matrix's y, y'
 //            (r each)
+//   sens     with np sensitivity parameters only: d/dp_j of q, v, qdd, lambda, a for each j
 // Taking one only reads. Restoring rebuilds the kept matrix from the callbacks at the same
 // iterate and hands every sparse LU its pivots back, so the restored run repeats the run it
 // came from bit for bit (a kept matrix or pivots left out would make the next steps converge
@@ -50,7 +52,8 @@ Layout layout(int n, int m)
 
 std::size_t Solver::state_size() const
 {
-    return layout(n_, m_).end + 6 * static_cast<std::size_t>(r());
+    return layout(n_, m_).end + 6 * static_cast<std::size_t>(r()) +
+           static_cast<std::size_t>(sens.np) * (4 * static_cast<std::size_t>(n_) + m_);
 }
 
 void Solver::get_state(double *buf) const
@@ -73,7 +76,8 @@ void Solver::get_state(double *buf) const
                                     r.t,
                                     r.h,
                                     r.t_b,
-                                    (r.K ? 1.0 : 0.0) + (r.C ? 2.0 : 0.0) + (r.Z ? 4.0 : 0.0),
+                                    (r.K ? 1.0 : 0.0) + (r.C ? 2.0 : 0.0) + (r.Z ? 4.0 : 0.0) +
+                                        (r.central ? 8.0 : 0.0),
                                     // without a matrix the rate is stale and unused
                                     jacobian_valid_ ? theta_prev_ : -1.0,
                                     static_cast<double>(refresh_steps_left_),
@@ -97,6 +101,11 @@ void Solver::get_state(double *buf) const
         Eigen::Map<Vec>(p, x->size()) = *x;
         p += x->size();
     }
+    for (const StateDerivative &d : sens.accepted)
+        for (const Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a}) {
+            Eigen::Map<Vec>(p, x->size()) = *x;
+            p += x->size();
+        }
 }
 
 ga_status Solver::set_state(const double *buf, std::size_t len)
@@ -142,7 +151,7 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
                          "short steps after steps of h_last = %g", sliver_span, buf[5]);
     const bool kept = !layout2 && buf[10] == 1.0;
     if (!layout2 && (!is_flag(buf[10]) || (kept && !(buf[12] > 0.0)) ||
-                     !is_count(buf[14], 7.0) || !(buf[15] == -1.0 || buf[15] >= 0.0) ||
+                     !is_count(buf[14], 15.0) || !(buf[15] == -1.0 || buf[15] >= 0.0) ||
                      !is_count(buf[16], 32.0) || !is_count(buf[17], 32.0) ||
                      !(buf[17] >= 1.0) || !is_flag(buf[18])))
         return diag.fail(GA_ERR_ARG, "checkpoint entries 10-18 (the kept iteration matrix and "
@@ -208,11 +217,17 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
         p += x->size();
     }
     const double *py = buf + l.end;
-    if (!layout2)
+    if (!layout2) {
         for (Vec *x : {&s.y, &s.ydot, &s.w, &s.w_prev, &recipe_.y, &recipe_.ydot}) {
             *x = Eigen::Map<const Vec>(py, x->size());
             py += x->size();
         }
+        for (StateDerivative &d : sens.accepted)
+            for (Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a}) {
+                *x = Eigen::Map<const Vec>(py, x->size());
+                py += x->size();
+            }
+    }
     invalidate_jacobian();
     previous_valid_ = false;
     events_.restart();
@@ -240,6 +255,7 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
         r.K = (tangents & 1) != 0;
         r.C = (tangents & 2) != 0;
         r.Z = (tangents & 4) != 0;
+        r.central = (tangents & 8) != 0;
         for (Vec *x : {&r.q, &r.v, &r.qdd, &r.lambda, &r.q_b}) {
             *x = Eigen::Map<const Vec>(p, x->size());
             p += x->size();
@@ -276,16 +292,22 @@ ga_status Solver::rebuild_matrix()
         b_t_ = r.t_b;
         b_q_ = &r.q_b;
     }
+    const ga_tangent_mode mode = model.tangent_mode;
+    if (r.central)  // the matrix of the sensitivities (sensitivity_step)
+        model.tangent_mode = GA_TANGENT_AUTO;
     if (!st && r.K)
-        st = model.stiffness(r.t, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_);
+        st = model.stiffness(r.t, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_, r.central);
     if (!st && r.C)
-        st = model.damping(r.t, x.q, x.v, f_, C_);
+        st = model.damping(r.t, x.q, x.v, f_, C_, r.central);
     if (!st && r.Z)
-        st = model.velocity_constraint_tangent(r.t, x.q, x.v, J_, Z_);
+        st = model.velocity_constraint_tangent(r.t, x.q, x.v, J_, Z_, r.central);
+    model.tangent_mode = mode;
     if (!st && this->r() > 0)
         st = first_order_matrix(r.t, x);
+    const bool central = r.central;
     if (!st)
         st = factorize(r.t, x, r.h, r.K, r.C, r.Z, 0);
+    recipe_.central = central && !st;
     return st;
 }
 

@@ -299,6 +299,7 @@ ga_status Solver::sensitivity_step(double h)
     model.tangent_mode = mode;
     if (!st)
         st = factorize(t1, x, h, K, C, Z, 0);
+    recipe_.central = !st;
     if (st) {
         diag.append(" (the exact iteration matrix for the sensitivities)");
         return st;

@@ -307,6 +307,7 @@ private:
     struct MatrixRecipe {
         double t = 0.0, h = 0.0, t_b = 0.0;
         bool K = false, C = false, Z = false;
+        bool central = false;  // tangents by central differences (the sensitivities' matrix)
         Vec q, v, qdd, lambda, q_b;
         Vec y, ydot;  // first-order states
     } recipe_;

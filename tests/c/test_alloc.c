@@ -455,6 +455,59 @@ static void no_allocation_with_first_order_states(void **state)
     }
 }
 
+/* Forward sensitivities: the pendulum's mass as parameter (it enters M and f: differences of
+ * both), index 3 and 2, fixed and adaptive steps, forces that fail now and then (the step and
+ * its sensitivities are dropped); and the chain on the sparse path. */
+static void no_allocation_with_sensitivities(void **state)
+{
+    (void)state;
+    for (int mode = 0; mode < 6; ++mode) {
+        const int adaptive = mode & 1, index2 = (mode >> 1) & 1, sparse = mode >= 4;
+        pendulum p = {1.0, 1.0, 9.81};
+        chain c = chain_make(8);
+        const int n = sparse ? 24 : 2, m = sparse ? 16 : 1;
+        double q[24], v[24];
+        ga_solver *s = NULL;
+        assert_int_equal(ga_create(n, m, &s), GA_OK);
+        if (sparse) {
+            chain_initial(&c, q, v);
+            assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
+                                              chain_jacobian, &c),
+                             GA_OK);
+            assert_int_equal(chain_declare_patterns(&c, s), GA_OK);
+            assert_int_equal(ga_set_sensitivity(s, 3, &c.mass, NULL,
+                                                GA_DEPENDS_FORCE | GA_DEPENDS_MASS),
+                             GA_OK);
+        } else {
+            pendulum_state(&p, 1.0, 0.5, q, v);
+            assert_int_equal(ga_set_callbacks(s, pendulum_mass, force_maybe_failing,
+                                              pendulum_constraint, pendulum_jacobian, &p),
+                             GA_OK);
+            assert_int_equal(ga_set_sensitivity(s, 1, &p.mass, NULL,
+                                                GA_DEPENDS_FORCE | GA_DEPENDS_MASS),
+                             GA_OK);
+        }
+        assert_int_equal(ga_set_formulation(s, index2 ? GA_INDEX2_STABILIZED : GA_INDEX3),
+                         GA_OK);
+        assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        assert_int_equal(take_step(s, adaptive), GA_OK);
+        allocations = 0;
+        armed = 1;
+        long failed = 0;
+        for (int i = 0; i < 200; ++i) {
+            fail_force = !sparse && i % 7 == 3 ? (i % 2 ? -1 : 1) : 0;
+            failed += take_step(s, adaptive) < GA_OK;
+        }
+        armed = 0;
+        fail_force = 0;
+        printf("  mode %d: %ld failed calls, %ld allocations\n", mode, failed, allocations);
+        assert_true(sparse || failed > 0);
+        assert_int_equal(allocations, 0);
+        ga_free(s);
+    }
+}
+
 static void no_allocation_after_tangent_options_change(void **state)
 {
     (void)state;
@@ -492,6 +545,7 @@ int main(void)
         cmocka_unit_test(no_allocation_after_tangent_options_change),
         cmocka_unit_test(no_allocation_with_events),
         cmocka_unit_test(no_allocation_with_first_order_states),
+        cmocka_unit_test(no_allocation_with_sensitivities),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

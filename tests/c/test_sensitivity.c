@@ -16,6 +16,7 @@
 
 #include <cmocka.h>
 
+#include "electromech.h"
 #include "scene_catalog.h"
 
 enum { kMaxSteps = 20000, kMaxP = 3, kQuantities = 4 };
@@ -217,12 +218,235 @@ static void chain_sensitivity(void **state)
     run_all(list, 2, "chain (sparse)");
 }
 
+
+/* ---- derivative callbacks, refusals, failed steps, checkpoints ---- */
+
+/* The slider-crank's parameters (m3, m4, torque) by exact derivative callbacks: f depends on
+ * the torque only (on the crank angle's row), M on m3 and m4 (the slider's and mass 4's rows) */
+static int crank_force_p(double t, const double *q, const double *v, int j, double *f_p, void *u)
+{
+    (void)t, (void)q, (void)v, (void)u;
+    memset(f_p, 0, sizeof(double) * SC_N);
+    if (j == 2)
+        f_p[SC_TH1] = 1.0;
+    return 0;
+}
+static int crank_mass_p(double t, const double *q, int j, const double *a, double *out, void *u)
+{
+    (void)t, (void)q, (void)u;
+    memset(out, 0, sizeof(double) * SC_N);
+    if (j == 0)
+        out[SC_X3] = a[SC_X3];
+    if (j == 1)
+        out[SC_X4] = a[SC_X4];
+    return 0;
+}
+static int force_p_failures; /* the call that fails (counted down), 0: none */
+static int failing_force_p(double t, const double *q, const double *v, int j, double *f_p,
+                           void *u)
+{
+    if (force_p_failures > 0 && --force_p_failures == 0)
+        return -3;
+    return crank_force_p(t, q, v, j, f_p, u);
+}
+
+static ga_solver *crank_solver(int index2, int with_callbacks)
+{
+    catalog_scene sc = catalog_make(1);
+    ga_solver *s = catalog_solver(&sc);
+    assert_non_null(s);
+    assert_int_equal(ga_set_formulation(s, index2 ? GA_INDEX2_STABILIZED : GA_INDEX3), GA_OK);
+    assert_int_equal(ga_set_sensitivity(s, 3, &g_catalog_crank.m3, NULL,
+                                        GA_DEPENDS_FORCE | GA_DEPENDS_MASS),
+                     GA_OK);
+    if (with_callbacks)
+        assert_int_equal(ga_set_parameter_derivatives(s, failing_force_p, crank_mass_p), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, sc.q0, sc.v0), GA_OK);
+    return s;
+}
+
+static void derivative_callbacks_agree_with_differences(void **state)
+{
+    (void)state;
+    for (int index2 = 0; index2 < 2; ++index2) {
+        ga_solver *a = crank_solver(index2, 0), *b = crank_solver(index2, 1);
+        for (int k = 0; k < 100; ++k) {
+            assert_int_equal(ga_step(a, 1e-2), GA_OK);
+            assert_int_equal(ga_step(b, 1e-2), GA_OK);
+        }
+        for (int j = 0; j < 3; ++j) {
+            double x[2][4][SC_N];
+            assert_int_equal(ga_get_sensitivity(a, j, x[0][0], x[0][1], x[0][2], x[0][3]), GA_OK);
+            assert_int_equal(ga_get_sensitivity(b, j, x[1][0], x[1][1], x[1][2], x[1][3]), GA_OK);
+            for (int qn = 0; qn < 4; ++qn) {
+                const int len = qn == 3 ? SC_M : SC_N;
+                double diff = 0, size = 0;
+                for (int i = 0; i < len; ++i) {
+                    diff = fmax(diff, fabs(x[0][qn][i] - x[1][qn][i]));
+                    size = fmax(size, fabs(x[1][qn][i]));
+                }
+                printf("  index %d p%d quantity %d: callbacks against differences %.2e\n",
+                       index2 ? 2 : 3, j, qn, diff / size);
+                assert_true(diff <= 1e-8 * size);
+            }
+        }
+        ga_free(a);
+        ga_free(b);
+    }
+}
+
+static void refusals(void **state)
+{
+    (void)state;
+    catalog_scene sc = catalog_make(1);
+    ga_solver *s = catalog_solver(&sc);
+    double *p = &g_catalog_crank.m3;
+    const double bad_scale[3] = {1.0, 0.0, 1.0};
+    double nan_p[1] = {NAN};
+    assert_int_equal(ga_set_sensitivity(s, 1, p, NULL, GA_DEPENDS_FORCE), GA_OK);
+    assert_int_equal(ga_set_sensitivity(s, -1, p, NULL, GA_DEPENDS_FORCE), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "np = -1"));
+    assert_int_equal(ga_set_sensitivity(s, 2, NULL, NULL, GA_DEPENDS_FORCE), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "p is NULL"));
+    assert_int_equal(ga_set_sensitivity(s, 2, p, NULL, 4), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "flags"));
+    assert_int_equal(ga_set_sensitivity(s, 3, p, bad_scale, GA_DEPENDS_FORCE), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "p_scale[1]"));
+    assert_int_equal(ga_set_sensitivity(s, 1, nan_p, NULL, GA_DEPENDS_FORCE), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "p[0]"));
+    assert_int_equal(ga_get_sensitivity(s, 0, NULL, NULL, NULL, NULL), GA_ERR_STATE);
+    /* a mass that depends on p is not constant, either way round */
+    assert_int_equal(ga_set_constant_mass(s, 1), GA_OK);
+    assert_int_equal(ga_set_sensitivity(s, 2, p, NULL, GA_DEPENDS_MASS), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "constant"));
+    assert_int_equal(ga_set_constant_mass(s, 0), GA_OK);
+    assert_int_equal(ga_set_sensitivity(s, 2, p, NULL, GA_DEPENDS_MASS), GA_OK);
+    assert_int_equal(ga_set_constant_mass(s, 1), GA_ERR_STATE);
+    assert_non_null(strstr(ga_last_error(s), "GA_DEPENDS_MASS"));
+    /* first-order states: not with sensitivities yet, in either order */
+    assert_int_equal(ga_set_first_order(s, 1, NULL, em_rate), GA_ERR_STATE);
+    assert_non_null(strstr(ga_last_error(s), "not built"));
+    /* the set of the last successful call is the one in use */
+    assert_int_equal(ga_init(s, 0.0, sc.q0, sc.v0), GA_OK);
+    assert_int_equal(ga_step(s, 1e-3), GA_OK);
+    double dq[SC_N];
+    assert_int_equal(ga_get_sensitivity(s, 1, dq, NULL, NULL, NULL), GA_OK);
+    assert_int_equal(ga_get_sensitivity(s, 2, dq, NULL, NULL, NULL), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "ga_get_sensitivity"));
+    assert_int_equal(ga_get_sensitivity(s, -1, dq, NULL, NULL, NULL), GA_ERR_ARG);
+    /* after ga_init */
+    assert_int_equal(ga_set_sensitivity(s, 1, p, NULL, GA_DEPENDS_FORCE), GA_ERR_STATE);
+    assert_non_null(strstr(ga_last_error(s), "after ga_init"));
+    ga_free(s);
+
+    ga_solver *f = NULL;
+    assert_int_equal(ga_create(EM_N, EM_M, &f), GA_OK);
+    assert_int_equal(ga_set_first_order(f, EM_R, em_force, em_rate), GA_OK);
+    assert_int_equal(ga_set_sensitivity(f, 1, p, NULL, GA_DEPENDS_FORCE), GA_ERR_STATE);
+    assert_non_null(strstr(ga_last_error(f), "first-order"));
+    ga_free(f);
+
+    /* the sparse path without a pattern of K_t has no place for the exact tangent */
+    catalog_scene chain_scene = catalog_make(4);
+    ga_solver *c = NULL;
+    assert_int_equal(ga_create(chain_scene.n, chain_scene.m, &c), GA_OK);
+    assert_int_equal(ga_set_callbacks(c, chain_mass, chain_force, chain_constraint,
+                                      chain_jacobian, &g_catalog_chain),
+                     GA_OK);
+    int rows[64], cols[64];
+    for (int which = GA_MATRIX_MASS; which <= GA_MATRIX_JACOBIAN; ++which) {
+        const int nnz = chain_pattern(&g_catalog_chain, which, rows, cols);
+        assert_int_equal(ga_set_pattern(c, which, nnz, rows, cols), GA_OK);
+    }
+    assert_int_equal(ga_set_pattern(c, GA_MATRIX_DAMPING, 0, NULL, NULL), GA_OK);
+    assert_int_equal(ga_set_tangent_mode(c, GA_TANGENT_NEGLECT), GA_OK);
+    assert_int_equal(ga_set_linear_solver(c, GA_LINEAR_SPARSE), GA_OK);
+    assert_int_equal(ga_set_sensitivity(c, 1, &g_catalog_chain.gravity, NULL, GA_DEPENDS_FORCE),
+                     GA_OK);
+    assert_int_equal(ga_init(c, 0.0, chain_scene.q0, chain_scene.v0), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(c), "patterns of K_t"));
+    ga_free(c);
+}
+
+/* A step whose sensitivities fail (a derivative callback) fails as a whole: state and
+ * sensitivities stay those of the step before, and the retry gives what an unbroken run gives. */
+static void failed_sensitivity_fails_the_step(void **state)
+{
+    (void)state;
+    ga_solver *a = crank_solver(0, 1), *b = crank_solver(0, 1);
+    for (int k = 0; k < 20; ++k) {
+        assert_int_equal(ga_step(a, 1e-2), GA_OK);
+        assert_int_equal(ga_step(b, 1e-2), GA_OK);
+    }
+    double before[2][SC_N], after[2][SC_N], t;
+    assert_int_equal(ga_get_q(a, before[0]), GA_OK);
+    assert_int_equal(ga_get_sensitivity(a, 2, before[1], NULL, NULL, NULL), GA_OK);
+    force_p_failures = 2; /* the second call in the next step */
+    assert_int_equal(ga_step(a, 1e-2), GA_ERR_CALLBACK);
+    assert_non_null(strstr(ga_last_error(a), "force_p"));
+    assert_int_equal(ga_get_q(a, after[0]), GA_OK);
+    assert_int_equal(ga_get_sensitivity(a, 2, after[1], NULL, NULL, NULL), GA_OK);
+    assert_int_equal(ga_get_t(a, &t), GA_OK);
+    assert_true(fabs(t - 0.2) < 1e-12);
+    assert_memory_equal(before, after, sizeof before);
+    assert_int_equal(ga_step(a, 1e-2), GA_OK);
+    assert_int_equal(ga_step(b, 1e-2), GA_OK);
+    double x[2][SC_N];
+    assert_int_equal(ga_get_sensitivity(a, 2, x[0], NULL, NULL, NULL), GA_OK);
+    assert_int_equal(ga_get_sensitivity(b, 2, x[1], NULL, NULL, NULL), GA_OK);
+    for (int i = 0; i < SC_N; ++i)
+        assert_true(fabs(x[0][i] - x[1][i]) <= 1e-9 * (1 + fabs(x[1][i])));
+    ga_free(a);
+    ga_free(b);
+}
+
+/* A checkpoint holds the sensitivities: a restored run goes on bit for bit. */
+static void checkpoint_holds_sensitivities(void **state)
+{
+    (void)state;
+    for (int index2 = 0; index2 < 2; ++index2) {
+        ga_solver *a = crank_solver(index2, 0);
+        for (int k = 0; k < 30; ++k)
+            assert_int_equal(ga_step(a, 1e-2), GA_OK);
+        size_t len = 0;
+        assert_int_equal(ga_state_size(a, &len), GA_OK);
+        double *buf = malloc(len * sizeof(double));
+        assert_int_equal(ga_get_state(a, buf, len), GA_OK);
+        ga_solver *b = crank_solver(index2, 0);
+        assert_int_equal(ga_set_state(b, buf, len), GA_OK);
+        for (int k = 0; k < 30; ++k) {
+            assert_int_equal(ga_step(a, 1e-2), GA_OK);
+            assert_int_equal(ga_step(b, 1e-2), GA_OK);
+        }
+        for (int j = 0; j < 3; ++j) {
+            double x[2][4][SC_N];
+            assert_int_equal(ga_get_sensitivity(a, j, x[0][0], x[0][1], x[0][2], x[0][3]), GA_OK);
+            assert_int_equal(ga_get_sensitivity(b, j, x[1][0], x[1][1], x[1][2], x[1][3]), GA_OK);
+            assert_memory_equal(x[0], x[1], sizeof x[0]);
+        }
+        /* a checkpoint of a solver with another number of parameters does not fit */
+        catalog_scene sc = catalog_make(1);
+        ga_solver *c = catalog_solver(&sc);
+        assert_int_equal(ga_set_sensitivity(c, 1, &g_catalog_crank.m3, NULL, GA_DEPENDS_FORCE),
+                         GA_OK);
+        assert_int_equal(ga_set_state(c, buf, len), GA_ERR_ARG);
+        free(buf);
+        ga_free(a);
+        ga_free(b);
+        ga_free(c);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(pendulum_gravity_sensitivity),
         cmocka_unit_test(crank_sensitivity),
         cmocka_unit_test(chain_sensitivity),
+        cmocka_unit_test(derivative_callbacks_agree_with_differences),
+        cmocka_unit_test(refusals),
+        cmocka_unit_test(failed_sensitivity_fails_the_step),
+        cmocka_unit_test(checkpoint_holds_sensitivities),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
