@@ -38,6 +38,7 @@ module galpha
   integer(c_int), parameter, public :: GA_INIT_PROJECT = 0, GA_INIT_REFUSE = 1
   integer(c_int), parameter, public :: GA_OUTPUT_CONSISTENT = 0, GA_OUTPUT_STEP = 1
   integer(c_int), parameter, public :: GA_COUPLING_G_Q = 0, GA_COUPLING_G_V = 1
+  integer(c_int), parameter, public :: GA_DEPENDS_FORCE = 1, GA_DEPENDS_MASS = 2
   integer(c_int), parameter, public :: GA_EVENT_BOTH = 0, GA_EVENT_RISING = 1, &
        GA_EVENT_FALLING = -1, GA_EVENT_LOG = 64
   integer(c_int), parameter, public :: GA_COUNT_STEPS = 0, GA_COUNT_FAILED_STEPS = 1, &
@@ -112,9 +113,26 @@ module galpha
        real(c_double), intent(out) :: g(*)
        type(c_ptr), value :: user
      end function ga_event_y_fn
+     ! sensitivities: df/dp_j (n) and (dM/dp_j) a (n), j 0-based as in C
+     integer(c_int) function ga_force_p_fn(t, q, v, j, f_p, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*), v(*)
+       integer(c_int), value :: j
+       real(c_double), intent(out) :: f_p(*)
+       type(c_ptr), value :: user
+     end function ga_force_p_fn
+     integer(c_int) function ga_mass_p_fn(t, q, j, a, out, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*), a(*)
+       integer(c_int), value :: j
+       real(c_double), intent(out) :: out(*)
+       type(c_ptr), value :: user
+     end function ga_mass_p_fn
   end interface
   public :: ga_mass_fn, ga_force_fn, ga_constraint_fn, ga_stiffness_fn, ga_event_fn, &
-       ga_force_y_fn, ga_coupling_fn, ga_event_y_fn
+       ga_force_y_fn, ga_coupling_fn, ga_event_y_fn, ga_force_p_fn, ga_mass_p_fn
 
   ! ---- the C API, one to one ----------------------------------------------------------------
   interface
@@ -471,6 +489,28 @@ module galpha
        real(c_double), value :: t
        real(c_double), intent(out), optional :: y(*), ydot(*)  ! absent: NULL
      end function ga_interpolate_y
+     integer(c_int) function ga_set_sensitivity(s, np, p, p_scale, depends) &
+          bind(C, name="ga_set_sensitivity")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       integer(c_int), value :: np
+       type(c_ptr), value :: p  ! the array the callbacks read: perturbed in place
+       real(c_double), intent(in), optional :: p_scale(*)  ! absent: NULL
+       integer(c_int), value :: depends
+     end function ga_set_sensitivity
+     integer(c_int) function ga_set_parameter_derivatives(s, force_p, mass_p) &
+          bind(C, name="ga_set_parameter_derivatives")
+       import :: c_int, c_ptr, c_funptr
+       type(c_ptr), value :: s
+       type(c_funptr), value :: force_p, mass_p
+     end function ga_set_parameter_derivatives
+     integer(c_int) function ga_get_sensitivity(s, j, dq, dv, dqdd, dlambda) &
+          bind(C, name="ga_get_sensitivity")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       integer(c_int), value :: j
+       real(c_double), intent(out), optional :: dq(*), dv(*), dqdd(*), dlambda(*)
+     end function ga_get_sensitivity
      function c_strlen(p) bind(C, name="strlen")
        import :: c_ptr, c_size_t
        type(c_ptr), value :: p
@@ -491,12 +531,13 @@ module galpha
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
        ga_interpolate, ga_interpolate_qdd, ga_set_output, ga_set_events, ga_get_event_count, &
        ga_get_event, ga_set_first_order, ga_set_coupling, ga_set_coupling_exact, ga_init_y, &
-       ga_get_y, ga_interpolate_y, ga_set_events_y, ga_set_coupling_pattern
+       ga_get_y, ga_interpolate_y, ga_set_events_y, ga_set_coupling_pattern, &
+       ga_set_sensitivity, ga_set_parameter_derivatives, ga_get_sensitivity
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
      type(c_ptr) :: handle = c_null_ptr
-     integer :: n = 0, m = 0, r = 0
+     integer :: n = 0, m = 0, r = 0, np = 0
    contains
      procedure :: create => solver_create
      procedure :: free => solver_free
@@ -596,6 +637,16 @@ module galpha
      !> set_events_y(fn, direction, terminal, with_multipliers): set_events with functions
      !> fn(t, q, v, y, lambda, g, user) of the first-order states as well
      procedure :: set_events_y => solver_set_events_y
+     !> set_sensitivity(p, depends, p_scale): forward sensitivities with respect to p, the
+     !> (target, contiguous) array the callbacks read and galpha perturbs in place; depends an
+     !> ior of GA_DEPENDS_FORCE and GA_DEPENDS_MASS; before init
+     procedure :: set_sensitivity => solver_set_sensitivity
+     !> set_parameter_derivatives(force_p, mass_p): exact df/dp_j, (dM/dp_j) a (either
+     !> optional: central differences)
+     procedure :: set_parameter_derivatives => solver_set_parameter_derivatives
+     !> get_sensitivity(j, dq, dv, dqdd, dlambda): d/dp_j (j 1-based) of the accepted step's
+     !> q, v, qdd, lambda (each optional)
+     procedure :: get_sensitivity => solver_get_sensitivity
   end type galpha_solver
   public :: galpha_strerror, galpha_version, galpha_version_number
 
@@ -823,6 +874,49 @@ contains
     if (present(y)) y(1:this%r) = yy(1:this%r)
     if (present(ydot)) ydot(1:this%r) = dd(1:this%r)
   end function solver_interpolate_y
+
+  integer(c_int) function solver_set_sensitivity(this, p, depends, p_scale) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), target, contiguous, intent(inout) :: p(:)
+    integer(c_int), intent(in) :: depends
+    real(c_double), intent(in), optional :: p_scale(:)
+    if (present(p_scale)) then
+       if (size(p_scale) /= size(p)) then
+          status = GA_ERR_ARG
+          return
+       end if
+       status = ga_set_sensitivity(this%handle, int(size(p), c_int), c_loc(p), p_scale, depends)
+    else
+       status = ga_set_sensitivity(this%handle, int(size(p), c_int), c_loc(p), depends=depends)
+    end if
+    if (status == GA_OK) this%np = size(p)
+  end function solver_set_sensitivity
+
+  integer(c_int) function solver_set_parameter_derivatives(this, force_p, mass_p) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    procedure(ga_force_p_fn), optional :: force_p
+    procedure(ga_mass_p_fn), optional :: mass_p
+    type(c_funptr) :: f, m
+    f = c_null_funptr
+    m = c_null_funptr
+    if (present(force_p)) f = c_funloc(force_p)
+    if (present(mass_p)) m = c_funloc(mass_p)
+    status = ga_set_parameter_derivatives(this%handle, f, m)
+  end function solver_set_parameter_derivatives
+
+  integer(c_int) function solver_get_sensitivity(this, j, dq, dv, dqdd, dlambda) result(status)
+    class(galpha_solver), intent(in) :: this
+    integer, intent(in) :: j
+    real(c_double), intent(out), optional :: dq(:), dv(:), dqdd(:), dlambda(:)
+    real(c_double) :: x(max(this%n, 1), 3), l(max(this%m, 1))
+    status = ga_get_sensitivity(this%handle, int(j - 1, c_int), x(:, 1), x(:, 2), x(:, 3), l)
+    if (status /= GA_OK) return
+    if (present(dq)) dq(1:this%n) = x(1:this%n, 1)
+    if (present(dv)) dv(1:this%n) = x(1:this%n, 2)
+    if (present(dqdd)) dqdd(1:this%n) = x(1:this%n, 3)
+    if (present(dlambda)) dlambda(1:this%m) = l(1:this%m)
+  end function solver_get_sensitivity
 
   integer(c_int) function solver_set_constraint_accel(this, fn) result(status)
     class(galpha_solver), intent(inout) :: this

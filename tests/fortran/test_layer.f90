@@ -5,6 +5,7 @@
 module layer_events
   use, intrinsic :: iso_c_binding
   implicit none
+  real(c_double), target, save :: stiffness(1) = [4.0d0]
 contains
   ! g(1) = x: the pendulum passes the vertical
   integer(c_int) function vertical(t, q, v, lambda, g, user) bind(C)
@@ -61,6 +62,25 @@ contains
     g(1) = y(1) - 0.5d0
     half = 0
   end function half
+
+  ! sensitivities: x'' = -k x, k read from stiffness(1) (the array galpha perturbs)
+  integer(c_int) function spring(t, q, v, f, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*)
+    real(c_double), intent(out) :: f(*)
+    type(c_ptr), value :: user
+    f(1) = -stiffness(1) * q(1)
+    spring = 0
+  end function spring
+  integer(c_int) function spring_p(t, q, v, j, f_p, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*)
+    integer(c_int), value :: j
+    real(c_double), intent(out) :: f_p(*)
+    type(c_ptr), value :: user
+    f_p(1) = -q(1)
+    spring_p = merge(0, -1, j == 0)
+  end function spring_p
 end module layer_events
 
 program test_layer
@@ -239,6 +259,35 @@ program test_layer
   call ok(r%get_event(1, te, index, direction), 'get_event (y)')
   call expect(abs(te - 0.5d0 * log(2.0d0)) < 1d-6, 'y = 1/2 at t = ln(2) / 2')
 
+  ! sensitivities: d x(1) / dk of x'' = -k x, x(0) = 1, against the exact
+  ! -t sin(sqrt(k) t) / (2 sqrt(k)) (O(h^2) apart) and against differences of whole runs
+  call r%free()
+  x = spring_run(4.0d0 + 1d-4) - spring_run(4.0d0 - 1d-4)
+  stiffness(1) = 4.0d0
+  call ok(r%create(1, 0), 'create for sensitivities')
+  call ok(r%set_callbacks(unit_mass, spring), 'callbacks')
+  call ok(r%set_sensitivity(stiffness, GA_DEPENDS_FORCE), 'set_sensitivity')
+  call expect(r%get_sensitivity(1, q(1:1)) == GA_ERR_STATE, 'get_sensitivity before init')
+  call ok(r%init(0.0d0, [1.0d0], [0.0d0]), 'init with sensitivities')
+  do i = 1, 1000
+     call ok(r%step(1d-3), 'step with sensitivities')
+  end do
+  call ok(r%get_sensitivity(1, q(1:1), v(1:1)), 'get_sensitivity')
+  call expect(abs(q(1) + sin(2.0d0) / 4.0d0) < 1d-5, 'dx/dk against the exact derivative')
+  call expect(abs(q(1) - x / 2d-4) < 1d-7 * abs(q(1)), 'dx/dk against differences of runs')
+  call expect(r%get_sensitivity(2, q(1:1)) == GA_ERR_ARG, 'get_sensitivity checks j')
+  call r%free()
+  call ok(r%create(1, 0), 'create for derivative callbacks')
+  call ok(r%set_callbacks(unit_mass, spring), 'callbacks')
+  call ok(r%set_sensitivity(stiffness, GA_DEPENDS_FORCE, [1.0d0]), 'set_sensitivity, scale')
+  call ok(r%set_parameter_derivatives(force_p=spring_p), 'set_parameter_derivatives')
+  call ok(r%init(0.0d0, [1.0d0], [0.0d0]), 'init')
+  do i = 1, 1000
+     call ok(r%step(1d-3), 'step with df/dk')
+  end do
+  call ok(r%get_sensitivity(1, q2(1:1)), 'get_sensitivity (callback)')
+  call expect(abs(q2(1) - q(1)) < 1d-9 * abs(q(1)), 'df/dk by callback as by differences')
+
   call s%free()
   call r%free()
   deallocate (ckpt, back)  ! (a main program's allocatables are never freed on their own)
@@ -247,6 +296,25 @@ program test_layer
   print '(a)', 'test_layer: all checks passed'
 
 contains
+
+  ! x(1) at t = 1 of x'' = -k x from x = 1 at rest, 1000 steps, full Newton
+  real(c_double) function spring_run(k) result(x1)
+    real(c_double), intent(in) :: k
+    type(galpha_solver) :: w
+    real(c_double) :: xq(1)
+    integer :: step
+    stiffness(1) = k
+    call ok(w%create(1, 0), 'create')
+    call ok(w%set_callbacks(unit_mass, spring), 'callbacks')
+    call ok(w%set_jacobian_reuse(GA_REUSE_NEVER), 'full Newton')
+    call ok(w%init(0.0d0, [1.0d0], [0.0d0]), 'init')
+    do step = 1, 1000
+       call ok(w%step(1d-3), 'step')
+    end do
+    call ok(w%get_q(xq), 'get_q')
+    x1 = xq(1)
+    call w%free()
+  end function spring_run
 
   subroutine ok(status, what)
     integer(c_int), intent(in) :: status

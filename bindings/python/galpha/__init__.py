@@ -10,7 +10,7 @@ M(q) q'' = f(q, q', t) - Phi_q^T lambda, Phi(q, t) = 0 -- Python bindings over c
 or, for time histories, galpha.integrate(...). The low-level mirror of the C API is
 galpha._ffi (one function per C function)."""
 from . import _ffi
-from ._ffi import (GA_EVENT_BOTH, GA_EVENT_FALLING, GA_EVENT_RISING,  # noqa: F401
+from ._ffi import (GA_DEPENDS_FORCE, GA_DEPENDS_MASS, GA_EVENT_BOTH, GA_EVENT_FALLING, GA_EVENT_RISING,  # noqa: F401
                    GA_INDEX2_STABILIZED, GA_INDEX3, GA_INFO_ERROR_ESTIMATE,  # noqa: F401
                    GA_INFO_H_NEXT, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_RCOND,
                    GA_INIT_PROJECT, GA_INIT_REFUSE, GA_LINEAR_AUTO, GA_LINEAR_DENSE,
@@ -27,7 +27,7 @@ from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceErr
                      OutOfMemoryError, RecoverableError, SingularMatrixError, StateError,
                      StepSizeError)
 from .integrate import IntegrateResult, OdeSolution, integrate  # noqa: F401
-from .solver import Solver  # noqa: F401
+from .solver import Sensitivity, Solver  # noqa: F401
 
 __version__ = _ffi.lib.ga_version().decode()
 library_path = _ffi.path

@@ -100,6 +100,10 @@ FORCE_Y_FN = EVENT_FN  # (t, q, v, y, f, user)
 RATE_FN = EVENT_FN     # (t, q, v, y, ydot, user)
 EVENT_Y_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
                               c_double_p, c_double_p, ctypes.c_void_p)
+FORCE_P_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, ctypes.c_int,
+                              c_double_p, ctypes.c_void_p)  # (t, q, v, j, f_p, user)
+MASS_P_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, ctypes.c_int, c_double_p,
+                             c_double_p, ctypes.c_void_p)   # (t, q, j, a, out, user)
 COUPLING_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
                                c_double_p, c_double_p, c_double_p, c_double_p, ctypes.c_void_p)
 
@@ -117,6 +121,10 @@ GA_ERR_INCONSISTENT = -9
 GA_ERR_INTERNAL = -10
 GA_ERR_STEP_SIZE = -11
 GA_EVENT = 1  # not an error: a stepping call stopped at an event
+
+# Sensitivity dependence flags (ga_depends).
+GA_DEPENDS_FORCE = 1
+GA_DEPENDS_MASS = 2
 
 # Enumerations.
 GA_TANGENT_AUTO, GA_TANGENT_FD, GA_TANGENT_NEGLECT = 0, 1, 2
@@ -209,6 +217,9 @@ _SIGNATURES = {
     "ga_interpolate_y": (_I, [_S, _D, c_double_p, c_double_p]),
     "ga_set_events_y": (_I, [_S, _I, EVENT_Y_FN, _P(_I), _P(_I), _I]),
     "ga_set_coupling_pattern": (_I, [_S, _I, _I, _P(_I), _P(_I)]),
+    "ga_set_sensitivity": (_I, [_S, _I, c_double_p, c_double_p, _I]),
+    "ga_set_parameter_derivatives": (_I, [_S, FORCE_P_FN, MASS_P_FN]),
+    "ga_get_sensitivity": (_I, [_S, _I, c_double_p, c_double_p, c_double_p, c_double_p]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():

@@ -12,6 +12,7 @@ this for speed: views of the library's buffers, valid during the call only). Mat
 A Python exception raised inside a callback makes the step fail cleanly (the solver stays at
 its last accepted state) and is re-raised, with its traceback, from the call that stepped.
 """
+import collections
 import ctypes
 import functools
 import signal
@@ -33,6 +34,11 @@ _STIFFNESS = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp)
 _EVENT = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp)
 _COUPLING = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp)
 _EVENT_Y = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp)
+_FORCE_P = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _i, _vp, _vp)
+_MASS_P = ctypes.CFUNCTYPE(_i, _d, _vp, _i, _vp, _vp, _vp)
+
+# The derivatives of the accepted step in the sensitivity parameters (Solver.sensitivity).
+Sensitivity = collections.namedtuple("Sensitivity", "dq dv dqdd dlam")
 
 
 def _cast(fn, ctype):
@@ -153,6 +159,14 @@ class Solver:
         cols)} declares where those blocks may be nonzero (0-based; empty: zero), so that their
         finite differences take one rate call per group of columns (ga_set_coupling_pattern).
         Start with init(t0, q0, v0, y0); read `y`, `ydot` and interpolate_y(t).
+    parameters, depends, parameter_scale, force_p(t, q, v, j, f_p), mass_p(t, q, j, a, out)
+        Forward sensitivities (ga_set_sensitivity): `parameters` is the 1-D float64 array the
+        callbacks read the model's parameters from at every call -- galpha perturbs its entries
+        in place for differences (restoring them before any call returns), so the callbacks
+        must read it, not a copy. `depends` is a subset of ("force", "mass") (default
+        ("force",)): what the parameters enter. `force_p` and `mass_p` optionally give df/dp_j
+        and (dM/dp_j) a exactly (central differences otherwise). Read the derivatives of the
+        accepted step with sensitivity().
     zero_copy : bool
         False (default): callbacks get copies of their inputs and an array of their own to
         fill, so what they keep stays valid and unchanged after the call. True: views of the
@@ -171,7 +185,8 @@ class Solver:
                  constant_mass=None, linear_solver=None, rescale=None, corrected_start=None,
                  step_limits=None, initial_step=None, output=None, patterns=None,
                  r=0, rate=None, force_y=None, coupling=None, coupling_exact=None,
-                 coupling_patterns=None, zero_copy=False):
+                 coupling_patterns=None, parameters=None, depends=("force",),
+                 parameter_scale=None, force_p=None, mass_p=None, zero_copy=False):
         self._ptr = None
         self._lock = threading.RLock()  # see _serialized
         self._pending = None          # exception raised inside a callback
@@ -344,6 +359,9 @@ class Solver:
                                                      cols.ctypes.data_as(ip)))
         if coupling_exact is not None:
             self._check(_ffi.ga_set_coupling_exact(self._ptr, int(bool(coupling_exact))))
+        self._parameters = None
+        if parameters is not None:
+            self._set_sensitivity(parameters, depends, parameter_scale, force_p, mass_p)
         if rho_inf is not None:
             self.set_rho_inf(rho_inf)
         if params is not None:
@@ -374,6 +392,55 @@ class Solver:
             self._check(_ffi.ga_set_step_limits(self._ptr, float(step_limits[0]), float(step_limits[1])))
         if initial_step is not None:
             self._check(_ffi.ga_set_initial_step(self._ptr, float(initial_step)))
+
+    def _set_sensitivity(self, parameters, depends, scale, force_p, mass_p):
+        p = parameters
+        if (not isinstance(p, np.ndarray) or p.dtype != np.float64 or p.ndim != 1 or
+                not p.flags.c_contiguous or not p.flags.writeable):
+            raise ValueError("parameters must be the writeable, contiguous 1-D float64 array "
+                             "the callbacks read (galpha perturbs it in place)")
+        flags = 0
+        for name in depends:
+            if name not in ("force", "mass"):
+                raise ValueError(f"unknown dependence {name!r} (force or mass)")
+            flags |= _ffi.GA_DEPENDS_FORCE if name == "force" else _ffi.GA_DEPENDS_MASS
+        sc = None
+        if scale is not None:
+            sc = np.ascontiguousarray(scale, dtype=float).ravel()
+            if sc.shape != p.shape:
+                raise ValueError("parameter_scale must have the shape of parameters")
+        self._check(_ffi.ga_set_sensitivity(self._ptr, p.size, self._dp(p),
+                                            None if sc is None else self._dp(sc), flags))
+        self._parameters = (p, sc)  # alive as long as the solver: the library holds p
+        n, call = self.n, self._call
+        cbs = [
+            _FORCE_P(lambda t, q, qd, j, out, u: call(
+                lambda t, q, qd, o: force_p(t, q, qd, j, o), out, (n,), t, (q, n), (qd, n)))
+            if force_p else None,
+            _MASS_P(lambda t, q, j, a, out, u: call(
+                lambda t, q, a, o: mass_p(t, q, j, a, o), out, (n,), t, (q, n), (a, n)))
+            if mass_p else None,
+        ]
+        if force_p or mass_p:
+            self._cbs += cbs
+            self._check(_ffi.ga_set_parameter_derivatives(self._ptr,
+                                                          _cast(cbs[0], _ffi.FORCE_P_FN),
+                                                          _cast(cbs[1], _ffi.MASS_P_FN)))
+
+    @_serialized
+    def sensitivity(self):
+        """Derivatives of the accepted step's q, v, qdd and lambda with respect to the
+        parameters (ga_get_sensitivity): a Sensitivity of arrays dq (n, np), dv (n, np),
+        dqdd (n, np), dlam (m, np); column j is d/dp_j."""
+        if self._parameters is None:
+            raise error_for(_ffi.GA_ERR_STATE, "no sensitivities: Solver(parameters=...)")
+        n, m, npar = self.n, self.m, self._parameters[0].size
+        out = [np.empty((npar, max(k, 1))) for k in (n, n, n, m)]
+        for j in range(npar):
+            self._check(_ffi.ga_get_sensitivity(self._handle(), j,
+                                                *[self._dp(x[j]) for x in out]))
+        dq, dv, dqdd, dlam = (x[:, :k].T.copy() for x, k in zip(out, (n, n, n, m)))
+        return Sensitivity(dq, dv, dqdd, dlam)
 
     # ---- plumbing ---------------------------------------------------------------------------
     def _view(self, address, shape, writeable=False):

@@ -1,0 +1,112 @@
+"""Forward sensitivities from Python: Solver(parameters=...) and Solver.sensitivity()."""
+import os
+import sys
+
+import numpy as np
+import pytest
+
+if "GALPHA_PYTHON_INSTALLED" not in os.environ:  # else: the package comes from PYTHONPATH
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "bindings", "python"))
+import galpha  # noqa: E402
+
+L = 1.0
+Q0 = np.array([np.sin(1.0), -np.cos(1.0)])
+V0 = np.zeros(2)
+
+
+def pendulum(p, **options):
+    """The pendulum with mass p[0] and gravity p[1], read from p at every call."""
+    def mass(t, q, M):
+        M[:] = p[0] * np.eye(2)
+
+    def force(t, q, v, f):
+        f[:] = (0.0, -p[0] * p[1])
+
+    def constraint(t, q, phi):
+        phi[0] = 0.5 * (q @ q - L * L)
+
+    def jacobian(t, q, J):
+        J[0, :] = q
+
+    return galpha.Solver(2, 1, mass, force, constraint, jacobian, **options)
+
+
+def final_state(p, steps=100, h=1e-2, **options):
+    with pendulum(p, **options) as s:
+        s.init(0.0, Q0, V0)
+        for _ in range(steps):
+            s.step(h)
+        return s.q.copy(), s.v.copy(), s.lam.copy(), (s.sensitivity() if "parameters" in
+                                                       options else None)
+
+
+def test_sensitivities_are_derivatives_of_the_discrete_solution():
+    """Against central differences of whole runs (full Newton), index 3 and 2."""
+    for formulation in (galpha.GA_INDEX3, galpha.GA_INDEX2_STABILIZED):
+        p = np.array([1.0, 9.81])
+        q, v, lam, sens = final_state(p, parameters=p, depends=("force", "mass"),
+                                      formulation=formulation)
+        assert sens.dq.shape == (2, 2) and sens.dlam.shape == (1, 2)
+        assert np.array_equal(p, [1.0, 9.81])  # restored after every perturbation
+        for j in range(2):
+            e = 1e-4 * p[j]
+            runs = []
+            for sign in (1, -1):
+                pp = p.copy()
+                pp[j] += sign * e
+                runs.append(final_state(pp, reuse=galpha.GA_REUSE_NEVER, newton=(1e-13, 30),
+                                        formulation=formulation))
+            for k, d in enumerate((sens.dq, sens.dv)):
+                fd = (runs[0][k] - runs[1][k]) / (2 * e)
+                assert np.allclose(d[:, j], fd, rtol=0, atol=1e-7 * max(1.0, np.abs(fd).max()))
+
+
+def test_derivative_callbacks():
+    """df/dp and (dM/dp) a by callbacks give what central differences give."""
+    p = np.array([1.0, 9.81])
+
+    def force_p(t, q, v, j, out):
+        out[:] = (0.0, -p[1]) if j == 0 else (0.0, -p[0])
+
+    def mass_p(t, q, j, a, out):
+        out[:] = a if j == 0 else 0.0
+
+    by_differences = final_state(p, parameters=p, depends=("force", "mass"))[3]
+    by_callbacks = final_state(p, parameters=p, depends=("force", "mass"), force_p=force_p,
+                               mass_p=mass_p)[3]
+    for a, b in zip(by_differences, by_callbacks):
+        assert np.allclose(a, b, rtol=1e-8, atol=1e-10)
+
+
+def test_refusals():
+    with pytest.raises(ValueError, match="float64"):
+        pendulum([1.0, 9.81], parameters=[1.0, 9.81])
+    with pytest.raises(ValueError, match="float64"):
+        pendulum(None, parameters=np.array([1, 2]))
+    with pytest.raises(ValueError, match="dependence"):
+        pendulum(None, parameters=np.array([1.0]), depends=("constraint",))
+    with pytest.raises(ValueError, match="shape"):
+        pendulum(None, parameters=np.array([1.0]), parameter_scale=[1.0, 2.0])
+    with pytest.raises(galpha.ArgumentError, match="p_scale"):
+        pendulum(None, parameters=np.array([1.0]), parameter_scale=[-1.0])
+    p = np.array([1.0, 9.81])
+    with pendulum(p) as s:
+        s.init(0.0, Q0, V0)
+        with pytest.raises(galpha.StateError, match="no sensitivities"):
+            s.sensitivity()
+    with pendulum(p, parameters=p) as s:
+        with pytest.raises(galpha.StateError):
+            s.sensitivity()  # before init
+
+
+def test_callback_errors_reach_the_caller():
+    p = np.array([1.0, 9.81])
+
+    def broken(t, q, v, j, out):
+        raise RuntimeError("no derivative today")
+
+    with pendulum(p, parameters=p, force_p=broken) as s:
+        s.init(0.0, Q0, V0)
+        with pytest.raises(RuntimeError, match="no derivative today"):
+            s.step(1e-2)
+        assert s.t == 0.0
