@@ -541,7 +541,7 @@ static void bad_checkpoints_are_refused(void **state)
     /* the kept matrix and its reuse (entries 10-18): flags, a step, counts as a solver
      * writes them */
     assert_true(before[10] == 1.0); /* a matrix is kept after ten steps */
-    const double bad_matrix[][2] = {{10, 0.5}, {12, 0.0}, {14, 8.0}, {14, 1.5}, {15, -0.5},
+    const double bad_matrix[][2] = {{10, 0.5}, {12, 0.0}, {14, 16.0}, {14, 1.5}, {15, -0.5},
                                     {16, 33.0}, {16, -1.0}, {17, 0.0}, {18, 2.0}};
     for (size_t k = 0; k < sizeof bad_matrix / sizeof bad_matrix[0]; ++k) {
         memcpy(buf, before, len * sizeof(double));
