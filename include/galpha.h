@@ -749,6 +749,39 @@ GA_API ga_status ga_set_parameter_derivatives(ga_solver *s, ga_force_p_fn force_
  *  sensitivities). */
 GA_API ga_status ga_get_sensitivity(const ga_solver *s, int j, double *dq, double *dv,
                                     double *dqdd, double *dlambda);
+
+/** How sensitivities are computed (flags, or-ed). */
+typedef enum ga_sensitivity_method {
+    GA_SENSITIVITY_FORWARD = 1, /**< after each step, for ga_get_sensitivity (default) */
+    GA_SENSITIVITY_ADJOINT = 2  /**< the run is recorded for ga_adjoint_gradient */
+} ga_sensitivity_method;
+
+/** methods is an or of ::ga_sensitivity_method; with GA_SENSITIVITY_ADJOINT each accepted step
+ *  from ga_init on is recorded (its size, q, v, qdd, lambda: 3 n + 2 m + 4 doubles), for up to
+ *  max_steps steps, allocated here; a step beyond them fails with GA_ERR_NOMEM and changes
+ *  nothing. After ga_set_sensitivity, before ga_init. Errors: GA_ERR_ARG (no method, unknown
+ *  flags, max_steps < 1 with the adjoint), GA_ERR_STATE (no parameters, after ga_init),
+ *  GA_ERR_NOMEM. */
+GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_steps);
+
+/** A cost term: its value at (t, q, v, qdd, lambda) and every partial derivative, in q, v, qdd
+ *  (n each), lambda (m) and the parameters p (np); all outputs are written. */
+typedef int (*ga_cost_fn)(double t, const double *q, const double *v, const double *qdd,
+                          const double *lambda, double *value, double *d_q, double *d_v,
+                          double *d_qdd, double *d_lambda, double *d_p, void *user);
+
+/** The cost J = G(x_N) + sum_n w_n L(x_n) over the steps recorded since ga_init (x_n: t, q, v,
+ *  and the steps' own qdd and lambda; w_n the trapezoidal weights of the step sizes, so that
+ *  the sum is the trapezoidal rule for the integral of L), and its gradient dJ/dp (np) by the
+ *  discrete adjoint of the steps taken: one backward sweep, one transposed solve per step with
+ *  the exact iteration matrix evaluated again at the recorded state. running (L) or terminal
+ *  (G) may be NULL. The recorded run must not contain Taylor steps or fresh starts after the
+ *  first step (ga_step sizes over 100 times shorter or longer than the one before). Leaves the
+ *  run as it was (it may be continued and asked again). Errors: GA_ERR_ARG (both NULL),
+ *  GA_ERR_STATE (no adjoint recording, before ga_init, a step kind not covered), callback
+ *  and linear-algebra errors. */
+GA_API ga_status ga_adjoint_gradient(ga_solver *s, ga_cost_fn running, ga_cost_fn terminal,
+                                     double *J, double *dJ_dp);
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */

@@ -784,11 +784,48 @@ GA_API ga_status ga_get_sensitivity(const ga_solver *s, int j, double *dq, doubl
 {
     return reading(s, "ga_get_sensitivity", "j is not the index of a parameter",
                    [&](const ga::Solver &c) {
-        if (!c.initialized() || !c.sens.active())
+        if (!c.initialized() || !c.sens.active() || !c.sens.forward)
             return GA_ERR_STATE;
         if (j < 0 || j >= c.sens.np)
             return GA_ERR_ARG;
         return c.get_sensitivity(j, dq, dv, dqdd, dlambda);
+    });
+}
+
+GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_steps)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if ((methods & ~(GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT)) != 0 || methods == 0)
+            return c.diag.fail(GA_ERR_ARG, "sensitivity methods 0x%x: an or of "
+                               "GA_SENSITIVITY_FORWARD and GA_SENSITIVITY_ADJOINT",
+                               static_cast<unsigned>(methods));
+        if ((methods & GA_SENSITIVITY_ADJOINT) && max_steps < 1)
+            return c.diag.fail(GA_ERR_ARG, "max_steps = %ld: the adjoint record needs room for "
+                               "at least one step", max_steps);
+        if (!c.sens.active())
+            return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity_method before "
+                               "ga_set_sensitivity with np > 0");
+        if (c.initialized())
+            return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity_method after ga_init");
+        return c.set_sensitivity_method(methods, max_steps);
+    });
+}
+
+GA_API ga_status ga_adjoint_gradient(ga_solver *s, ga_cost_fn running, ga_cost_fn terminal,
+                                     double *J, double *dJ_dp)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!running && !terminal)
+            return c.diag.fail(GA_ERR_ARG, "ga_adjoint_gradient: no cost (running and terminal "
+                               "are NULL)");
+        if (!J || !dJ_dp)
+            return c.diag.fail(GA_ERR_ARG, "ga_adjoint_gradient: J or dJ_dp is NULL");
+        if (!c.sens.adjoint)
+            return c.diag.fail(GA_ERR_STATE, "ga_adjoint_gradient without a recorded run "
+                               "(ga_set_sensitivity_method with GA_SENSITIVITY_ADJOINT)");
+        if (!c.initialized())
+            return c.diag.fail(GA_ERR_STATE, "ga_adjoint_gradient before ga_init");
+        return c.adjoint_gradient(running, terminal, J, dJ_dp);
     });
 }
 

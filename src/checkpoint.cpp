@@ -170,6 +170,9 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
     }
     if (!model.ready())
         return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
+    if (sens.adjoint)
+        return diag.fail(GA_ERR_STATE, "ga_set_state on a run recorded for the adjoint: the "
+                         "record starts at ga_init (restoring into it is not built)");
     if (auto st = setup())
         return st;
     if (!layout2) {

@@ -127,6 +127,8 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
 
     accepted_.swap(trial_);
     sens.accepted.swap(sens.trial);
+    if (sens.adjoint)
+        record_start();
     ++state_id_;
     initialized_ = true;
     previous_valid_ = false;

@@ -57,6 +57,7 @@ ga_status Solver::set_sensitivity(int np, double *p, const double *p_scale, int 
         sens_scratch_.allocate(n_, m_);
     }
     sens = std::move(s);
+    adjoint_ = AdjointRecord{};  // the method is forward again (ga_set_sensitivity_method)
     return GA_OK;
 }
 
@@ -248,22 +249,24 @@ ga_status Solver::parameter_residual(int j, double t, const State &x)
     return GA_OK;
 }
 
-// d/dq_n of -B(q_n)^T eta_bar along s (index 2: the position correction uses Phi_q at the
-// start of the step), into sens.bt: central differences of Phi_q.
-ga_status Solver::correction_derivative(const Vec &s)
+// -d/dq (Phi_q(q)^T eta) s at (t, q), into out: central differences of Phi_q. Index 2: the
+// position correction -B^T eta_bar uses B = Phi_q(q_n) of the step's start. The matrix
+// d/dq (Phi_q^T eta) is symmetric (second derivatives of eta^T Phi), so this also applies its
+// transpose (adjoint.cpp).
+ga_status Solver::correction_derivative(double t, const Vec &q, const Vec &eta, const Vec &s,
+                                        Vec &out)
 {
     Sensitivities &z = sens;
-    z.bt.setZero();
+    out.setZero();
     const double s_max = s.lpNorm<Eigen::Infinity>();
     if (s_max == 0.0)
         return GA_OK;
-    const State &x0 = accepted_;
-    const double e = std::cbrt(kEps) * std::max(x0.q.lpNorm<Eigen::Infinity>(), 1.0) / s_max;
+    const double e = std::cbrt(kEps) * std::max(q.lpNorm<Eigen::Infinity>(), 1.0) / s_max;
     for (int side = 0; side < 2; ++side) {
-        z.d = x0.q + (side == 0 ? e : -e) * s;
-        if (auto st = model.jacobian(b_t_, z.d, z.J_pert))
+        z.d = q + (side == 0 ? e : -e) * s;
+        if (auto st = model.jacobian(t, z.d, z.J_pert))
             return st;
-        z.J_pert.multiply_transpose_add(side == 0 ? -0.5 / e : 0.5 / e, eta_total_, z.bt);
+        z.J_pert.multiply_transpose_add(side == 0 ? -0.5 / e : 0.5 / e, eta, out);
     }
     return GA_OK;
 }
@@ -271,9 +274,27 @@ ga_status Solver::correction_derivative(const Vec &s)
 // After a step converged (trial_ holds it), the derivatives of its state.
 ga_status Solver::sensitivity_step(double h)
 {
-    if (!sens.active() || sens.step_done)
+    if (!sens.active())
         return GA_OK;
     const State &s = accepted_;
+    if (sens.adjoint) {  // how the step began, for the record (adjoint.cpp; commit keeps it)
+        AdjointRecord &r = adjoint_;
+        if (r.steps >= r.capacity)
+            return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (%ld steps: "
+                             "ga_set_sensitivity_method)", r.capacity);
+        r.pending_rho = 1.0;
+        if (sens.step_done || (sens.start_given && !start_pending_)) {
+            r.pending_kind = AdjointRecord::Unsupported;
+        } else if (sens.start_given) {
+            r.pending_kind = AdjointRecord::First;
+        } else {
+            r.pending_kind = AdjointRecord::Regular;
+            if (a_start_ != &s.a)
+                r.pending_rho = h / s.h_last;
+        }
+    }
+    if (!sens.forward || sens.step_done)
+        return GA_OK;
     const State &x = trial_;
     const Params &p = params;
     const NewtonCoefficients c = newton_coefficients(p, h);
@@ -326,7 +347,7 @@ ga_status Solver::sensitivity_step(double h)
         s1.q = sn.q + h * sv + (h * h) * ((0.5 - p.beta) * *sa + p.beta * s1.a);
         s1.v = sv + h * ((1.0 - p.gamma) * *sa + p.gamma * s1.a);
         if (index2 && m_ > 0) {
-            if ((st = correction_derivative(sn.q)))
+            if ((st = correction_derivative(b_t_, s.q, eta_total_, sn.q, z.bt)))
                 return st;
             s1.q += z.bt;
         }

@@ -29,8 +29,8 @@ struct Sensitivities {
     double *p = nullptr;       // the user's parameters, perturbed in place by differences
     std::vector<double> scale;  // of those perturbations (p_scale)
     int depends = GA_DEPENDS_FORCE;
-    ga_force_p_fn force_p = nullptr;
-    ga_mass_p_fn mass_p = nullptr;
+    bool forward = true;   // GA_SENSITIVITY_FORWARD: derivatives after each step
+    bool adjoint = false;  // GA_SENSITIVITY_ADJOINT: the run recorded (AdjointRecord)
 
     std::vector<StateDerivative> accepted, trial;
     // The step's start (v_n, a_n, qdd_n as the step uses them) when it is not the accepted

@@ -357,6 +357,8 @@ void Solver::undo_step(const StepUndo &u)
     previous_.swap(trial_);  // commit's swaps, backwards
     accepted_.swap(trial_);
     sens.accepted.swap(sens.trial);
+    if (sens.adjoint && --adjoint_.steps < adjoint_.unsupported_at)
+        adjoint_.unsupported_at = -1;  // that step is gone
     previous_valid_ = u.previous_valid;
     start_pending_ = u.start_pending;
     if (u.adaptive)
@@ -375,6 +377,8 @@ void Solver::commit(bool land_on, double t_land)
     previous_.swap(trial_);    // ... and the old one the start of the interval for dense output
     if (land_on)
         accepted_.t = t_land;  // exactly, not t_n + h rounded
+    if (sens.adjoint)
+        record_step();
     previous_valid_ = true;
     start_pending_ = false;
     ++state_id_;
@@ -394,8 +398,12 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     if (sliver_allowed && short_step && s.sliver_span + h <= short_limit) {
         if (sens.active()) {
             sens.step_done = false;
-            if (auto st = sensitivity_by_differences(h, true, false))
-                return st;
+            if (sens.forward) {
+                if (auto st = sensitivity_by_differences(h, true, false))
+                    return st;
+            } else {
+                sens.step_done = true;  // (adjoint only: recorded as a step not covered)
+            }
         }
         return sliver_step(h);
     }
@@ -405,9 +413,13 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     if (sens.active()) {  // sensitivity.cpp: starts that are not the linear map, by differences
         sens.start_given = false;
         sens.step_done = false;
-        if (start_pending_ || long_after_short(h) || restart_short)
+        const bool fresh = start_pending_ || long_after_short(h) || restart_short;
+        if (fresh && (sens.forward || start_pending_)) {
             if (auto st = sensitivity_by_differences(h, false, restart_short))
                 return st;
+        } else if (fresh) {
+            sens.start_given = true;  // (adjoint only: recorded as a start not covered)
+        }
     }
     if (auto st = prepare_start(h, restart_short))
         return st;

@@ -12,6 +12,7 @@
 #include "model.hpp"
 #include "newton.hpp"
 #include "params.hpp"
+#include "adjoint.hpp"
 #include "sensitivity.hpp"
 
 namespace ga {
@@ -132,6 +133,9 @@ public:
     Sensitivities sens;
     ga_status set_sensitivity(int np, double *p, const double *p_scale, int depends);
     ga_status get_sensitivity(int j, double *dq, double *dv, double *dqdd, double *dlambda) const;
+    // adjoint.cpp
+    ga_status set_sensitivity_method(int methods, long max_steps);
+    ga_status adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ);
 
     // Events (events.cpp): the functions watched, where their search stands, the last log.
     EventSet &events() { return events_; }
@@ -234,9 +238,15 @@ private:
     static void shift_state(const State &from, const StateDerivative &s, double shift, State &to);
     ga_status sensitivity_by_differences(double h, bool taylor_step, bool restart_short);
     ga_status parameter_residual(int j, double t, const State &x);
-    ga_status correction_derivative(const Vec &s);
+    ga_status correction_derivative(double t, const Vec &q, const Vec &eta, const Vec &s,
+                                    Vec &out);
     ga_status sensitivity_step(double h);
     State sens_scratch_;  // the accepted state while a perturbed one takes its place
+    AdjointRecord adjoint_;
+    void record_start();   // adjoint.cpp: x_0 and the start's derivatives, at ga_init
+    void record_step();    // the accepted step, at commit
+    struct AdjointWork;
+    ga_status adjoint_step(long k, AdjointWork &w);
     Vec eta_total_;       // index 2: the converged step's eta_bar (sum of its increments)
     ga_status factorize(double t, const State &x, double h, bool tangents_K, bool tangents_C,
                         bool tangent_Z, int iter);

@@ -1,0 +1,391 @@
+// The discrete adjoint of the steps taken (docs/algorithms.md sec. 13). A recorded run is the
+// composition of the maps sensitivity.cpp differentiates: per step the predictor P, the
+// residual linearized at the converged step, the solve with the exact iteration matrix S and
+// the update U of eq. (7). The sweep applies their transposes in reverse order, step by step
+// from the last: U^T, then S^{-T} (its own factorization of S, assembled again at the recorded
+// state: a transposed solve), then the transposed tangents K^T, C^T, Phi_q^T (and Z^T in
+// index 2), then P^T -- one transposed solve per step, whatever the number of parameters.
+// The parameters enter through R_p of each step and the start's derivatives.
+#include <cmath>
+#include <limits>
+
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+
+#include "solver.hpp"
+
+namespace ga {
+
+void AdjointRecord::allocate(int n_, int m_, int np, long capacity_)
+{
+    n = n_;
+    m = m_;
+    capacity = capacity_;
+    steps = 0;
+    unsupported_at = -1;
+    data.assign((static_cast<std::size_t>(capacity_) + 1) * stride(), 0.0);
+    for (auto *set : {&sigma0, &start0}) {
+        set->resize(np);
+        for (StateDerivative &x : *set)
+            x.allocate(n_, m_);
+    }
+}
+
+ga_status Solver::set_sensitivity_method(int methods, long max_steps)
+{
+    AdjointRecord record;  // built aside: a failed allocation leaves the one before
+    if (methods & GA_SENSITIVITY_ADJOINT)
+        record.allocate(n_, m_, sens.np, max_steps);
+    adjoint_ = std::move(record);
+    sens.forward = (methods & GA_SENSITIVITY_FORWARD) != 0;
+    sens.adjoint = (methods & GA_SENSITIVITY_ADJOINT) != 0;
+    return GA_OK;
+}
+
+namespace {
+void put(const Vec &x, double *&out)
+{
+    Eigen::Map<Vec>(out, x.size()) = x;
+    out += x.size();
+}
+}  // namespace
+
+void Solver::record_start()
+{
+    AdjointRecord &r = adjoint_;
+    const State &x = accepted_;
+    r.steps = 0;
+    r.unsupported_at = -1;
+    double *e = r.entry(0);
+    e[0] = x.t;
+    e[1] = e[2] = e[3] = 0.0;
+    e += 4;
+    for (const Vec *v : {&x.q, &x.v, &x.qdd, &x.lambda})
+        put(*v, e);
+    Eigen::Map<Vec>(e, m_).setZero();
+    for (int j = 0; j < sens.np; ++j) {
+        const StateDerivative &s = sens.accepted[j];
+        StateDerivative &d = r.sigma0[j];
+        d.q = s.q;
+        d.v = s.v;
+        d.qdd = s.qdd;
+        d.lambda = s.lambda;
+        d.a = s.a;
+    }
+}
+
+void Solver::record_step()
+{
+    AdjointRecord &r = adjoint_;
+    const State &x = accepted_;
+    double *e = r.entry(++r.steps);
+    e[0] = x.t;
+    e[1] = x.h_last;
+    e[2] = r.pending_rho;
+    e[3] = r.pending_kind;
+    e += 4;
+    for (const Vec *v : {&x.q, &x.v, &x.qdd, &x.lambda})
+        put(*v, e);
+    if (formulation == GA_INDEX2_STABILIZED)
+        Eigen::Map<Vec>(e, m_) = eta_total_;
+    else
+        Eigen::Map<Vec>(e, m_).setZero();
+    if (r.pending_kind == AdjointRecord::First)
+        for (int j = 0; j < sens.np; ++j) {
+            r.start0[j].v = sens.start[j].v;
+            r.start0[j].a = sens.start[j].a;
+            r.start0[j].qdd = sens.start[j].qdd;
+        }
+    if (r.pending_kind == AdjointRecord::Unsupported && r.unsupported_at < 0)
+        r.unsupported_at = r.steps;
+}
+
+// The sweep's state and scratch: the adjoint variables of the state derivative (q, v, qdd,
+// lambda, a) of the step being taken back, and the transposed system.
+struct Solver::AdjointWork {
+    Vec mq, mv, mqdd, ml, ma;      // adjoint of sigma_{k+1}, then of sigma_k
+    Vec cq, cv, cqdd, cl, cp;      // a cost term's gradient
+    Vec yq, yl, ye, zq, zl, ze;    // right-hand side and solution of S^T z = y
+    Vec rr, rl, rv, qp, vp, tmp;   // adjoints of the linearized residual and the predictor
+    Vec eta;
+    std::vector<double> dJ;
+    State x;                        // a recorded state
+    Eigen::SparseMatrix<double> S;
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+    std::vector<Eigen::Triplet<double>> entries;
+    int np = 0;
+    void allocate(int n, int m, int p)
+    {
+        for (Vec *v : {&mq, &mv, &mqdd, &ma, &cq, &cv, &cqdd, &yq, &zq, &rr, &qp, &vp, &tmp})
+            v->setZero(n);
+        for (Vec *v : {&ml, &cl, &yl, &ye, &zl, &ze, &rl, &rv, &eta})
+            v->setZero(m);
+        cp.setZero(p);
+        dJ.assign(p, 0.0);
+        x.allocate(n, m);
+        np = p;
+    }
+};
+
+namespace {
+using Sparse = Eigen::SparseMatrix<double>;
+
+// A user matrix as a sparse one (dense: every entry).
+Sparse to_sparse(const ModelMatrix &A)
+{
+    Sparse S(A.rows(), A.cols());
+    std::vector<Eigen::Triplet<double>> t;
+    if (A.dense()) {
+        const auto D = A.as_dense();
+        for (int j = 0; j < A.cols(); ++j)
+            for (int i = 0; i < A.rows(); ++i)
+                t.emplace_back(i, j, D(i, j));
+    } else {
+        for (int k = 0; k < A.nnz(); ++k)
+            t.emplace_back(A.row_index()[k], A.col_index()[k], A.data()[k]);
+    }
+    S.setFromTriplets(t.begin(), t.end());
+    return S;
+}
+
+void add_block(std::vector<Eigen::Triplet<double>> &t, const Sparse &A, double scale, int row0,
+               int col0, bool transposed = false)
+{
+    for (int j = 0; j < A.outerSize(); ++j)
+        for (Sparse::InnerIterator it(A, j); it; ++it)
+            transposed ? t.emplace_back(row0 + it.col(), col0 + it.row(), scale * it.value())
+                       : t.emplace_back(row0 + it.row(), col0 + it.col(), scale * it.value());
+}
+
+double dot_map(const Vec &a, const double *b) { return a.dot(Eigen::Map<const Vec>(b, a.size())); }
+}  // namespace
+
+// Step k -> k + 1 backwards: w.mq ... w.ma hold the adjoint of sigma_{k+1}; on return they
+// hold that of sigma_k (k > 0), or the parameters have received the start's share (k = 0).
+ga_status Solver::adjoint_step(long k, AdjointWork &w)
+{
+    const AdjointRecord &r = adjoint_;
+    const Params &p = params;
+    const bool index2 = formulation == GA_INDEX2_STABILIZED;
+    const int n = n_, m = m_;
+    const double *e0 = r.entry(k), *e1 = r.entry(k + 1);
+    const double h = e1[1], rho = e1[2];
+    const auto kind = static_cast<AdjointRecord::Kind>(e1[3]);
+    const NewtonCoefficients c = newton_coefficients(p, h);
+    const double bh2 = p.beta * h * h, t1 = e1[0];
+
+    // the converged step and its exact iteration matrix (as sensitivity_step builds it)
+    State &x = w.x;
+    const double *src = e1 + 4;
+    for (Vec *v : {&x.q, &x.v, &x.qdd}) {
+        *v = Eigen::Map<const Vec>(src, n);
+        src += n;
+    }
+    x.lambda = Eigen::Map<const Vec>(src, m);
+    w.eta = Eigen::Map<const Vec>(src + m, m);
+    ga_status st = residual(t1, x);
+    const ga_tangent_mode mode = model.tangent_mode;
+    model.tangent_mode = GA_TANGENT_AUTO;
+    const bool K = !K_.zero() && K_.size() > 0;
+    const bool C = !C_.zero() && C_.size() > 0 && (model.has_force() || model.cb.damping);
+    const bool Z = index2 && m > 0;
+    if (!st && K)
+        st = model.stiffness(t1, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_, true);
+    if (!st && C)
+        st = model.damping(t1, x.q, x.v, f_, C_, true);
+    if (!st && Z)
+        st = model.velocity_constraint_tangent(t1, x.q, x.v, J_, Z_, true);
+    model.tangent_mode = mode;
+    const Vec q_n = Eigen::Map<const Vec>(e0 + 4, n);
+    if (!st && index2 && m > 0)
+        st = model.jacobian(e0[0], q_n, B_);
+    if (st)
+        return st;
+
+    // S, scaled: rows (beta h^2, 1[, beta h / gamma]), unknowns (d or w, beta h^2 dlambda[, e])
+    const Sparse Ms = to_sparse(M_), Js = to_sparse(J_);
+    Sparse A = (bh2 * c.beta_prime) * Ms;
+    if (K)
+        A += bh2 * to_sparse(K_);
+    if (C)
+        A += (bh2 * c.gamma_prime) * to_sparse(C_);
+    w.entries.clear();
+    add_block(w.entries, A, 1.0, 0, 0);
+    add_block(w.entries, Js, 1.0, 0, n, true);
+    add_block(w.entries, Js, 1.0, n, 0);
+    const int N = n + (index2 ? 2 * m : m);
+    if (index2 && m > 0) {
+        const Sparse Bs = to_sparse(B_), Zs = to_sparse(Z_);
+        const Sparse BT = Bs.transpose();
+        const double s3 = p.beta * h / p.gamma;
+        if (K) {
+            const Sparse KBT = to_sparse(K_) * BT;
+            add_block(w.entries, KBT, -bh2, 0, n + m);
+        }
+        const Sparse JBT = Js * BT, ZBT = Zs * BT;
+        add_block(w.entries, JBT, -1.0, n, n + m);
+        add_block(w.entries, Zs, s3, n + m, 0);
+        add_block(w.entries, Js, 1.0, n + m, 0);
+        add_block(w.entries, ZBT, -s3, n + m, n + m);
+    }
+    w.S.resize(N, N);
+    w.S.setFromTriplets(w.entries.begin(), w.entries.end());
+    count(counters, GA_COUNT_FACTORIZATIONS);
+    w.lu.compute(w.S);
+    if (w.lu.info() != Eigen::Success)
+        return diag.fail(GA_ERR_SINGULAR,
+                         "iteration matrix of the step from t = %.17g (h = %g) is singular in "
+                         "the adjoint sweep",
+                         e0[0], h);
+
+    // U^T: s_q' = q_p + d, s_v' = v_p + gamma' w, s_qdd' = beta' w, s_lambda' = dlambda,
+    // s_a' = (alpha_f sqdd - alpha_m sa + (1 - alpha_f) s_qdd') / (1 - alpha_m)
+    const double am = p.alpha_m, af = p.alpha_f;
+    const Vec mqdd_total = w.mqdd + ((1.0 - af) / (1.0 - am)) * w.ma;
+    w.tmp = c.gamma_prime * w.mv + c.beta_prime * mqdd_total;  // adjoint of w (or of d)
+    Eigen::VectorXd y(N);
+    if (index2 && m > 0) {
+        y.head(n) = w.tmp + w.mq;  // d = w - B^T e
+        y.segment(n, m) = w.ml / bh2;
+        w.ye.setZero();
+        B_.multiply_add(-1.0, w.mq, w.ye);
+        y.tail(m) = w.ye;
+    } else {
+        y.head(n) = w.tmp + w.mq;
+        y.tail(m) = w.ml / bh2;
+    }
+    // S^{-T}; the right-hand side was -(rows' scales) (r, r_lambda, r_v)
+    const Eigen::VectorXd z = w.lu.transpose().solve(y);
+    w.rr = -bh2 * z.head(n);
+    w.rl = -z.segment(n, m);
+    if (index2 && m > 0)
+        w.rv = -(p.beta * h / p.gamma) * z.tail(m);
+    // the linearized residual r = K q_p + C v_p + R_p, r_lambda = J q_p, r_v = Z q_p + J v_p
+    w.qp = w.mq;
+    w.vp = w.mv;
+    if (K)
+        K_.multiply_transpose_add(1.0, w.rr, w.qp);
+    if (C)
+        C_.multiply_transpose_add(1.0, w.rr, w.vp);
+    J_.multiply_transpose_add(1.0, w.rl, w.qp);
+    if (index2 && m > 0) {
+        Z_.multiply_transpose_add(1.0, w.rv, w.qp);
+        J_.multiply_transpose_add(1.0, w.rv, w.vp);
+    }
+    for (int j = 0; j < w.np; ++j) {
+        sens.rq.setZero();
+        if ((st = parameter_residual(j, t1, x)))
+            return st;
+        w.dJ[j] += w.rr.dot(sens.rq);
+    }
+    // P^T: a_p = (af sqdd - am sa) / (1 - am), q_p = s_q + h sv + h^2 ((1/2 - beta) sa + beta a_p)
+    // (- in index 2 the derivative of B^T eta_bar along s_q), v_p = sv + h ((1 - gamma) sa +
+    // gamma a_p)
+    const Vec map = (h * h * p.beta) * w.qp + (h * p.gamma) * w.vp;
+    const Vec msv = h * w.qp + w.vp;
+    const Vec msa = (h * h * (0.5 - p.beta)) * w.qp + (h * (1.0 - p.gamma)) * w.vp -
+                    (am / (1.0 - am)) * (map + w.ma);
+    const Vec msqdd = (af / (1.0 - am)) * (map + w.ma);
+    Vec msq = w.qp;
+    if (index2 && m > 0) {
+        if ((st = correction_derivative(e0[0], q_n, w.eta, w.qp, w.tmp)))
+            return st;
+        msq += w.tmp;
+    }
+    if (kind == AdjointRecord::First) {  // the start, differenced in p (sensitivity.cpp)
+        for (int j = 0; j < w.np; ++j)
+            w.dJ[j] += msq.dot(r.sigma0[j].q) + msv.dot(r.start0[j].v) +
+                       msa.dot(r.start0[j].a) + msqdd.dot(r.start0[j].qdd);
+        return GA_OK;
+    }
+    // the start as the accepted state (a_n rescaled by rho): the adjoint of sigma_k
+    w.mq = msq;
+    w.mv = msv;
+    w.mqdd = msqdd + (1.0 - rho) * msa;
+    w.ma = rho * msa;
+    w.ml.setZero();
+    return GA_OK;
+}
+
+ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, double *J,
+                                   double *dJ)
+{
+    AdjointRecord &r = adjoint_;
+    if (r.unsupported_at >= 0)
+        return diag.fail(GA_ERR_STATE,
+                         "the recorded run has a step the adjoint sweep does not cover (step "
+                         "%ld: a Taylor step, or a fresh start after short steps)",
+                         r.unsupported_at);
+    if (redundancy == GA_REDUNDANT_DROP && m_ > 0)
+        return diag.fail(GA_ERR_STATE, "the adjoint sweep with dropped redundant constraints is "
+                         "not built");
+    AdjointWork w;
+    w.allocate(n_, m_, sens.np);
+    const long N = r.steps;
+    // Cost terms at a recorded state k: its value into `value`, weight times its gradient
+    // into the adjoint variables (and into dJ/dp).
+    const auto cost = [&](ga_cost_fn fn, long k, double weight, double &total) {
+        const double *e = r.entry(k);
+        const double *q = e + 4, *v = q + n_, *qdd = v + n_, *lambda = qdd + n_;
+        double value = 0.0;
+        const int rc = fn(e[0], q, v, qdd, lambda, &value, w.cq.data(), w.cv.data(),
+                          w.cqdd.data(), w.cl.data(), w.cp.data(), model.cb.user);
+        if (rc)
+            return diag.fail(rc > 0 ? GA_ERR_CALLBACK_RETRY : GA_ERR_CALLBACK,
+                             "cost callback returned %d at t = %.17g", rc, e[0]);
+        if (!std::isfinite(value) || !all_finite(w.cq) || !all_finite(w.cv) ||
+            !all_finite(w.cqdd) || !all_finite(w.cl) || !all_finite(w.cp))
+            return diag.fail(GA_ERR_NONFINITE, "cost callback output is not finite at t = %.17g",
+                             e[0]);
+        total += weight * value;
+        w.mq += weight * w.cq;
+        w.mv += weight * w.cv;
+        w.mqdd += weight * w.cqdd;
+        w.ml += weight * w.cl;
+        for (int j = 0; j < w.np; ++j)
+            w.dJ[j] += weight * w.cp[j];
+        return GA_OK;
+    };
+    // trapezoidal weights of the recorded steps
+    const auto weight = [&](long k) {
+        const double before = k > 0 ? r.entry(k)[1] : 0.0;
+        const double after = k < N ? r.entry(k + 1)[1] : 0.0;
+        return 0.5 * (before + after);
+    };
+    double total = 0.0;
+    // at x_N
+    if (terminal)
+        if (auto st = cost(terminal, N, 1.0, total))
+            return st;
+    for (long k = N; k >= 0; --k) {
+        if (running)
+            if (auto st = cost(running, k, weight(k), total))
+                return st;
+        if (k == 0) {  // x_0 itself: sigma_0 (the start without a step, or L at t0)
+            for (int j = 0; j < w.np; ++j) {
+                const StateDerivative &s0 = r.sigma0[j];
+                w.dJ[j] += w.mq.dot(s0.q) + w.mv.dot(s0.v) + w.mqdd.dot(s0.qdd) +
+                           w.ml.dot(s0.lambda) + w.ma.dot(s0.a);
+            }
+            break;
+        }
+        if (auto st = adjoint_step(k - 1, w)) {
+            diag.append(" (adjoint sweep, step %ld of %ld)", k, N);
+            return st;
+        }
+        if (k - 1 == 0) {  // the first step took the start's share (sigma_0 included)
+            w.mq.setZero();
+            w.mv.setZero();
+            w.mqdd.setZero();
+            w.ml.setZero();
+            w.ma.setZero();
+        }
+    }
+    (void)dot_map;
+    *J = total;
+    for (int j = 0; j < w.np; ++j)
+        dJ[j] = w.dJ[j];
+    return GA_OK;
+}
+
+}  // namespace ga

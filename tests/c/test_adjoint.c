@@ -1,0 +1,226 @@
+/* The discrete adjoint (ga_adjoint_gradient) against the forward sensitivities of the same run
+ * (issue 20). A terminal cost linear in the final state, c . x_N, makes dJ/dp = c . sigma_N the
+ * dot-product identity of the tangent map and its transpose: equal to round-off. Running costs
+ * (the kinetic energy, a multiplier squared) against the forward sensitivities summed with the
+ * same trapezoidal weights. Pendulum, slider-crank, sparse chain; index 3 and 2; fixed and
+ * adaptive steps. Refusals and a full record. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "scene_catalog.h"
+
+enum { kMaxP = 3, kMaxSteps = 5000 };
+
+typedef struct setup {
+    int scene, formulation, adaptive, steps;
+    double t_end, tol;
+    int np, depends;
+    double *(*params)(void);
+} setup;
+
+static double *pendulum_gravity(void) { return &g_catalog_pendulum.gravity; }
+static double *crank_masses_torque(void) { return &g_catalog_crank.m3; }
+static double *chain_link(void) { return &g_catalog_chain.mass; }
+
+/* the cost's weights: c . (q, v, qdd, lambda) at the end; running: |v|^2 / 2 + lambda_0^2 */
+static double g_c[4][kCatalogMaxN];
+static int g_n, g_m, g_np;
+
+static int terminal_linear(double t, const double *q, const double *v, const double *qdd,
+                           const double *lambda, double *value, double *d_q, double *d_v,
+                           double *d_qdd, double *d_lambda, double *d_p, void *user)
+{
+    (void)t, (void)user;
+    double J = 0;
+    for (int i = 0; i < g_n; ++i) {
+        J += g_c[0][i] * q[i] + g_c[1][i] * v[i] + g_c[2][i] * qdd[i];
+        d_q[i] = g_c[0][i], d_v[i] = g_c[1][i], d_qdd[i] = g_c[2][i];
+    }
+    for (int i = 0; i < g_m; ++i) {
+        J += g_c[3][i] * lambda[i];
+        d_lambda[i] = g_c[3][i];
+    }
+    for (int j = 0; j < g_np; ++j)
+        d_p[j] = 0.0;
+    *value = J;
+    return 0;
+}
+
+static int running_energy_multiplier(double t, const double *q, const double *v,
+                                     const double *qdd, const double *lambda, double *value,
+                                     double *d_q, double *d_v, double *d_qdd, double *d_lambda,
+                                     double *d_p, void *user)
+{
+    (void)t, (void)q, (void)qdd, (void)user;
+    double J = 0;
+    for (int i = 0; i < g_n; ++i) {
+        J += 0.5 * v[i] * v[i];
+        d_q[i] = 0.0, d_v[i] = v[i], d_qdd[i] = 0.0;
+    }
+    for (int i = 0; i < g_m; ++i)
+        d_lambda[i] = 0.0;
+    J += lambda[0] * lambda[0];
+    d_lambda[0] = 2.0 * lambda[0];
+    for (int j = 0; j < g_np; ++j)
+        d_p[j] = 0.0;
+    *value = J;
+    return 0;
+}
+
+/* One run with forward sensitivities and the adjoint record: the adjoint's J and dJ/dp for the
+ * terminal and the running cost, and the same from the forward sensitivities. */
+static void compare(const setup *u, const char *label)
+{
+    catalog_scene sc = catalog_make(u->scene);
+    g_n = sc.n, g_m = sc.m, g_np = u->np;
+    srand(7);
+    for (int k = 0; k < 4; ++k)
+        for (int i = 0; i < kCatalogMaxN; ++i)
+            g_c[k][i] = (double)rand() / RAND_MAX - 0.5;
+    ga_solver *s = catalog_solver(&sc);
+    assert_non_null(s);
+    assert_int_equal(ga_set_formulation(s, u->formulation), GA_OK);
+    assert_int_equal(ga_set_sensitivity(s, u->np, u->params(), NULL, u->depends), GA_OK);
+    assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT,
+                                               kMaxSteps),
+                     GA_OK);
+    assert_int_equal(ga_init(s, 0.0, sc.q0, sc.v0), GA_OK);
+    if (u->adaptive)
+        assert_int_equal(ga_set_tolerances(s, u->tol, u->tol), GA_OK);
+    /* forward: dJ/dp of the running cost by the trapezoidal rule over the steps */
+    double fwd_run[kMaxP] = {0}, run_prev[kMaxP], J_run = 0, L_prev = 0, t = 0, t_prev = 0;
+    double q[kCatalogMaxN], v[kCatalogMaxN], qdd[kCatalogMaxN], lam[kCatalogMaxN];
+    double d[4][kCatalogMaxN], grad[4][kCatalogMaxN], dp[kMaxP], L;
+    int steps = 0;
+    for (;;) {
+        assert_int_equal(ga_get_q(s, q), GA_OK);
+        assert_int_equal(ga_get_v(s, v), GA_OK);
+        assert_int_equal(ga_set_output(s, GA_OUTPUT_STEP), GA_OK);
+        assert_int_equal(ga_get_qdd(s, qdd), GA_OK);
+        assert_int_equal(ga_get_lambda(s, lam), GA_OK);
+        running_energy_multiplier(t, q, v, qdd, lam, &L, grad[0], grad[1], grad[2], grad[3], dp,
+                                  NULL);
+        for (int j = 0; j < u->np; ++j) {
+            assert_int_equal(ga_get_sensitivity(s, j, d[0], d[1], d[2], d[3]), GA_OK);
+            double dL = 0;
+            for (int k = 0; k < 4; ++k)
+                for (int i = 0; i < (k == 3 ? sc.m : sc.n); ++i)
+                    dL += grad[k][i] * d[k][i];
+            if (steps > 0)
+                fwd_run[j] += 0.5 * (t - t_prev) * (run_prev[j] + dL);
+            run_prev[j] = dL;
+        }
+        if (steps > 0)
+            J_run += 0.5 * (t - t_prev) * (L_prev + L);
+        L_prev = L;
+        t_prev = t;
+        if (t >= (u->t_end > 0 ? u->t_end : sc.t_end) * (1 - 1e-12))
+            break;
+        const ga_status st = u->adaptive ? ga_step_adaptive(s, u->t_end) : ga_step(s, u->t_end / u->steps);
+        assert_int_equal(st, GA_OK);
+        assert_int_equal(ga_get_t(s, &t), GA_OK);
+        ++steps;
+    }
+    /* c . sigma_N, with c on (q, v) only and on (q, v, qdd, lambda): the latter carries the
+     * round-off of the step's qdd and lambda, eps / (beta h^2) relative to them in index 3 and
+     * eps / (gamma h) in index 2 (paper, sec. 3.3), amplified alike in both sweeps */
+    for (int full = 0; full < 2; ++full) {
+        if (!full)
+            for (int i = 0; i < kCatalogMaxN; ++i)
+                g_c[2][i] = g_c[3][i] = 0.0;
+        else
+            for (int k = 2; k < 4; ++k)
+                for (int i = 0; i < kCatalogMaxN; ++i)
+                    g_c[k][i] = (double)rand() / RAND_MAX - 0.5;
+        double fwd_lin[kMaxP] = {0};
+        for (int j = 0; j < u->np; ++j) {
+            assert_int_equal(ga_get_sensitivity(s, j, d[0], d[1], d[2], d[3]), GA_OK);
+            for (int k = 0; k < 4; ++k)
+                for (int i = 0; i < (k == 3 ? sc.m : sc.n); ++i)
+                    fwd_lin[j] += g_c[k][i] * d[k][i];
+        }
+        double J, adj[kMaxP];
+        assert_int_equal(ga_adjoint_gradient(s, NULL, terminal_linear, &J, adj), GA_OK);
+        const double bound = !full ? 1e-12 : u->formulation == GA_INDEX3 ? 1e-9 : 1e-10;
+        for (int j = 0; j < u->np; ++j) {
+            const double rel = fabs(adj[j] - fwd_lin[j]) / fmax(fabs(fwd_lin[j]), 1e-300);
+            printf("  %-34s p%d  c.sigma_N (%s): forward %+.15e adjoint %+.15e (%.1e)\n", label,
+                   j, full ? "q, v, qdd, lambda" : "q, v", fwd_lin[j], adj[j], rel);
+            assert_true(rel < bound);
+        }
+    }
+    double J, adj[kMaxP];
+    assert_int_equal(ga_adjoint_gradient(s, running_energy_multiplier, NULL, &J, adj), GA_OK);
+    assert_true(fabs(J - J_run) <= 1e-12 * fabs(J_run));
+    for (int j = 0; j < u->np; ++j) {
+        const double rel = fabs(adj[j] - fwd_run[j]) / fmax(fabs(fwd_run[j]), 1e-300);
+        printf("  %-34s p%d  int(|v|^2/2 + lambda_0^2): forward %+.12e adjoint %+.12e (%.1e)\n",
+               label, j, fwd_run[j], adj[j], rel);
+        assert_true(rel < 1e-9);
+    }
+    printf("  %-34s %d steps\n", label, steps);
+    ga_free(s);
+}
+
+static void run_list(const setup *list, int count, const char *name)
+{
+    for (int k = 0; k < count; ++k) {
+        char label[80];
+        snprintf(label, sizeof label, "%s %s %s", name,
+                 list[k].formulation == GA_INDEX3 ? "index 3" : "index 2",
+                 list[k].adaptive ? "adaptive" : "fixed");
+        compare(&list[k], label);
+    }
+}
+
+static void pendulum_adjoint(void **state)
+{
+    (void)state;
+    const setup list[] = {
+        {0, GA_INDEX3, 0, 200, 1.0, 0, 1, GA_DEPENDS_FORCE, pendulum_gravity},
+        {0, GA_INDEX2_STABILIZED, 0, 200, 1.0, 0, 1, GA_DEPENDS_FORCE, pendulum_gravity},
+        {0, GA_INDEX3, 1, 0, 1.0, 1e-4, 1, GA_DEPENDS_FORCE, pendulum_gravity},
+        {0, GA_INDEX2_STABILIZED, 1, 0, 1.0, 1e-5, 1, GA_DEPENDS_FORCE, pendulum_gravity},
+    };
+    run_list(list, 4, "pendulum gravity");
+}
+
+static void crank_adjoint(void **state)
+{
+    (void)state;
+    const int md = GA_DEPENDS_FORCE | GA_DEPENDS_MASS;
+    const setup list[] = {
+        {1, GA_INDEX3, 0, 100, 0.5, 0, 3, md, crank_masses_torque},
+        {1, GA_INDEX2_STABILIZED, 0, 100, 0.5, 0, 3, md, crank_masses_torque},
+        {1, GA_INDEX2_STABILIZED, 1, 0, 0.5, 1e-5, 3, md, crank_masses_torque},
+    };
+    run_list(list, 3, "slider-crank");
+}
+
+static void chain_adjoint(void **state)
+{
+    (void)state;
+    const int md = GA_DEPENDS_FORCE | GA_DEPENDS_MASS;
+    const setup list[] = {
+        {4, GA_INDEX3, 0, 100, 1.0, 0, 3, md, chain_link},
+        {4, GA_INDEX2_STABILIZED, 1, 0, 1.0, 1e-5, 3, md, chain_link},
+    };
+    run_list(list, 2, "chain (sparse)");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(pendulum_adjoint),
+        cmocka_unit_test(crank_adjoint),
+        cmocka_unit_test(chain_adjoint),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
