@@ -157,7 +157,6 @@ void add_block(std::vector<Eigen::Triplet<double>> &t, const Sparse &A, double s
                        : t.emplace_back(row0 + it.row(), col0 + it.col(), scale * it.value());
 }
 
-double dot_map(const Vec &a, const double *b) { return a.dot(Eigen::Map<const Vec>(b, a.size())); }
 }  // namespace
 
 // Step k -> k + 1 backwards: w.mq ... w.ma hold the adjoint of sigma_{k+1}; on return they
@@ -328,15 +327,9 @@ ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, doub
         const double *e = r.entry(k);
         const double *q = e + 4, *v = q + n_, *qdd = v + n_, *lambda = qdd + n_;
         double value = 0.0;
-        const int rc = fn(e[0], q, v, qdd, lambda, &value, w.cq.data(), w.cv.data(),
-                          w.cqdd.data(), w.cl.data(), w.cp.data(), model.cb.user);
-        if (rc)
-            return diag.fail(rc > 0 ? GA_ERR_CALLBACK_RETRY : GA_ERR_CALLBACK,
-                             "cost callback returned %d at t = %.17g", rc, e[0]);
-        if (!std::isfinite(value) || !all_finite(w.cq) || !all_finite(w.cv) ||
-            !all_finite(w.cqdd) || !all_finite(w.cl) || !all_finite(w.cp))
-            return diag.fail(GA_ERR_NONFINITE, "cost callback output is not finite at t = %.17g",
-                             e[0]);
+        if (auto st = model.cost(fn, e[0], q, v, qdd, lambda, value, w.cq, w.cv, w.cqdd, w.cl,
+                                 w.cp))
+            return st;
         total += weight * value;
         w.mq += weight * w.cq;
         w.mv += weight * w.cv;
@@ -381,7 +374,6 @@ ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, doub
             w.ma.setZero();
         }
     }
-    (void)dot_map;
     *J = total;
     for (int j = 0; j < w.np; ++j)
         dJ[j] = w.dJ[j];

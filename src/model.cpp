@@ -227,6 +227,30 @@ ga_status Model::mass_p(double t, const Vec &q, int j, const Vec &a, Vec &out)
     return check_finite(out.data(), n_, 0, "(dM/dp) a", t);
 }
 
+ga_status Model::cost(ga_cost_fn fn, double t, const double *q, const double *v,
+                      const double *qdd, const double *lambda, double &value, Vec &d_q,
+                      Vec &d_v, Vec &d_qdd, Vec &d_lambda, Vec &d_p)
+{
+    if (auto st = callback_status(user([&] {
+                                      return fn(t, q, v, qdd, lambda, &value, d_q.data(),
+                                                d_v.data(), d_qdd.data(), d_lambda.data(),
+                                                d_p.data(), cb.user);
+                                  }),
+                                  "cost", t))
+        return st;
+    if (!std::isfinite(value))
+        return check_finite(&value, 1, 0, "cost value", t);
+    if (auto st = check_finite(d_q.data(), d_q.size(), 0, "cost gradient in q", t))
+        return st;
+    if (auto st = check_finite(d_v.data(), d_v.size(), 0, "cost gradient in v", t))
+        return st;
+    if (auto st = check_finite(d_qdd.data(), d_qdd.size(), 0, "cost gradient in qdd", t))
+        return st;
+    if (auto st = check_finite(d_lambda.data(), d_lambda.size(), 0, "cost gradient in lambda", t))
+        return st;
+    return check_finite(d_p.data(), d_p.size(), 0, "cost gradient in p", t);
+}
+
 ga_status Model::constraint(double t, const Vec &q, Vec &phi)
 {
     if (m_ == 0)

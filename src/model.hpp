@@ -141,6 +141,11 @@ public:
     // df/dp_j, and (dM/dp_j) a, by the callbacks of ga_set_parameter_derivatives.
     ga_status force_p(double t, const Vec &q, const Vec &v, int j, Vec &out);
     ga_status mass_p(double t, const Vec &q, int j, const Vec &a, Vec &out);
+    // A cost term of ga_adjoint_gradient (q, v, qdd, lambda as recorded): its value and its
+    // gradients, checked.
+    ga_status cost(ga_cost_fn fn, double t, const double *q, const double *v, const double *qdd,
+                   const double *lambda, double &value, Vec &d_q, Vec &d_v, Vec &d_qdd,
+                   Vec &d_lambda, Vec &d_p);
     // Phi_qq(v, v) + 2 Phi_qt v + Phi_tt.
     ga_status constraint_accel(double t, const Vec &q, const Vec &v, Vec &out);
     // Phi_t: the callback, or extrapolated central differences in t (exactly zero for

@@ -215,12 +215,126 @@ static void chain_adjoint(void **state)
     run_list(list, 2, "chain (sparse)");
 }
 
+
+/* ---- refusals, a full record, steps the sweep does not cover ---- */
+static int failing_cost(double t, const double *q, const double *v, const double *qdd,
+                        const double *lambda, double *value, double *d_q, double *d_v,
+                        double *d_qdd, double *d_lambda, double *d_p, void *user)
+{
+    terminal_linear(t, q, v, qdd, lambda, value, d_q, d_v, d_qdd, d_lambda, d_p, user);
+    return -2;
+}
+
+static ga_solver *pendulum_solver(int methods, long max_steps)
+{
+    catalog_scene sc = catalog_make(0);
+    g_n = sc.n, g_m = sc.m, g_np = 1;
+    ga_solver *s = catalog_solver(&sc);
+    assert_int_equal(ga_set_sensitivity(s, 1, &g_catalog_pendulum.gravity, NULL,
+                                        GA_DEPENDS_FORCE),
+                     GA_OK);
+    assert_int_equal(ga_set_sensitivity_method(s, methods, max_steps), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, sc.q0, sc.v0), GA_OK);
+    return s;
+}
+
+static void refusals(void **state)
+{
+    (void)state;
+    catalog_scene sc = catalog_make(0);
+    g_n = sc.n, g_m = sc.m, g_np = 1;
+    ga_solver *s = catalog_solver(&sc);
+    double J, dJ[1];
+    assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 10), GA_ERR_STATE);
+    assert_non_null(strstr(ga_last_error(s), "before ga_set_sensitivity"));
+    assert_int_equal(ga_set_sensitivity(s, 1, &g_catalog_pendulum.gravity, NULL,
+                                        GA_DEPENDS_FORCE),
+                     GA_OK);
+    assert_int_equal(ga_set_sensitivity_method(s, 0, 10), GA_ERR_ARG);
+    assert_int_equal(ga_set_sensitivity_method(s, 4, 10), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "GA_SENSITIVITY_FORWARD"));
+    assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 0), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "max_steps"));
+    assert_int_equal(ga_adjoint_gradient(s, NULL, terminal_linear, &J, dJ), GA_ERR_STATE);
+    assert_non_null(strstr(ga_last_error(s), "without a recorded run"));
+    assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 10), GA_OK);
+    assert_int_equal(ga_adjoint_gradient(s, NULL, terminal_linear, &J, dJ), GA_ERR_STATE);
+    assert_non_null(strstr(ga_last_error(s), "before ga_init"));
+    assert_int_equal(ga_init(s, 0.0, sc.q0, sc.v0), GA_OK);
+    assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 10), GA_ERR_STATE);
+    assert_non_null(strstr(ga_last_error(s), "after ga_init"));
+    assert_int_equal(ga_adjoint_gradient(s, NULL, NULL, &J, dJ), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "no cost"));
+    assert_int_equal(ga_adjoint_gradient(s, NULL, terminal_linear, NULL, dJ), GA_ERR_ARG);
+    /* adjoint only: no forward sensitivities to read */
+    assert_int_equal(ga_step(s, 1e-2), GA_OK);
+    assert_int_equal(ga_get_sensitivity(s, 0, dJ, NULL, NULL, NULL), GA_ERR_STATE);
+    /* a failing cost */
+    assert_int_equal(ga_adjoint_gradient(s, NULL, failing_cost, &J, dJ), GA_ERR_CALLBACK);
+    assert_non_null(strstr(ga_last_error(s), "cost"));
+    /* restoring into a recorded run */
+    size_t len = 0;
+    assert_int_equal(ga_state_size(s, &len), GA_OK);
+    double *buf = malloc(len * sizeof(double));
+    assert_int_equal(ga_get_state(s, buf, len), GA_OK);
+    assert_int_equal(ga_set_state(s, buf, len), GA_ERR_STATE);
+    assert_non_null(strstr(ga_last_error(s), "recorded"));
+    free(buf);
+    ga_free(s);
+}
+
+/* A step beyond the record's room fails and changes nothing; the sweep covers what was
+ * recorded, and after a Taylor step it refuses. */
+static void full_record_and_uncovered_steps(void **state)
+{
+    (void)state;
+    ga_solver *s = pendulum_solver(GA_SENSITIVITY_ADJOINT, 5);
+    double J, dJ[1], t, q[2], q_after[2];
+    for (int k = 0; k < 5; ++k)
+        assert_int_equal(ga_step(s, 1e-2), GA_OK);
+    assert_int_equal(ga_get_q(s, q), GA_OK);
+    assert_int_equal(ga_step(s, 1e-2), GA_ERR_NOMEM);
+    assert_non_null(strstr(ga_last_error(s), "record is full"));
+    assert_int_equal(ga_get_t(s, &t), GA_OK);
+    assert_int_equal(ga_get_q(s, q_after), GA_OK);
+    assert_true(fabs(t - 0.05) < 1e-15);
+    assert_memory_equal(q, q_after, sizeof q);
+    assert_int_equal(ga_adjoint_gradient(s, NULL, terminal_linear, &J, dJ), GA_OK);
+    /* the same five steps with forward sensitivities: the same gradient */
+    ga_solver *f = pendulum_solver(GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT, 5);
+    for (int k = 0; k < 5; ++k)
+        assert_int_equal(ga_step(f, 1e-2), GA_OK);
+    double d[4][kCatalogMaxN], fwd = 0.0;
+    assert_int_equal(ga_get_sensitivity(f, 0, d[0], d[1], d[2], d[3]), GA_OK);
+    for (int k = 0; k < 4; ++k)
+        for (int i = 0; i < (k == 3 ? 1 : 2); ++i)
+            fwd += g_c[k][i] * d[k][i];
+    printf("  adjoint only %.15e, with forward %.15e\n", dJ[0], fwd);
+    assert_true(fabs(dJ[0] - fwd) <= 1e-8 * fabs(fwd));
+    ga_free(f);
+    ga_free(s);
+
+    s = pendulum_solver(GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT, 100);
+    assert_int_equal(ga_step(s, 1e-2), GA_OK);
+    assert_int_equal(ga_step(s, 1e-5), GA_OK); /* a Taylor step */
+    assert_int_equal(ga_adjoint_gradient(s, NULL, terminal_linear, &J, dJ), GA_ERR_STATE);
+    assert_non_null(strstr(ga_last_error(s), "Taylor step"));
+    /* a restart records afresh */
+    catalog_scene sc = catalog_make(0);
+    assert_int_equal(ga_init(s, 0.0, sc.q0, sc.v0), GA_OK);
+    assert_int_equal(ga_step(s, 1e-2), GA_OK);
+    assert_int_equal(ga_adjoint_gradient(s, NULL, terminal_linear, &J, dJ), GA_OK);
+    ga_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(pendulum_adjoint),
         cmocka_unit_test(crank_adjoint),
         cmocka_unit_test(chain_adjoint),
+        cmocka_unit_test(refusals),
+        cmocka_unit_test(full_record_and_uncovered_steps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -457,12 +457,14 @@ static void no_allocation_with_first_order_states(void **state)
 
 /* Forward sensitivities: the pendulum's mass as parameter (it enters M and f: differences of
  * both), index 3 and 2, fixed and adaptive steps, forces that fail now and then (the step and
- * its sensitivities are dropped); and the chain on the sparse path. */
+ * its sensitivities are dropped); the chain on the sparse path; the adjoint record, with and
+ * without forward sensitivities. */
 static void no_allocation_with_sensitivities(void **state)
 {
     (void)state;
-    for (int mode = 0; mode < 6; ++mode) {
-        const int adaptive = mode & 1, index2 = (mode >> 1) & 1, sparse = mode >= 4;
+    for (int mode = 0; mode < 8; ++mode) { /* 6, 7: the adjoint record, with and without */
+        const int adaptive = mode & 1, index2 = (mode >> 1) & 1, sparse = mode == 4 || mode == 5;
+        const int record = mode >= 6;
         pendulum p = {1.0, 1.0, 9.81};
         chain c = chain_make(8);
         const int n = sparse ? 24 : 2, m = sparse ? 16 : 1;
@@ -487,6 +489,11 @@ static void no_allocation_with_sensitivities(void **state)
                                                 GA_DEPENDS_FORCE | GA_DEPENDS_MASS),
                              GA_OK);
         }
+        if (record)
+            assert_int_equal(ga_set_sensitivity_method(
+                                 s, (mode == 6 ? GA_SENSITIVITY_FORWARD : 0) |
+                                        GA_SENSITIVITY_ADJOINT, 1000),
+                             GA_OK);
         assert_int_equal(ga_set_formulation(s, index2 ? GA_INDEX2_STABILIZED : GA_INDEX3),
                          GA_OK);
         assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
