@@ -39,6 +39,7 @@ module galpha
   integer(c_int), parameter, public :: GA_OUTPUT_CONSISTENT = 0, GA_OUTPUT_STEP = 1
   integer(c_int), parameter, public :: GA_COUPLING_G_Q = 0, GA_COUPLING_G_V = 1
   integer(c_int), parameter, public :: GA_DEPENDS_FORCE = 1, GA_DEPENDS_MASS = 2
+  integer(c_int), parameter, public :: GA_SENSITIVITY_FORWARD = 1, GA_SENSITIVITY_ADJOINT = 2
   integer(c_int), parameter, public :: GA_EVENT_BOTH = 0, GA_EVENT_RISING = 1, &
        GA_EVENT_FALLING = -1, GA_EVENT_LOG = 64
   integer(c_int), parameter, public :: GA_COUNT_STEPS = 0, GA_COUNT_FAILED_STEPS = 1, &
@@ -130,9 +131,18 @@ module galpha
        real(c_double), intent(out) :: out(*)
        type(c_ptr), value :: user
      end function ga_mass_p_fn
+     ! a cost term of ga_adjoint_gradient: its value and every partial derivative
+     integer(c_int) function ga_cost_fn(t, q, v, qdd, lambda, value, d_q, d_v, d_qdd, &
+          d_lambda, d_p, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*), v(*), qdd(*), lambda(*)
+       real(c_double), intent(out) :: value, d_q(*), d_v(*), d_qdd(*), d_lambda(*), d_p(*)
+       type(c_ptr), value :: user
+     end function ga_cost_fn
   end interface
   public :: ga_mass_fn, ga_force_fn, ga_constraint_fn, ga_stiffness_fn, ga_event_fn, &
-       ga_force_y_fn, ga_coupling_fn, ga_event_y_fn, ga_force_p_fn, ga_mass_p_fn
+       ga_force_y_fn, ga_coupling_fn, ga_event_y_fn, ga_force_p_fn, ga_mass_p_fn, ga_cost_fn
 
   ! ---- the C API, one to one ----------------------------------------------------------------
   interface
@@ -511,6 +521,20 @@ module galpha
        integer(c_int), value :: j
        real(c_double), intent(out), optional :: dq(*), dv(*), dqdd(*), dlambda(*)
      end function ga_get_sensitivity
+     integer(c_int) function ga_set_sensitivity_method(s, methods, max_steps) &
+          bind(C, name="ga_set_sensitivity_method")
+       import :: c_int, c_ptr, c_long
+       type(c_ptr), value :: s
+       integer(c_int), value :: methods
+       integer(c_long), value :: max_steps
+     end function ga_set_sensitivity_method
+     integer(c_int) function ga_adjoint_gradient(s, running, terminal, J, dJ_dp) &
+          bind(C, name="ga_adjoint_gradient")
+       import :: c_int, c_ptr, c_funptr, c_double
+       type(c_ptr), value :: s
+       type(c_funptr), value :: running, terminal
+       real(c_double), intent(out) :: J, dJ_dp(*)
+     end function ga_adjoint_gradient
      function c_strlen(p) bind(C, name="strlen")
        import :: c_ptr, c_size_t
        type(c_ptr), value :: p
@@ -532,7 +556,8 @@ module galpha
        ga_interpolate, ga_interpolate_qdd, ga_set_output, ga_set_events, ga_get_event_count, &
        ga_get_event, ga_set_first_order, ga_set_coupling, ga_set_coupling_exact, ga_init_y, &
        ga_get_y, ga_interpolate_y, ga_set_events_y, ga_set_coupling_pattern, &
-       ga_set_sensitivity, ga_set_parameter_derivatives, ga_get_sensitivity
+       ga_set_sensitivity, ga_set_parameter_derivatives, ga_get_sensitivity, &
+       ga_set_sensitivity_method, ga_adjoint_gradient
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
@@ -647,6 +672,12 @@ module galpha
      !> get_sensitivity(j, dq, dv, dqdd, dlambda): d/dp_j (j 1-based) of the accepted step's
      !> q, v, qdd, lambda (each optional)
      procedure :: get_sensitivity => solver_get_sensitivity
+     !> set_sensitivity_method(methods, max_steps): an ior of GA_SENSITIVITY_FORWARD and
+     !> GA_SENSITIVITY_ADJOINT (the run recorded for adjoint_gradient, up to max_steps steps)
+     procedure :: set_sensitivity_method => solver_set_sensitivity_method
+     !> adjoint_gradient(J, dJ_dp, running, terminal): the cost and its gradient by the
+     !> discrete adjoint of the recorded run (running and terminal optional, one needed)
+     procedure :: adjoint_gradient => solver_adjoint_gradient
   end type galpha_solver
   public :: galpha_strerror, galpha_version, galpha_version_number
 
@@ -917,6 +948,28 @@ contains
     if (present(dqdd)) dqdd(1:this%n) = x(1:this%n, 3)
     if (present(dlambda)) dlambda(1:this%m) = l(1:this%m)
   end function solver_get_sensitivity
+
+  integer(c_int) function solver_set_sensitivity_method(this, methods, max_steps) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer(c_int), intent(in) :: methods
+    integer, intent(in) :: max_steps
+    status = ga_set_sensitivity_method(this%handle, methods, int(max_steps, c_long))
+  end function solver_set_sensitivity_method
+
+  integer(c_int) function solver_adjoint_gradient(this, J, dJ_dp, running, terminal) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(out) :: J, dJ_dp(:)
+    procedure(ga_cost_fn), optional :: running, terminal
+    type(c_funptr) :: r, g
+    real(c_double) :: d(max(this%np, 1))
+    r = c_null_funptr
+    g = c_null_funptr
+    if (present(running)) r = c_funloc(running)
+    if (present(terminal)) g = c_funloc(terminal)
+    status = ga_adjoint_gradient(this%handle, r, g, J, d)
+    if (status == GA_OK) dJ_dp(1:this%np) = d(1:this%np)
+  end function solver_adjoint_gradient
 
   integer(c_int) function solver_set_constraint_accel(this, fn) result(status)
     class(galpha_solver), intent(inout) :: this

@@ -81,6 +81,20 @@ contains
     f_p(1) = -q(1)
     spring_p = merge(0, -1, j == 0)
   end function spring_p
+  ! the cost J = x(1) at the end
+  integer(c_int) function final_position(t, q, v, qdd, lambda, value, d_q, d_v, d_qdd, &
+       d_lambda, d_p, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*), qdd(*), lambda(*)
+    real(c_double), intent(out) :: value, d_q(*), d_v(*), d_qdd(*), d_lambda(*), d_p(*)
+    type(c_ptr), value :: user
+    value = q(1)
+    d_q(1) = 1.0d0
+    d_v(1) = 0.0d0
+    d_qdd(1) = 0.0d0
+    d_p(1) = 0.0d0
+    final_position = 0
+  end function final_position
 end module layer_events
 
 program test_layer
@@ -287,6 +301,21 @@ program test_layer
   end do
   call ok(r%get_sensitivity(1, q2(1:1)), 'get_sensitivity (callback)')
   call expect(abs(q2(1) - q(1)) < 1d-9 * abs(q(1)), 'df/dk by callback as by differences')
+  ! the adjoint of the same run: J = x(1) at t = 1, dJ/dk = dx/dk
+  call r%free()
+  call ok(r%create(1, 0), 'create for the adjoint')
+  call ok(r%set_callbacks(unit_mass, spring), 'callbacks')
+  call ok(r%set_sensitivity(stiffness, GA_DEPENDS_FORCE), 'set_sensitivity')
+  call ok(r%set_sensitivity_method(ior(GA_SENSITIVITY_FORWARD, GA_SENSITIVITY_ADJOINT), 1000), &
+          'set_sensitivity_method')
+  call ok(r%init(0.0d0, [1.0d0], [0.0d0]), 'init')
+  do i = 1, 1000
+     call ok(r%step(1d-3), 'step with the record')
+  end do
+  call ok(r%adjoint_gradient(x, q2(1:1), terminal=final_position), 'adjoint_gradient')
+  call ok(r%get_sensitivity(1, q(1:1)), 'get_sensitivity')
+  call expect(abs(q2(1) - q(1)) < 1d-12 * abs(q(1)), 'adjoint dJ/dk = forward dx/dk')
+  call expect(r%adjoint_gradient(x, q2(1:1)) == GA_ERR_ARG, 'adjoint_gradient needs a cost')
 
   call s%free()
   call r%free()

@@ -110,3 +110,61 @@ def test_callback_errors_reach_the_caller():
         with pytest.raises(RuntimeError, match="no derivative today"):
             s.step(1e-2)
         assert s.t == 0.0
+
+
+def test_adjoint_gradient_equals_forward():
+    """dJ/dp of J = integral of |v|^2 / 2 + lambda^2 plus the final height, by the adjoint
+    sweep and by the forward sensitivities summed with the same trapezoidal weights."""
+    p = np.array([1.0, 9.81])
+
+    def running(t, q, v, qdd, lam, d_q, d_v, d_qdd, d_lam, d_p):
+        d_v[:] = v
+        d_lam[0] = 2.0 * lam[0]
+        return 0.5 * v @ v + lam[0] ** 2
+
+    def terminal(t, q, v, qdd, lam, d_q, d_v, d_qdd, d_lam, d_p):
+        d_q[1] = 1.0
+        return q[1]
+
+    h, steps = 1e-2, 100
+    with pendulum(p, parameters=p, depends=("force", "mass"),
+                  sensitivity_method=("forward", "adjoint"), max_steps=steps,
+                  output=galpha.GA_OUTPUT_STEP) as s:
+        s.init(0.0, Q0, V0)
+        J_fwd, dJ_fwd, prev = 0.0, np.zeros(2), None
+        for k in range(steps + 1):
+            if k:
+                s.step(h)
+            v, lam, sens = s.v, s.lam, s.sensitivity()
+            L = 0.5 * v @ v + lam[0] ** 2
+            dL = v @ sens.dv + 2.0 * lam[0] * sens.dlam[0]
+            if prev is not None:
+                J_fwd += 0.5 * h * (prev[0] + L)
+                dJ_fwd += 0.5 * h * (prev[1] + dL)
+            prev = (L, dL)
+        J_fwd += s.q[1]
+        dJ_fwd += s.sensitivity().dq[1]
+        J, dJ = s.adjoint_gradient(running, terminal)
+    assert J == pytest.approx(J_fwd, rel=1e-12)
+    assert np.allclose(dJ, dJ_fwd, rtol=1e-9, atol=1e-12)
+
+
+def test_adjoint_refusals_and_errors():
+    p = np.array([1.0, 9.81])
+    with pytest.raises(ValueError, match="max_steps"):
+        pendulum(p, parameters=p, sensitivity_method=("adjoint",))
+    with pytest.raises(ValueError, match="unknown sensitivity method"):
+        pendulum(p, parameters=p, sensitivity_method=("backward",))
+
+    def broken(t, q, v, qdd, lam, *grads):
+        raise ZeroDivisionError("cost")
+
+    with pendulum(p, parameters=p, sensitivity_method=("adjoint",), max_steps=10) as s:
+        s.init(0.0, Q0, V0)
+        s.step(1e-2)
+        with pytest.raises(ZeroDivisionError):
+            s.adjoint_gradient(terminal=broken)
+        with pytest.raises(galpha.ArgumentError, match="no cost"):
+            s.adjoint_gradient()
+        with pytest.raises(galpha.StateError):
+            s.sensitivity()  # adjoint only: no forward sensitivities

@@ -104,6 +104,9 @@ FORCE_P_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_doubl
                               c_double_p, ctypes.c_void_p)  # (t, q, v, j, f_p, user)
 MASS_P_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, ctypes.c_int, c_double_p,
                              c_double_p, ctypes.c_void_p)   # (t, q, j, a, out, user)
+COST_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
+                           c_double_p, c_double_p, c_double_p, c_double_p, c_double_p,
+                           c_double_p, c_double_p, ctypes.c_void_p)
 COUPLING_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
                                c_double_p, c_double_p, c_double_p, c_double_p, ctypes.c_void_p)
 
@@ -125,6 +128,8 @@ GA_EVENT = 1  # not an error: a stepping call stopped at an event
 # Sensitivity dependence flags (ga_depends).
 GA_DEPENDS_FORCE = 1
 GA_DEPENDS_MASS = 2
+GA_SENSITIVITY_FORWARD = 1
+GA_SENSITIVITY_ADJOINT = 2
 
 # Enumerations.
 GA_TANGENT_AUTO, GA_TANGENT_FD, GA_TANGENT_NEGLECT = 0, 1, 2
@@ -220,6 +225,8 @@ _SIGNATURES = {
     "ga_set_sensitivity": (_I, [_S, _I, c_double_p, c_double_p, _I]),
     "ga_set_parameter_derivatives": (_I, [_S, FORCE_P_FN, MASS_P_FN]),
     "ga_get_sensitivity": (_I, [_S, _I, c_double_p, c_double_p, c_double_p, c_double_p]),
+    "ga_set_sensitivity_method": (_I, [_S, _I, ctypes.c_long]),
+    "ga_adjoint_gradient": (_I, [_S, COST_FN, COST_FN, c_double_p, c_double_p]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():

@@ -36,6 +36,7 @@ _COUPLING = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp)
 _EVENT_Y = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp)
 _FORCE_P = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _i, _vp, _vp)
 _MASS_P = ctypes.CFUNCTYPE(_i, _d, _vp, _i, _vp, _vp, _vp)
+_COST = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp)
 
 # The derivatives of the accepted step in the sensitivity parameters (Solver.sensitivity).
 Sensitivity = collections.namedtuple("Sensitivity", "dq dv dqdd dlam")
@@ -167,6 +168,10 @@ class Solver:
         ("force",)): what the parameters enter. `force_p` and `mass_p` optionally give df/dp_j
         and (dM/dp_j) a exactly (central differences otherwise). Read the derivatives of the
         accepted step with sensitivity().
+    sensitivity_method, max_steps
+        A subset of ("forward", "adjoint") (ga_set_sensitivity_method; default ("forward",)):
+        with "adjoint" the run from init() on is recorded, up to max_steps steps, for
+        adjoint_gradient().
     zero_copy : bool
         False (default): callbacks get copies of their inputs and an array of their own to
         fill, so what they keep stays valid and unchanged after the call. True: views of the
@@ -186,7 +191,8 @@ class Solver:
                  step_limits=None, initial_step=None, output=None, patterns=None,
                  r=0, rate=None, force_y=None, coupling=None, coupling_exact=None,
                  coupling_patterns=None, parameters=None, depends=("force",),
-                 parameter_scale=None, force_p=None, mass_p=None, zero_copy=False):
+                 parameter_scale=None, force_p=None, mass_p=None,
+                 sensitivity_method=("forward",), max_steps=None, zero_copy=False):
         self._ptr = None
         self._lock = threading.RLock()  # see _serialized
         self._pending = None          # exception raised inside a callback
@@ -362,6 +368,17 @@ class Solver:
         self._parameters = None
         if parameters is not None:
             self._set_sensitivity(parameters, depends, parameter_scale, force_p, mass_p)
+            methods = 0
+            for name in sensitivity_method:
+                if name not in ("forward", "adjoint"):
+                    raise ValueError(f"unknown sensitivity method {name!r} (forward or adjoint)")
+                methods |= (_ffi.GA_SENSITIVITY_FORWARD if name == "forward"
+                            else _ffi.GA_SENSITIVITY_ADJOINT)
+            if methods != _ffi.GA_SENSITIVITY_FORWARD or max_steps is not None:
+                if "adjoint" in sensitivity_method and max_steps is None:
+                    raise ValueError("the adjoint record needs max_steps")
+                self._check(_ffi.ga_set_sensitivity_method(self._ptr, methods,
+                                                           int(max_steps or 0)))
         if rho_inf is not None:
             self.set_rho_inf(rho_inf)
         if params is not None:
@@ -441,6 +458,47 @@ class Solver:
                                                 *[self._dp(x[j]) for x in out]))
         dq, dv, dqdd, dlam = (x[:, :k].T.copy() for x, k in zip(out, (n, n, n, m)))
         return Sensitivity(dq, dv, dqdd, dlam)
+
+    @_serialized
+    @_runs_callbacks
+    def adjoint_gradient(self, running=None, terminal=None):
+        """(J, dJ/dp) of J = terminal(x_N) + the trapezoidal sum of running(x_n) over the
+        steps recorded since init() (ga_adjoint_gradient), by the discrete adjoint. Each cost is
+        fn(t, q, v, qdd, lam, d_q, d_v, d_qdd, d_lam, d_p) -> value, filling the partial
+        derivatives (zeroed arrays of lengths n, n, n, m, np) where they are not zero."""
+        if self._parameters is None:
+            raise error_for(_ffi.GA_ERR_STATE, "no sensitivities: Solver(parameters=...)")
+        n, m, npar = self.n, self.m, self._parameters[0].size
+        v = self._view
+
+        def trampoline(fn):
+            if fn is None:
+                return None
+
+            def c(t, q, qd, qdd, lam, value, dq, dv, dqdd, dlam, dp, u):
+                if self._pending is not None or self._interrupted:
+                    return -1
+                try:
+                    outs = [np.zeros(k) for k in (n, n, n, m, npar)]
+                    val = fn(t, self._copied(q, n), self._copied(qd, n), self._copied(qdd, n),
+                             self._copied(lam, m) if m else np.zeros(0), *outs)
+                    v(value, (1,), True)[0] = float(val)
+                    for address, out in zip((dq, dv, dqdd, dlam, dp), outs):
+                        if out.size:
+                            v(address, out.shape, True)[...] = out
+                    return 0
+                except BaseException as e:  # re-raised below
+                    self._pending = e
+                    return -1
+            return _COST(c)
+
+        cbs = (trampoline(running), trampoline(terminal))
+        J = np.zeros(1)
+        dJ = np.zeros(max(npar, 1))
+        self._check(_ffi.ga_adjoint_gradient(self._handle(), _cast(cbs[0], _ffi.COST_FN),
+                                             _cast(cbs[1], _ffi.COST_FN), self._dp(J),
+                                             self._dp(dJ)))
+        return float(J[0]), dJ[:npar].copy()
 
     # ---- plumbing ---------------------------------------------------------------------------
     def _view(self, address, shape, writeable=False):
