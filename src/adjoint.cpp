@@ -8,10 +8,11 @@
 // The parameters enter through R_p of each step and the start's derivatives.
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include <Eigen/SparseCore>
-#include <Eigen/SparseLU>
 
+#include "linear/klu_system.hpp"
 #include "solver.hpp"
 
 namespace ga {
@@ -110,8 +111,15 @@ struct Solver::AdjointWork {
     Vec eta;
     std::vector<double> dJ;
     State x;                        // a recorded state
-    Eigen::SparseMatrix<double> S;
-    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+    // S, sparse on the sparse path (its pattern ordered once per sweep: the entries come from
+    // the user's fixed patterns), else dense
+#ifdef GALPHA_HAVE_KLU
+    std::unique_ptr<KluSystem> klu;
+    std::vector<int> slots;  // of the assembled entries, in order
+    Eigen::VectorXd rhs;
+#endif
+    Mat D, Md, Jd, Kd, Cd, Bd, Zd;
+    Eigen::PartialPivLU<Mat> dense_lu;
     std::vector<Eigen::Triplet<double>> entries;
     int np = 0;
     void allocate(int n, int m, int p)
@@ -146,6 +154,18 @@ Sparse to_sparse(const ModelMatrix &A)
     }
     S.setFromTriplets(t.begin(), t.end());
     return S;
+}
+
+// A user matrix as a dense one, into D.
+void dense_of(const ModelMatrix &A, Mat &D)
+{
+    if (A.dense()) {
+        D = A.as_dense();
+        return;
+    }
+    D.setZero(A.rows(), A.cols());
+    for (int k = 0; k < A.nnz(); ++k)
+        D(A.row_index()[k], A.col_index()[k]) += A.data()[k];
 }
 
 void add_block(std::vector<Eigen::Triplet<double>> &t, const Sparse &A, double scale, int row0,
@@ -202,36 +222,82 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
         return st;
 
     // S, scaled: rows (beta h^2, 1[, beta h / gamma]), unknowns (d or w, beta h^2 dlambda[, e])
-    const Sparse Ms = to_sparse(M_), Js = to_sparse(J_);
-    Sparse A = (bh2 * c.beta_prime) * Ms;
-    if (K)
-        A += bh2 * to_sparse(K_);
-    if (C)
-        A += (bh2 * c.gamma_prime) * to_sparse(C_);
-    w.entries.clear();
-    add_block(w.entries, A, 1.0, 0, 0);
-    add_block(w.entries, Js, 1.0, 0, n, true);
-    add_block(w.entries, Js, 1.0, n, 0);
     const int N = n + (index2 ? 2 * m : m);
-    if (index2 && m > 0) {
-        const Sparse Bs = to_sparse(B_), Zs = to_sparse(Z_);
-        const Sparse BT = Bs.transpose();
-        const double s3 = p.beta * h / p.gamma;
-        if (K) {
-            const Sparse KBT = to_sparse(K_) * BT;
-            add_block(w.entries, KBT, -bh2, 0, n + m);
-        }
-        const Sparse JBT = Js * BT, ZBT = Zs * BT;
-        add_block(w.entries, JBT, -1.0, n, n + m);
-        add_block(w.entries, Zs, s3, n + m, 0);
-        add_block(w.entries, Js, 1.0, n + m, 0);
-        add_block(w.entries, ZBT, -s3, n + m, n + m);
-    }
-    w.S.resize(N, N);
-    w.S.setFromTriplets(w.entries.begin(), w.entries.end());
+    const double s3 = p.beta * h / p.gamma;
     count(counters, GA_COUNT_FACTORIZATIONS);
-    w.lu.compute(w.S);
-    if (w.lu.info() != Eigen::Success)
+    bool singular = false;
+    if (sparse_backend_) {
+        const Sparse Ms = to_sparse(M_), Js = to_sparse(J_);
+        Sparse A = (bh2 * c.beta_prime) * Ms;
+        if (K)
+            A += bh2 * to_sparse(K_);
+        if (C)
+            A += (bh2 * c.gamma_prime) * to_sparse(C_);
+        w.entries.clear();
+        add_block(w.entries, A, 1.0, 0, 0);
+        add_block(w.entries, Js, 1.0, 0, n, true);
+        add_block(w.entries, Js, 1.0, n, 0);
+        if (index2 && m > 0) {
+            const Sparse Zs = to_sparse(Z_);
+            const Sparse BT = to_sparse(B_).transpose();
+            if (K)
+                add_block(w.entries, Sparse(to_sparse(K_) * BT), -bh2, 0, n + m);
+            add_block(w.entries, Sparse(Js * BT), -1.0, n, n + m);
+            add_block(w.entries, Zs, s3, n + m, 0);
+            add_block(w.entries, Js, 1.0, n + m, 0);
+            add_block(w.entries, Sparse(Zs * BT), -s3, n + m, n + m);
+        }
+#ifdef GALPHA_HAVE_KLU
+        if (!w.klu) {
+            std::vector<std::pair<int, int>> pattern;
+            pattern.reserve(w.entries.size());
+            for (const auto &t : w.entries)
+                pattern.emplace_back(t.row(), t.col());
+            w.klu = std::make_unique<KluSystem>();
+            w.klu->setup(N, pattern);
+            w.slots.resize(w.entries.size());
+            for (std::size_t k = 0; k < w.entries.size(); ++k)
+                w.slots[k] = w.klu->slot(w.entries[k].row(), w.entries[k].col());
+        }
+        if (w.slots.size() != w.entries.size())
+            return diag.fail(GA_ERR_INTERNAL, "the adjoint's sparse pattern changed");
+        std::vector<double> &values = w.klu->values();
+        std::fill(values.begin(), values.end(), 0.0);
+        for (std::size_t k = 0; k < w.entries.size(); ++k)
+            values[w.slots[k]] += w.entries[k].value();
+        singular = !w.klu->factorize();
+#else
+        return diag.fail(GA_ERR_INTERNAL, "sparse path without KLU");
+#endif
+    } else {
+        Mat &D = w.D;
+        D.setZero(N, N);
+        dense_of(M_, w.Md);
+        dense_of(J_, w.Jd);
+        D.topLeftCorner(n, n) = (bh2 * c.beta_prime) * w.Md;
+        if (K) {
+            dense_of(K_, w.Kd);
+            D.topLeftCorner(n, n) += bh2 * w.Kd;
+        }
+        if (C) {
+            dense_of(C_, w.Cd);
+            D.topLeftCorner(n, n) += (bh2 * c.gamma_prime) * w.Cd;
+        }
+        D.block(0, n, n, m) = w.Jd.transpose();
+        D.block(n, 0, m, n) = w.Jd;
+        if (index2 && m > 0) {
+            dense_of(B_, w.Bd);
+            dense_of(Z_, w.Zd);
+            if (K)
+                D.block(0, n + m, n, m) = -bh2 * (w.Kd * w.Bd.transpose());
+            D.block(n, n + m, m, m) = -(w.Jd * w.Bd.transpose());
+            D.block(n + m, 0, m, n) = s3 * w.Zd + w.Jd;
+            D.block(n + m, n + m, m, m) = -s3 * (w.Zd * w.Bd.transpose());
+        }
+        w.dense_lu.compute(D);
+        singular = !(w.dense_lu.rcond() > std::numeric_limits<double>::epsilon());
+    }
+    if (singular)
         return diag.fail(GA_ERR_SINGULAR,
                          "iteration matrix of the step from t = %.17g (h = %g) is singular in "
                          "the adjoint sweep",
@@ -254,7 +320,16 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
         y.tail(m) = w.ml / bh2;
     }
     // S^{-T}; the right-hand side was -(rows' scales) (r, r_lambda, r_v)
-    const Eigen::VectorXd z = w.lu.transpose().solve(y);
+    Eigen::VectorXd z;
+#ifdef GALPHA_HAVE_KLU
+    if (sparse_backend_) {
+        z = y;
+        w.klu->solve_transpose(z.data());
+    } else
+#endif
+    {
+        z = w.dense_lu.transpose().solve(y);
+    }
     w.rr = -bh2 * z.head(n);
     w.rl = -z.segment(n, m);
     if (index2 && m > 0)

@@ -256,6 +256,33 @@ void FixedPivotLU::solve(double *rhs)
     }
 }
 
+// A = (S P)^{-1} L U Q^{-1} (S the row scaling, P and Q the permutations of solve()), so
+// A^{-T} = P^T S L^{-T} U^{-T} Q^T: U^T and L^T are triangular, read by the columns of U and L.
+void FixedPivotLU::solve_transpose(double *rhs)
+{
+    double *w = work_.data();
+    const int *Lp = Lp_.data(), *Li = Li_.data(), *Up = Up_.data(), *Ui = Ui_.data();
+    const double *Lx = Lx_.data(), *Ux = Ux_.data();
+    for (int k = 0; k < N_; ++k)
+        w[k] = rhs[Q_[k]];
+    for (int k = 0; k < N_; ++k) {  // U^T z = w, forward
+        double z = w[k];
+        for (int p = Up[k]; p < Up[k + 1]; ++p)
+            z -= Ux[p] * w[Ui[p]];
+        w[k] = z / Ud_[k];
+    }
+    for (int k = N_ - 1; k >= 0; --k) {  // L^T y = z, backward (unit diagonal)
+        double y = w[k];
+        for (int q = Lp[k]; q < Lp[k + 1]; ++q)
+            y -= Lx[q] * w[Li[q]];
+        w[k] = y;
+    }
+    for (int i = 0; i < N_; ++i) {
+        rhs[P_[i]] = scale_[i] * w[i];
+        w[i] = 0.0;  // the work column stays zero between calls
+    }
+}
+
 // As solve(), walking b and x in their own order: row r of b goes to row pinv_[r] of w,
 // column c of x comes from row qinv_[c] of z (clearing it, as solve() does).
 void FixedPivotLU::solve_blocks(const double *b1, double c1, const double *b2, double c2,

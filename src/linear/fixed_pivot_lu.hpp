@@ -64,6 +64,8 @@ public:
 
     // rhs <- A^{-1} rhs, in place (length N).
     void solve(double *rhs);
+    // rhs <- A^{-T} rhs, in place (length N): the adjoint sweep's transposed solves.
+    void solve_transpose(double *rhs);
     // The same for a right-hand side and a solution kept in two blocks of their callers: rows
     // [0, n1) of b are c1 b1, the others c2 b2; x1 gets rows [0, n1) of x, x2 the others
     // divided by div2. Bit for bit what copying them in and out around solve() gives, without

@@ -326,6 +326,12 @@ void KluSystem::solve(double *rhs)
     lu_.solve(rhs);  // (D S) x = D b: lu_ scales b
 }
 
+void KluSystem::solve_transpose(double *rhs)
+{
+    const FlushSubnormals flush;
+    lu_.solve_transpose(rhs);
+}
+
 void KluSystem::solve_blocks(const double *b1, double c1, const double *b2, double c2, int n1,
                              double *x1, double *x2, double div2)
 {

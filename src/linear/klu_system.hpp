@@ -57,6 +57,7 @@ public:
     // first factorization then allocates only if it fills more. Throws std::bad_alloc.
     void reserve_factors();
     void solve(double *rhs);  // in place, length N
+    void solve_transpose(double *rhs);  // A^T x = rhs, in place
     // the same with b and x in two blocks (FixedPivotLU::solve_blocks)
     void solve_blocks(const double *b1, double c1, const double *b2, double c2, int n1,
                       double *x1, double *x2, double div2);

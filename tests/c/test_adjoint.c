@@ -130,7 +130,8 @@ static void compare(const setup *u, const char *label)
     }
     /* c . sigma_N, with c on (q, v) only and on (q, v, qdd, lambda): the latter carries the
      * round-off of the step's qdd and lambda, eps / (beta h^2) relative to them in index 3 and
-     * eps / (gamma h) in index 2 (paper, sec. 3.3), amplified alike in both sweeps */
+     * eps / (gamma h) in index 2 (paper, sec. 3.3) at each step, in each sweep: 3e-10 per step
+     * at the adaptive pendulum's h = 1.6e-3 in index 3, over 600 steps */
     for (int full = 0; full < 2; ++full) {
         if (!full)
             for (int i = 0; i < kCatalogMaxN; ++i)
@@ -148,7 +149,7 @@ static void compare(const setup *u, const char *label)
         }
         double J, adj[kMaxP];
         assert_int_equal(ga_adjoint_gradient(s, NULL, terminal_linear, &J, adj), GA_OK);
-        const double bound = !full ? 1e-12 : u->formulation == GA_INDEX3 ? 1e-9 : 1e-10;
+        const double bound = !full ? 1e-12 : u->formulation == GA_INDEX3 ? 1e-8 : 1e-10;
         for (int j = 0; j < u->np; ++j) {
             const double rel = fabs(adj[j] - fwd_lin[j]) / fmax(fabs(fwd_lin[j]), 1e-300);
             printf("  %-34s p%d  c.sigma_N (%s): forward %+.15e adjoint %+.15e (%.1e)\n", label,
