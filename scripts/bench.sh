@@ -55,6 +55,8 @@ if command -v valgrind >/dev/null; then
             >> "$out/step_instructions.csv"
     done
 fi
+echo "sensitivities: forward and adjoint against the plain run (interleaved rounds)"
+"$b/sensitivity_cost" 21 > "$out/sensitivity_cost.csv"
 echo "events that never fire: run time with and without (interleaved rounds)"
 "$b/event_cost" 41 > "$out/event_cost.csv"
 "$b/event_cost" side_by_side 800 > "$out/event_side_by_side.csv"

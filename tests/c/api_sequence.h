@@ -19,7 +19,7 @@
  * masses at the links' ends), m = L constraints |p_k - p_(k-1)|^2 = 1 (p_(-1) = 0), or L + 1
  * with the first stated twice (redundant), or none (free particles). */
 enum { MAX_LINKS = 3, NMAX = 2 * MAX_LINKS, MMAX = MAX_LINKS + 1, MAX_OPS = 64,
-       STATE_MAX = 1 + 4 * NMAX + MMAX + 2, CKPT_MAX = 1024 };
+       STATE_MAX = 1 + 4 * NMAX + MMAX + 2 + 2 * (3 * NMAX + MMAX), CKPT_MAX = 1024 };
 
 typedef enum fault_kind { NONE, RETURN_RETRY, RETURN_FATAL, WRITE_NAN, WRITE_INF, WRITE_HUGE,
                           REENTER, FAULT_KINDS } fault_kind;
@@ -47,6 +47,10 @@ typedef struct model {
      * multipliers */
     int ev_count, ev_dir[3], ev_term[3], ev_lambda;
     double ev_level[3];
+    /* sensitivities (ga_set_sensitivity) in p = (gravity, a parameter nothing reads); forward
+     * ones are part of the snapshot; an adjoint record refuses checkpoints */
+    double p[2];
+    int sens, sens_forward, sens_adjoint;
 } model;
 
 static uint64_t next(model *md)
@@ -141,7 +145,7 @@ static int force(double t, const double *q, const double *v, double *f, void *us
     model *md = user;
     (void)t, (void)q, (void)v;
     for (int i = 0; i < md->n; ++i)
-        f[i] = i % 2 ? -9.81 : 0.0;
+        f[i] = i % 2 ? -md->p[0] : 0.0;
     return misbehave(md, FORCE, f, md->n);
 }
 static int force_y(double t, const double *q, const double *v, const double *y, double *f,
@@ -245,6 +249,23 @@ static int time_derivative(double t, const double *q, double *phi_t, void *user)
     for (int i = 0; i < md->m; ++i)
         phi_t[i] = 0.0;
     return misbehave(md, DT, phi_t, md->m);
+}
+
+/* The adjoint's cost: q_0 at the end. */
+static int adjoint_cost(double t, const double *q, const double *v, const double *qdd,
+                        const double *lambda, double *value, double *d_q, double *d_v,
+                        double *d_qdd, double *d_lambda, double *d_p, void *user)
+{
+    const model *md = user;
+    (void)t, (void)v, (void)qdd, (void)lambda;
+    memset(d_q, 0, sizeof(double) * (size_t)md->n);
+    memset(d_v, 0, sizeof(double) * (size_t)md->n);
+    memset(d_qdd, 0, sizeof(double) * (size_t)md->n);
+    memset(d_lambda, 0, sizeof(double) * (size_t)md->m);
+    d_p[0] = d_p[1] = 0.0;
+    d_q[0] = 1.0;
+    *value = q[0];
+    return 0;
 }
 
 /* A pattern declaration: the model's own, or one ga_set_pattern must refuse. */
@@ -358,7 +379,14 @@ static int snapshot(const model *md, ga_solver *s, double *x)
     SEQ_REQUIRE(ga_get_lambda(s, md->m ? x + 1 + 4 * n : NULL) == GA_OK);
     if (md->r)
         SEQ_REQUIRE(ga_get_y(s, x + 1 + 4 * n + md->m, x + 2 + 4 * n + md->m) == GA_OK);
-    return 1 + 4 * n + md->m + 2 * md->r;
+    int len = 1 + 4 * n + md->m + 2 * md->r;
+    for (int j = 0; md->sens_forward && j < 2; ++j) {
+        double *d = x + len;
+        SEQ_REQUIRE(ga_get_sensitivity(s, j, d, d + n, d + 2 * n, md->m ? d + 3 * n : NULL) ==
+                    GA_OK);
+        len += 3 * n + md->m;
+    }
+    return len;
 }
 
 static void check(ga_solver *s, ga_status st, int changes_solver, const char *call, int seq)
@@ -389,7 +417,8 @@ static void check_transaction(const model *md, ga_solver *s, ga_status st,
 }
 
 typedef struct seq_stats {
-    long long calls, steps_ok, sparse_ok, twin_steps_ok, events;
+    long long calls, steps_ok, sparse_ok, twin_steps_ok, events, sensitivity_steps_ok,
+        adjoint_ok;
 } seq_stats;
 
 /* The restart twin: a few steps from a checkpoint, then the checkpoint restored in the same
@@ -458,6 +487,7 @@ static void after_step(const model *md, ga_solver *s, ga_status st, const double
     check_event_log(md, s, st, seq);
     stats->steps_ok += st >= GA_OK;
     stats->events += st == GA_EVENT;
+    stats->sensitivity_steps_ok += st >= GA_OK && md->sens;
     stats->sparse_ok += st >= GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
 }
 
@@ -466,6 +496,7 @@ static void after_step(const model *md, ga_solver *s, ga_status st, const double
 static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *stats)
 {
     model md = {0};
+    md.p[0] = 9.81;
     md.rng = 0x9E3779B97F4A7C15ull * (uint64_t)(seq + 1);
     md.data = data;
     md.size = size;
@@ -501,6 +532,13 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
     if (pick(&md, 3) == 0) {  /* a first-order state in a third of the runs */
         md.r = 1;
         SEQ_REQUIRE(ga_set_first_order(s, 1, force_y, rate) == GA_OK);
+    } else if (pick(&md, 3) == 0) {  /* else sensitivities in a third: forward, adjoint, both */
+        const int methods = 1 + pick(&md, 3);
+        md.sens = 1;
+        md.sens_forward = methods & GA_SENSITIVITY_FORWARD;
+        md.sens_adjoint = (methods & GA_SENSITIVITY_ADJOINT) != 0;
+        SEQ_REQUIRE(ga_set_sensitivity(s, 2, md.p, NULL, GA_DEPENDS_FORCE) == GA_OK);
+        SEQ_REQUIRE(ga_set_sensitivity_method(s, methods, 1 + pick(&md, 40)) == GA_OK);
     }
     const int ops = data ? MAX_OPS : 5 + pick(&md, MAX_OPS - 5);
     for (int op = 0; op < ops && !md.exhausted; ++op) {
@@ -514,7 +552,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         ga_status st = GA_OK;
         int changes = 1;
         const char *call = "";
-        switch (pick(&md, 38)) {
+        switch (pick(&md, 39)) {
         case 0: call = "ga_set_rho_inf"; st = ga_set_rho_inf(s, edge_value(&md)); break;
         case 1: {
             const double am = edge_value(&md), af = edge_value(&md), b = edge_value(&md);
@@ -615,7 +653,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
                 check(s, st, changes, call, seq);
                 /* (values a solver keeps, such as a constant mass matrix, are evaluated
                  * again after a restore: the twins agree when the callbacks are functions) */
-                if (pick(&md, 2) == 0 && !md.impure)
+                if (pick(&md, 2) == 0 && !md.impure && !md.sens_adjoint)
                     stats->twin_steps_ok += restart_twin(&md, s, buf, len, seq);
                 if (pick(&md, 3) == 0)
                     buf[pick(&md, (int)len)] = edge_value(&md);
@@ -668,6 +706,45 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             default:
                 call = "ga_set_first_order";
                 st = ga_set_first_order(s, md.r, force_y, rate);  /* the same, or refused */
+            }
+            break;
+        }
+        case 37: {  /* sensitivities: reads, the adjoint sweep, late or bad settings */
+            double d[NMAX], J, dJ[2];
+            switch (pick(&md, 4)) {
+            case 0:
+                call = "ga_get_sensitivity";
+                changes = 0;
+                st = ga_get_sensitivity(s, pick(&md, 4) - 1, d, NULL, NULL, NULL);
+                break;
+            case 1: {  /* reads the record: leaves the state as it was, whatever its status */
+                const int len = snapshot(&md, s, before);
+                double after[STATE_MAX];
+                call = "ga_adjoint_gradient";
+                st = ga_adjoint_gradient(s, NULL, adjoint_cost, &J, dJ);
+                stats->adjoint_ok += st == GA_OK;
+                if (len && (snapshot(&md, s, after) != len ||
+                            memcmp(before, after, sizeof(double) * (size_t)len) != 0))
+                    SEQ_FAIL("sequence %d: ga_adjoint_gradient changed the state", seq);
+                break;
+            }
+            case 2:
+                call = "ga_set_sensitivity_method";
+                st = ga_set_sensitivity_method(s, pick(&md, 5) - 1, pick(&md, 3) - 1);
+                if (st == GA_OK) {  /* before any ga_init: the record's size changed */
+                    md.sens_forward = 0;
+                    SEQ_REQUIRE(ga_set_sensitivity_method(
+                                    s, GA_SENSITIVITY_FORWARD |
+                                           (md.sens_adjoint ? GA_SENSITIVITY_ADJOINT : 0),
+                                    40) == GA_OK);
+                    md.sens_forward = md.sens;
+                }
+                break;
+            default:
+                call = "ga_set_sensitivity";  /* refused after ga_init or with np < 0 */
+                st = ga_set_sensitivity(s, -pick(&md, 2), md.p, NULL, GA_DEPENDS_FORCE);
+                if (st == GA_OK)  /* np = 0 before ga_init: sensitivities off */
+                    md.sens = md.sens_forward = md.sens_adjoint = 0;
             }
             break;
         }

@@ -40,15 +40,19 @@ static void random_call_sequences_keep_the_contract(void **state)
     for (int seq = 0; seq < SEQUENCES; ++seq)
         run_sequence(seq, NULL, 0, &stats);
     const long long steps_ok = stats.steps_ok, sparse_ok = stats.sparse_ok;
-    printf("  %d sequences, %lld calls, %lld accepted steps (%lld on the sparse path), %lld "
-           "steps repeated from a restored checkpoint, %lld stops at events\n",
-           SEQUENCES, stats.calls, steps_ok, sparse_ok, stats.twin_steps_ok, stats.events);
+    printf("  %d sequences, %lld calls, %lld accepted steps (%lld on the sparse path, %lld with "
+           "sensitivities), %lld steps repeated from a restored checkpoint, %lld stops at "
+           "events, %lld adjoint sweeps\n",
+           SEQUENCES, stats.calls, steps_ok, sparse_ok, stats.sensitivity_steps_ok,
+           stats.twin_steps_ok, stats.events, stats.adjoint_ok);
     /* the sequences must reach the stepping code, dense and sparse, not only the checks of
      * arguments and of the call order */
     assert_true(steps_ok > SEQUENCES / 2);
     assert_true(sparse_ok > SEQUENCES / 100);
     assert_true(stats.twin_steps_ok > SEQUENCES / 100);
     assert_true(stats.events > SEQUENCES / 400); /* few sequences step far; some must stop */
+    assert_true(stats.sensitivity_steps_ok > SEQUENCES / 100);
+    assert_true(stats.adjoint_ok > SEQUENCES / 400);
 }
 
 /* The sequences' model is exact: for every chain length, with and without the redundant
