@@ -732,7 +732,8 @@ typedef int (*ga_mass_p_fn)(double t, const double *q, int j, const double *a, d
  *  perturbs its entries in place (central differences, restored bit for bit before any call
  *  returns), and it must stay valid while the solver lives. p_scale (may be NULL: |p_j|, or 1
  *  where p_j = 0) sets the size of those perturbations, cbrt(eps) p_scale[j]. depends is an
- *  or of ::ga_depends. np = 0 turns sensitivities off. Errors: GA_ERR_ARG (np < 0, p NULL
+ *  or of ::ga_depends. np = 0 turns sensitivities off; the method is forward again
+ *  (ga_set_sensitivity_method). Errors: GA_ERR_ARG (np < 0, p NULL
  *  with np > 0, a p_scale entry not positive and finite, unknown flags, GA_DEPENDS_MASS with
  *  a constant mass), GA_ERR_STATE (after ga_init; with first-order states), GA_ERR_NOMEM. */
 GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const double *p_scale,
@@ -745,8 +746,8 @@ GA_API ga_status ga_set_parameter_derivatives(ga_solver *s, ga_force_p_fn force_
 
 /** The sensitivities of the accepted step with respect to p_j (lengths n, n, n, m; any pointer
  *  may be NULL). qdd and lambda are the step's own (GA_OUTPUT_STEP), whatever ga_set_output
- *  says. Errors: GA_ERR_ARG (j out of range), GA_ERR_STATE (before ga_init, or no
- *  sensitivities). */
+ *  says. Errors: GA_ERR_ARG (j out of range), GA_ERR_STATE (before ga_init, no sensitivities,
+ *  or only the adjoint's record). */
 GA_API ga_status ga_get_sensitivity(const ga_solver *s, int j, double *dq, double *dv,
                                     double *dqdd, double *dlambda);
 
