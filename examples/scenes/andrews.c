@@ -73,8 +73,16 @@ int an7_mass(double t, const double *q, double *M, void *user)
     return 0;
 }
 
+const andrews_params andrews_published = {4530.0, 0.033};
+
+/* The force's parameters: the user pointer's, or the published ones (NULL). */
+static const andrews_params *params_of(const void *user)
+{
+    return user ? (const andrews_params *)user : &andrews_published;
+}
+
 /* The spring acts between D on the triangle and the fixed point C. */
-static void spring(double gam, double *xd, double *yd, double *fx, double *fy)
+static void spring(double c0, double gam, double *xd, double *yd, double *fx, double *fy)
 {
     *xd = sd * cos(gam) + sc * sin(gam) + xb;
     *yd = sd * sin(gam) - sc * cos(gam) + yb;
@@ -87,10 +95,11 @@ static void spring(double gam, double *xd, double *yd, double *fx, double *fy)
 int an7_force(double t, const double *q, const double *v, double *f, void *user)
 {
     double xd, yd, fx, fy;
-    (void)t, (void)user;
-    spring(q[GA], &xd, &yd, &fx, &fy);
+    const andrews_params *p = params_of(user);
+    (void)t;
+    spring(p->c0, q[GA], &xd, &yd, &fx, &fy);
     const double sth = sin(q[TH]), cph = cos(q[PH]), com = cos(q[OM]);
-    f[0] = mom - m2 * da * rr * v[TH] * (v[TH] + 2 * v[BE]) * sth;
+    f[0] = p->mom - m2 * da * rr * v[TH] * (v[TH] + 2 * v[BE]) * sth;
     f[1] = m2 * da * rr * v[BE] * v[BE] * sth;
     f[2] = fx * (sc * cos(q[GA]) - sd * sin(q[GA])) + fy * (sd * cos(q[GA]) + sc * sin(q[GA]));
     f[3] = m4 * zt * (e - ea) * v[DE] * v[DE] * cph;
@@ -174,7 +183,7 @@ double an7_energy(const double *q, const double *v)
     for (int i = 0; i < 7; ++i)
         for (int j = 0; j < 7; ++j)
             T += 0.5 * v[i] * M[i + 7 * j] * v[j];
-    spring(q[GA], &xd, &yd, &fx, &fy);
+    spring(c0, q[GA], &xd, &yd, &fx, &fy);
     return T + spring_energy(xd, yd) - mom * (q[BE] - andrews_q0[BE]);
 }
 
@@ -255,11 +264,12 @@ int an31_mass(double t, const double *q, double *M, void *user)
 
 int an31_force(double t, const double *q, const double *v, double *f, void *user)
 {
-    (void)t, (void)v, (void)user;
+    const andrews_params *p = params_of(user);
+    (void)t, (void)v;
     memset(f, 0, sizeof(double) * AN31_N);
-    f[CM(1) + 2] = mom;
+    f[CM(1) + 2] = p->mom;
     const double dx = q[PD] - xc, dy = q[PD + 1] - yc, lg = hypot(dx, dy);
-    const double s = -c0 * (lg - l0) / lg;
+    const double s = -p->c0 * (lg - l0) / lg;
     f[PD] = s * dx;
     f[PD + 1] = s * dy;
     return 0;
@@ -318,7 +328,8 @@ int an31_constraint_accel(double t, const double *q, const double *v, double *ou
 int an31_stiffness(double t, const double *q, const double *v, const double *qdd,
                    const double *lambda, double *K, void *user)
 {
-    (void)t, (void)v, (void)qdd, (void)user;
+    const double c0 = params_of(user)->c0;
+    (void)t, (void)v, (void)qdd;
     memset(K, 0, sizeof(double) * AN31_N * AN31_N);
     /* the Phi_q^T lambda entry of a rotation is lambda_k . R(th)(b, -a); its derivative in th
      * is lambda_k . R(th)(a, b) */
@@ -406,7 +417,8 @@ int an31_jacobian_sparse(double t, const double *q, double *J, void *user)
 int an31_stiffness_sparse(double t, const double *q, const double *v, const double *qdd,
                           const double *lambda, double *K, void *user)
 {
-    (void)t, (void)v, (void)qdd, (void)user;
+    const double c0 = params_of(user)->c0;
+    (void)t, (void)v, (void)qdd;
     /* the same entries as an31_stiffness, written directly in the declared order */
     for (int b = 0; b < 7; ++b)
         K[b] = 0.0;

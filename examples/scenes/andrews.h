@@ -38,6 +38,14 @@ extern const double andrews_t_end;
 /* Relative 2-norm error of the 7 angles against the published reference at t = 0.03. */
 double andrews_angle_error(const double *q7);
 
+/* The parameters of the applied forces: the spring's stiffness c0 and the motor torque. The
+ * force and stiffness callbacks read them through their user pointer (NULL: these published
+ * values, 4530 N/m and 0.033 N m); the other callbacks ignore it. */
+typedef struct andrews_params {
+    double c0, mom;
+} andrews_params;
+extern const andrews_params andrews_published;
+
 /* ---- 7 relative angles ---------------------------------------------------------------- */
 int an7_mass(double t, const double *q, double *M, void *user);
 int an7_force(double t, const double *q, const double *v, double *f, void *user);

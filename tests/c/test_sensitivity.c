@@ -3,7 +3,9 @@
  * runs in p (steps p_j +- e and +- e/2, Richardson-extrapolated; those runs use full Newton, so
  * that their solutions are converged to round-off) to 1e-7 relative. Scenes: the pendulum
  * (gravity), the slider-crank of the paper (spring stiffness; slider mass, added mass and
- * torque, which enter M and f) and a chain on the sparse path (link mass, inertia and gravity);
+ * torque, which enter M and f), Andrews' mechanism in 7 angles and in 31 coordinates on the
+ * sparse path (the spring's stiffness and the motor torque) and a chain on the sparse path
+ * (link mass, inertia and gravity);
  * index 3 and stabilized index 2; fixed steps and adaptive ones (their step sizes replayed by
  * the difference runs: the sizes are inputs of the discrete map). */
 #include <math.h>
@@ -37,6 +39,10 @@ static double *pendulum_gravity(void) { return &g_catalog_pendulum.gravity; }
 static double *crank_stiffness(void) { return &g_catalog_crank.k; }
 static double *crank_masses_torque(void) { return &g_catalog_crank.m3; }
 static double *chain_link(void) { return &g_catalog_chain.mass; }
+/* Andrews' mechanism: the spring's stiffness and the motor torque, through the force's user
+ * pointer */
+static andrews_params g_andrews;
+static double *andrews_force(void) { return &g_andrews.c0; }
 
 typedef struct result {
     double x[kQuantities][kCatalogMaxN]; /* q, v, qdd, lambda */
@@ -62,6 +68,8 @@ static void read_state(ga_solver *s, int n, int m, result *r)
 static void run(const setup *u, const double *p, result *out, result *sens)
 {
     catalog_scene sc = catalog_make(u->scene);
+    if (u->scene == 2 || u->scene == 3)
+        sc.user = &g_andrews;
     double *pp = u->params();
     memcpy(pp, p, sizeof(double) * (size_t)u->np);
     ga_solver *s = catalog_solver(&sc);
@@ -119,6 +127,7 @@ static double check_setup(const setup *u, const char *label)
 {
     double p0[kMaxP];
     (void)catalog_make(u->scene); /* the scene's parameters as the runs start from them */
+    g_andrews = andrews_published;
     memcpy(p0, u->params(), sizeof(double) * (size_t)u->np);
     result base, sens[kMaxP];
     run(u, p0, &base, sens);
@@ -437,12 +446,24 @@ static void checkpoint_holds_sensitivities(void **state)
     }
 }
 
+static void andrews_sensitivity(void **state)
+{
+    (void)state;
+    const setup list[] = {
+        {2, GA_INDEX3, 0, 100, 0.03, 0, 2, GA_DEPENDS_FORCE, andrews_force},
+        {2, GA_INDEX2_STABILIZED, 1, 0, 0.03, 1e-5, 2, GA_DEPENDS_FORCE, andrews_force},
+        {3, GA_INDEX2_STABILIZED, 0, 300, 0.03, 0, 2, GA_DEPENDS_FORCE, andrews_force},
+    };
+    run_all(list, 3, "Andrews");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(pendulum_gravity_sensitivity),
         cmocka_unit_test(crank_sensitivity),
         cmocka_unit_test(chain_sensitivity),
+        cmocka_unit_test(andrews_sensitivity),
         cmocka_unit_test(derivative_callbacks_agree_with_differences),
         cmocka_unit_test(refusals),
         cmocka_unit_test(failed_sensitivity_fails_the_step),
