@@ -21,6 +21,8 @@
 
 #include <galpha.h>
 
+#include "rounds.h"
+
 #include "scenes/andrews.h"
 #include "scenes/chain.h"
 #include "scenes/pendulum.h"
@@ -30,7 +32,6 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-static int by_value(const void *a, const void *b);
 
 static int never(double t, const double *q, const double *v, const double *lambda, double *g,
                  void *user)
@@ -125,18 +126,6 @@ static long run(int k, int with_events)
     return st == GA_OK ? (long)steps : -1;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static int by_value(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 /* Two pendulum solvers, the second watching `functions` events, stepping in turns from the
  * same start: the median over `rounds` of the ratio of their times for 500 steps. */

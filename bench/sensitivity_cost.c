@@ -17,6 +17,8 @@
 
 #include <galpha.h>
 
+#include "rounds.h"
+
 #include "scenes/chain.h"
 #include "scenes/crank_spring_damper.h"
 #include "scenes/slider_crank.h"
@@ -35,18 +37,6 @@ static crank_spring_damper g_csd;
 static chain g_chain;
 static double g_mass_diag[3000];
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static int by_value(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 /* the kinetic energy v^T M v / 2 with M diagonal (g_mass_diag, set per scene) */
 static int g_n, g_m, g_np;

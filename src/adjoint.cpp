@@ -202,19 +202,8 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     }
     x.lambda = Eigen::Map<const Vec>(src, m);
     w.eta = Eigen::Map<const Vec>(src + m, m);
-    ga_status st = residual(t1, x);
-    const ga_tangent_mode mode = model.tangent_mode;
-    model.tangent_mode = GA_TANGENT_AUTO;
-    const bool K = !K_.zero() && K_.size() > 0;
-    const bool C = !C_.zero() && C_.size() > 0 && (model.has_force() || model.cb.damping);
-    const bool Z = index2 && m > 0;
-    if (!st && K)
-        st = model.stiffness(t1, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_, true);
-    if (!st && C)
-        st = model.damping(t1, x.q, x.v, f_, C_, true);
-    if (!st && Z)
-        st = model.velocity_constraint_tangent(t1, x.q, x.v, J_, Z_, true);
-    model.tangent_mode = mode;
+    bool K = false, C = false, Z = false;
+    ga_status st = exact_tangents(t1, x, K, C, Z);
     const Vec q_n = Eigen::Map<const Vec>(e0 + 4, n);
     if (!st && index2 && m > 0)
         st = model.jacobian(e0[0], q_n, B_);

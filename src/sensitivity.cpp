@@ -271,6 +271,26 @@ ga_status Solver::correction_derivative(double t, const Vec &q, const Vec &eta, 
     return GA_OK;
 }
 
+// M, f, Phi_q and every tangent at the converged step x (the user's callbacks whatever the
+// tangent mode, or central differences), into M_, f_, J_, K_, C_, Z_; which tangents exist.
+ga_status Solver::exact_tangents(double t, const State &x, bool &K, bool &C, bool &Z)
+{
+    ga_status st = residual(t, x);
+    const ga_tangent_mode mode = model.tangent_mode;
+    model.tangent_mode = GA_TANGENT_AUTO;
+    K = !K_.zero() && K_.size() > 0;
+    C = !C_.zero() && C_.size() > 0 && (model.has_force() || model.cb.damping);
+    Z = formulation == GA_INDEX2_STABILIZED && m_ > 0;
+    if (!st && K)
+        st = model.stiffness(t, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_, true);
+    if (!st && C)
+        st = model.damping(t, x.q, x.v, f_, C_, true);
+    if (!st && Z)
+        st = model.velocity_constraint_tangent(t, x.q, x.v, J_, Z_, true);
+    model.tangent_mode = mode;
+    return st;
+}
+
 // After a step converged (trial_ holds it), the derivatives of its state.
 ga_status Solver::sensitivity_step(double h)
 {
@@ -305,19 +325,8 @@ ga_status Solver::sensitivity_step(double h)
     // and where they come by differences, central ones (their error enters dqdd and dlambda
     // at full size; a kept matrix is of an older iterate). The next step's Newton iteration
     // starts with it.
-    ga_status st = residual(t1, x);
-    const ga_tangent_mode mode = model.tangent_mode;
-    model.tangent_mode = GA_TANGENT_AUTO;
-    const bool K = !K_.zero() && K_.size() > 0;
-    const bool C = !C_.zero() && C_.size() > 0 && (model.has_force() || model.cb.damping);
-    const bool Z = index2 && m_ > 0;
-    if (!st && K)
-        st = model.stiffness(t1, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_, true);
-    if (!st && C)
-        st = model.damping(t1, x.q, x.v, f_, C_, true);
-    if (!st && Z)
-        st = model.velocity_constraint_tangent(t1, x.q, x.v, J_, Z_, true);
-    model.tangent_mode = mode;
+    bool K = false, C = false, Z = false;
+    ga_status st = exact_tangents(t1, x, K, C, Z);
     if (!st)
         st = factorize(t1, x, h, K, C, Z, 0);
     recipe_.central = !st;

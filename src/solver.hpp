@@ -241,6 +241,7 @@ private:
     ga_status correction_derivative(double t, const Vec &q, const Vec &eta, const Vec &s,
                                     Vec &out);
     ga_status sensitivity_step(double h);
+    ga_status exact_tangents(double t, const State &x, bool &K, bool &C, bool &Z);
     State sens_scratch_;  // the accepted state while a perturbed one takes its place
     AdjointRecord adjoint_;
     void record_start();   // adjoint.cpp: x_0 and the start's derivatives, at ga_init
