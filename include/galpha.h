@@ -739,6 +739,16 @@ typedef int (*ga_mass_p_fn)(double t, const double *q, int j, const double *a, d
 GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const double *p_scale,
                                     int depends);
 
+/** The derivatives of the initial values with respect to p_j, dq0/dp_j and dv0/dp_j (length n
+ *  each; NULL: zero, the default), used by every later ga_init: initial values as parameters
+ *  (a p_j that no callback reads), or initial values that depend on a model parameter. The
+ *  start projects them as it projects q0 and v0 (at consistent q0 and v0 the derivative of its
+ *  minimum-norm projections): dq0 onto Phi_q dq = 0, dv0 onto Phi_q dv = -d(Phi_q v + Phi_t)/dq
+ *  dq. Errors: GA_ERR_ARG (j out of range, a value not finite), GA_ERR_STATE (no
+ *  sensitivities), GA_ERR_NOMEM. */
+GA_API ga_status ga_set_sensitivity_start(ga_solver *s, int j, const double *dq0,
+                                          const double *dv0);
+
 /** Derivative callbacks (either may be NULL: central differences in p). Errors: GA_ERR_STATE
  *  (from a callback). */
 GA_API ga_status ga_set_parameter_derivatives(ga_solver *s, ga_force_p_fn force_p,

@@ -769,6 +769,22 @@ GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const doubl
     });
 }
 
+GA_API ga_status ga_set_sensitivity_start(ga_solver *s, int j, const double *dq0,
+                                          const double *dv0)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!c.sens.active())
+            return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity_start before ga_set_sensitivity "
+                               "with np > 0");
+        if (j < 0 || j >= c.sens.np)
+            return c.diag.fail(GA_ERR_ARG, "parameter %d: there are %d (0-based)", j, c.sens.np);
+        for (int i = 0; i < c.n(); ++i)
+            if ((dq0 && !std::isfinite(dq0[i])) || (dv0 && !std::isfinite(dv0[i])))
+                return c.diag.fail(GA_ERR_ARG, "dq0 or dv0 entry %d is not finite", i);
+        return c.set_sensitivity_start(j, dq0, dv0);
+    });
+}
+
 GA_API ga_status ga_set_parameter_derivatives(ga_solver *s, ga_force_p_fn force_p,
                                               ga_mass_p_fn mass_p)
 {

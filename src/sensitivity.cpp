@@ -24,8 +24,10 @@ void Sensitivities::allocate(int n, int m)
         for (StateDerivative &x : *set)
             x.allocate(n, m);
     }
-    for (Vec *x : {&rq, &d, &w, &f_plus, &f_minus, &bt, &a0})
+    for (Vec *x : {&rq, &d, &w, &f_plus, &f_minus, &bt, &a0, &xq, &xv})
         x->setZero(n);
+    seed_q.assign(np, Vec::Zero(n));
+    seed_v.assign(np, Vec::Zero(n));
     for (Vec *x : {&rl, &rv, &dl, &e})
         x->setZero(m);
 }
@@ -58,6 +60,15 @@ ga_status Solver::set_sensitivity(int np, double *p, const double *p_scale, int 
     }
     sens = std::move(s);
     adjoint_ = AdjointRecord{};  // the method is forward again (ga_set_sensitivity_method)
+    return GA_OK;
+}
+
+ga_status Solver::set_sensitivity_start(int j, const double *dq0, const double *dv0)
+{
+    Vec q = dq0 ? Vec(Eigen::Map<const Vec>(dq0, n_)) : Vec::Zero(n_);
+    Vec v = dv0 ? Vec(Eigen::Map<const Vec>(dv0, n_)) : Vec::Zero(n_);
+    sens.seed_q[j].swap(q);  // (no allocation after the two above)
+    sens.seed_v[j].swap(v);
     return GA_OK;
 }
 
@@ -99,8 +110,11 @@ ga_status Solver::central_difference(int j, Perturb &&perturb, Evaluate &&evalua
     return st;
 }
 
-// At ga_init: q0 and v0 do not depend on p; qdd0 and lambda0 do, through the acceleration-level
-// system they solve (differences of that solve: it is linear, and cheap once).
+// At ga_init: q0 and v0 depend on p as the seeds say (zero unless given), projected as the
+// start projects q0 and v0 -- at a consistent point the derivative of the minimum-norm
+// projections: dq0 onto Phi_q dq = 0, dv0 onto Phi_q dv = -d(Phi_q v + Phi_t)/dq dq0; qdd0 and
+// lambda0 follow through the acceleration-level system they solve (central differences of
+// that solve along (dq0, dv0) and p_j: it is linear in p, and cheap once).
 ga_status Solver::sensitivity_start(const State &x)
 {
     // Exact derivatives need every tangent in the matrix (sensitivity_step): on the sparse
@@ -109,28 +123,78 @@ ga_status Solver::sensitivity_start(const State &x)
     if (sparse_backend_ && ((!K_.zero() && K_.dense()) || (damped && !C_.zero() && C_.dense())))
         return diag.fail(GA_ERR_ARG, "sensitivities on the sparse path need the patterns of K_t "
                          "and C_t (ga_set_pattern; an empty pattern declares a zero matrix)");
-    for (int j = 0; j < sens.np; ++j) {
-        StateDerivative &s = sens.trial[j];
-        s.q.setZero();
-        s.v.setZero();
+    Sensitivities &z = sens;
+    for (int j = 0; j < z.np; ++j) {
+        StateDerivative &s = z.trial[j];
+        s.q = z.seed_q[j];
+        s.v = z.seed_v[j];
+        if (m_ > 0 && (!s.q.isZero(0.0) || !s.v.isZero(0.0)))
+            if (auto st = project_seeds(x, s)) {
+                diag.append(" (the start's derivative in parameter %d)", j);
+                return st;
+            }
         double span = 0.0;
+        const auto perturb = [&](bool on, double shift) {
+            if (!on)
+                return;
+            z.xq = x.q + shift * s.q;
+            z.xv = x.v + shift * s.v;
+        };
         const auto evaluate = [&](int side) {
             SaddleWorkspace w{S_, M_, J_, f_, c_, rq_};
-            Vec &qdd = side == 0 ? s.qdd : sens.d;
-            Vec &lambda = side == 0 ? s.lambda : sens.dl;
-            return acceleration_level(x.t, x.q, x.v, w, qdd, lambda);
+            Vec &qdd = side == 0 ? s.qdd : z.d;
+            Vec &lambda = side == 0 ? s.lambda : z.dl;
+            return acceleration_level(x.t, z.xq, z.xv, w, qdd, lambda);
         };
-        const ga_status st = central_difference(j, [](bool, double) {}, evaluate, span);
+        const ga_status st = central_difference(j, perturb, evaluate, span);
         jacobian_valid_ = false;  // S_ holds another matrix now
         mass_valid_ = false;      // and M_ was evaluated with p perturbed
         if (st) {
             diag.append(" (sensitivity of the consistent start to parameter %d)", j);
             return st;
         }
-        s.qdd = (s.qdd - sens.d) / span;
-        s.lambda = (s.lambda - sens.dl) / span;
+        s.qdd = (s.qdd - z.d) / span;
+        s.lambda = (s.lambda - z.dl) / span;
         s.a = s.qdd;  // a_0 = qdd_0
     }
+    return GA_OK;
+}
+
+// The seeds (s.q, s.v) onto the linearized position and velocity constraints at the start x:
+// [I Phi_q^T; Phi_q 0] [dq; mu] = [dq0; 0], then [dv; mu] = [dv0; -Z dq] with
+// Z dq = d/de (Phi_q(q + e dq) v + Phi_t(q + e dq)) by central differences.
+ga_status Solver::project_seeds(const State &x, StateDerivative &s)
+{
+    Sensitivities &z = sens;
+    if (auto st = model.jacobian(x.t, x.q, J_))
+        return st;
+    count(counters, GA_COUNT_FACTORIZATIONS);
+    jacobian_valid_ = false;  // S_ holds another matrix now
+    if (!S_.factorize_projection(J_))
+        return diag.fail(GA_ERR_SINGULAR, "cannot project the start's derivative: Phi_q is rank "
+                         "deficient (rcond of [I Phi_q^T; Phi_q 0] = %.3g)", S_.rcond());
+    z.rq = -s.q;
+    z.rl.setZero();
+    S_.solve(z.rq, z.rl, z.d, z.dl);
+    s.q = z.d;
+    z.rl.setZero();
+    const double s_max = s.q.lpNorm<Eigen::Infinity>();
+    if (s_max > 0.0) {
+        const double e = std::cbrt(kEps) * std::max(x.q.lpNorm<Eigen::Infinity>(), 1.0) / s_max;
+        for (int side = 0; side < 2; ++side) {
+            const double sign = side == 0 ? 1.0 : -1.0;
+            z.xq = x.q + (sign * e) * s.q;
+            if (auto st = model.jacobian(x.t, z.xq, z.J_pert))
+                return st;
+            if (auto st = model.constraint_dt(x.t, z.xq, z.rv))
+                return st;
+            z.J_pert.multiply_add(1.0, x.v, z.rv);
+            z.rl += (sign * 0.5 / e) * z.rv;
+        }
+    }
+    z.rq = -s.v;
+    S_.solve(z.rq, z.rl, z.d, z.dl);
+    s.v = z.d;
     return GA_OK;
 }
 

@@ -32,6 +32,8 @@ struct Sensitivities {
     bool forward = true;   // GA_SENSITIVITY_FORWARD: derivatives after each step
     bool adjoint = false;  // GA_SENSITIVITY_ADJOINT: the run recorded (AdjointRecord)
 
+    // d q0 / dp_j and d v0 / dp_j as given (ga_set_sensitivity_start; zero unless given)
+    std::vector<Vec> seed_q, seed_v;
     std::vector<StateDerivative> accepted, trial;
     // The step's start (v_n, a_n, qdd_n as the step uses them) when it is not the accepted
     // state's own: fresh starts and their corrected values, by differences.
@@ -40,7 +42,7 @@ struct Sensitivities {
     bool step_done = false;    // a Taylor step (sliver): trial holds its derivative already
 
     // scratch of one step
-    Vec rq, rl, rv, d, w, dl, e, f_plus, f_minus, bt, a0;
+    Vec rq, rl, rv, d, w, dl, e, f_plus, f_minus, bt, a0, xq, xv;
     ModelMatrix M_pert, J_pert;
 
     bool active() const { return np > 0; }

@@ -133,6 +133,7 @@ public:
     Sensitivities sens;
     ga_status set_sensitivity(int np, double *p, const double *p_scale, int depends);
     ga_status get_sensitivity(int j, double *dq, double *dv, double *dqdd, double *dlambda) const;
+    ga_status set_sensitivity_start(int j, const double *dq0, const double *dv0);
     // adjoint.cpp
     ga_status set_sensitivity_method(int methods, long max_steps);
     ga_status adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ);
@@ -235,6 +236,7 @@ private:
     template <class Perturb, class Evaluate>
     ga_status central_difference(int j, Perturb &&perturb, Evaluate &&evaluate, double &span);
     ga_status sensitivity_start(const State &x);
+    ga_status project_seeds(const State &x, StateDerivative &s);
     static void shift_state(const State &from, const StateDerivative &s, double shift, State &to);
     ga_status sensitivity_by_differences(double h, bool taylor_step, bool restart_short);
     ga_status parameter_residual(int j, double t, const State &x);

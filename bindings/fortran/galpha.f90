@@ -514,6 +514,13 @@ module galpha
        type(c_ptr), value :: s
        type(c_funptr), value :: force_p, mass_p
      end function ga_set_parameter_derivatives
+     integer(c_int) function ga_set_sensitivity_start(s, j, dq0, dv0) &
+          bind(C, name="ga_set_sensitivity_start")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       integer(c_int), value :: j
+       real(c_double), intent(in), optional :: dq0(*), dv0(*)  ! absent: NULL
+     end function ga_set_sensitivity_start
      integer(c_int) function ga_get_sensitivity(s, j, dq, dv, dqdd, dlambda) &
           bind(C, name="ga_get_sensitivity")
        import :: c_int, c_ptr, c_double
@@ -557,6 +564,7 @@ module galpha
        ga_get_event, ga_set_first_order, ga_set_coupling, ga_set_coupling_exact, ga_init_y, &
        ga_get_y, ga_interpolate_y, ga_set_events_y, ga_set_coupling_pattern, &
        ga_set_sensitivity, ga_set_parameter_derivatives, ga_get_sensitivity, &
+       ga_set_sensitivity_start, &
        ga_set_sensitivity_method, ga_adjoint_gradient
 
   ! ---- the Fortran layer --------------------------------------------------------------------
@@ -672,6 +680,9 @@ module galpha
      !> get_sensitivity(j, dq, dv, dqdd, dlambda): d/dp_j (j 1-based) of the accepted step's
      !> q, v, qdd, lambda (each optional)
      procedure :: get_sensitivity => solver_get_sensitivity
+     !> set_sensitivity_start(j, dq0, dv0): dq0/dp_j and dv0/dp_j (j 1-based; either optional:
+     !> zero) for every later init
+     procedure :: set_sensitivity_start => solver_set_sensitivity_start
      !> set_sensitivity_method(methods, max_steps): an ior of GA_SENSITIVITY_FORWARD and
      !> GA_SENSITIVITY_ADJOINT (the run recorded for adjoint_gradient, up to max_steps steps)
      procedure :: set_sensitivity_method => solver_set_sensitivity_method
@@ -935,6 +946,17 @@ contains
     if (present(mass_p)) m = c_funloc(mass_p)
     status = ga_set_parameter_derivatives(this%handle, f, m)
   end function solver_set_parameter_derivatives
+
+  integer(c_int) function solver_set_sensitivity_start(this, j, dq0, dv0) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer, intent(in) :: j
+    real(c_double), intent(in), optional :: dq0(:), dv0(:)
+    if ((present(dq0) .and. size(dq0) < this%n) .or. (present(dv0) .and. size(dv0) < this%n)) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_set_sensitivity_start(this%handle, int(j - 1, c_int), dq0, dv0)
+  end function solver_set_sensitivity_start
 
   integer(c_int) function solver_get_sensitivity(this, j, dq, dv, dqdd, dlambda) result(status)
     class(galpha_solver), intent(in) :: this

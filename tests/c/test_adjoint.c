@@ -328,12 +328,60 @@ static void full_record_and_uncovered_steps(void **state)
     ga_free(s);
 }
 
+
+/* Initial values as parameters (ga_set_sensitivity_start): the adjoint's gradient in theta0
+ * and omega0 of the pendulum is the forward one. */
+static void initial_values_adjoint(void **state)
+{
+    (void)state;
+    for (int f = 0; f < 2; ++f) {
+        pendulum pd = {1.0, 1.0, 9.81};
+        double q0[2], v0[2], p[2] = {1.0, 0.5}, J, adj[2];
+        pendulum_state(&pd, p[0], p[1], q0, v0);
+        const double dq_theta[2] = {cos(p[0]), sin(p[0])},
+                     dv_theta[2] = {-p[1] * sin(p[0]), p[1] * cos(p[0])},
+                     dv_omega[2] = {cos(p[0]), sin(p[0])};
+        g_n = 2, g_m = 1, g_np = 2;
+        for (int k = 0; k < 4; ++k)
+            for (int i = 0; i < 2; ++i)
+                g_c[k][i] = k < 2 ? 0.3 + 0.2 * k - 0.5 * i : 0.0;
+        ga_solver *s = NULL;
+        assert_int_equal(ga_create(2, 1, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                          pendulum_jacobian, &pd),
+                         GA_OK);
+        assert_int_equal(ga_set_formulation(s, f ? GA_INDEX2_STABILIZED : GA_INDEX3), GA_OK);
+        assert_int_equal(ga_set_sensitivity(s, 2, p, NULL, GA_DEPENDS_FORCE), GA_OK);
+        assert_int_equal(ga_set_sensitivity_start(s, 0, dq_theta, dv_theta), GA_OK);
+        assert_int_equal(ga_set_sensitivity_start(s, 1, NULL, dv_omega), GA_OK);
+        assert_int_equal(ga_set_sensitivity_method(
+                             s, GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT, 200),
+                         GA_OK);
+        assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+        for (int k = 0; k < 200; ++k)
+            assert_int_equal(ga_step(s, 5e-3), GA_OK);
+        assert_int_equal(ga_adjoint_gradient(s, NULL, terminal_linear, &J, adj), GA_OK);
+        for (int j = 0; j < 2; ++j) {
+            double d[4][2], fwd = 0.0;
+            assert_int_equal(ga_get_sensitivity(s, j, d[0], d[1], d[2], d[3]), GA_OK);
+            for (int k = 0; k < 2; ++k)
+                for (int i = 0; i < 2; ++i)
+                    fwd += g_c[k][i] * d[k][i];
+            printf("  index %d d/d%s: forward %+.15e adjoint %+.15e\n", f ? 2 : 3,
+                   j ? "omega0" : "theta0", fwd, adj[j]);
+            assert_true(fabs(adj[j] - fwd) <= 1e-12 * fabs(fwd));
+        }
+        ga_free(s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(pendulum_adjoint),
         cmocka_unit_test(crank_adjoint),
         cmocka_unit_test(chain_adjoint),
+        cmocka_unit_test(initial_values_adjoint),
         cmocka_unit_test(refusals),
         cmocka_unit_test(full_record_and_uncovered_steps),
     };

@@ -457,6 +457,102 @@ static void andrews_sensitivity(void **state)
     run_all(list, 3, "Andrews");
 }
 
+
+/* ---- initial values as parameters ---- */
+
+/* The pendulum started at angle theta0 and rate omega0, p = (theta0, omega0) (no callback reads
+ * them): q0 = L (sin, -cos), v0 = L omega0 (cos, sin); their derivatives as seeds, with
+ * `radial` times the radial direction added to dq0 (a seed off the constraint, which the start
+ * projects away). Returns the final q, v, qdd, lambda and, with sensitivities, d/dp. */
+static void pendulum_from(const double p[2], int formulation, double radial, int with_sens,
+                          result *out, result *sens)
+{
+    pendulum pd = {1.0, 1.0, 9.81};
+    double q0[2], v0[2], pp[2] = {p[0], p[1]};
+    pendulum_state(&pd, p[0], p[1], q0, v0);
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, pendulum_constraint,
+                                      pendulum_jacobian, &pd),
+                     GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    assert_int_equal(ga_set_output(s, GA_OUTPUT_STEP), GA_OK);
+    if (with_sens) {
+        const double c = cos(p[0]), sn = sin(p[0]);
+        const double dq_theta[2] = {c + radial * sn, sn - radial * c}, dv_theta[2] = {-p[1] * sn,
+                                                                                    p[1] * c};
+        const double dv_omega[2] = {c, sn};
+        assert_int_equal(ga_set_sensitivity(s, 2, pp, NULL, GA_DEPENDS_FORCE), GA_OK);
+        assert_int_equal(ga_set_sensitivity_start(s, 0, dq_theta, dv_theta), GA_OK);
+        assert_int_equal(ga_set_sensitivity_start(s, 1, NULL, dv_omega), GA_OK);
+    } else {
+        assert_int_equal(ga_set_jacobian_reuse(s, GA_REUSE_NEVER), GA_OK);
+        assert_int_equal(ga_set_newton(s, 1e-13, 30), GA_OK);
+    }
+    assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+    for (int k = 0; k < 200; ++k)
+        assert_int_equal(ga_step(s, 5e-3), GA_OK);
+    read_state(s, 2, 1, out);
+    for (int j = 0; with_sens && j < 2; ++j) {
+        assert_int_equal(ga_get_sensitivity(s, j, sens[j].x[0], sens[j].x[1], sens[j].x[2],
+                                            sens[j].x[3]),
+                         GA_OK);
+        memcpy(sens[j].count, out->count, sizeof out->count);
+    }
+    ga_free(s);
+}
+
+static void initial_values_as_parameters(void **state)
+{
+    (void)state;
+    const double p0[2] = {1.0, 0.5};
+    for (int f = 0; f < 2; ++f) {
+        const int formulation = f ? GA_INDEX2_STABILIZED : GA_INDEX3;
+        result base, sens[2], off[2], r[4];
+        pendulum_from(p0, formulation, 0.0, 1, &base, sens);
+        pendulum_from(p0, formulation, 0.7, 1, &base, off);
+        for (int j = 0; j < 2; ++j) {
+            /* (index-3 qdd and lambda: their round-off over e, 1e-5 relative at e = 1e-4,
+             * calls for a long step; extrapolated, its truncation is below 1e-9) */
+            const double e = 1e-2, shift[4] = {e, -e, 0.5 * e, -0.5 * e};
+            for (int k = 0; k < 4; ++k) {
+                double p[2] = {p0[0], p0[1]};
+                p[j] += shift[k];
+                pendulum_from(p, formulation, 0.0, 0, &r[k], NULL);
+            }
+            for (int qn = 0; qn < kQuantities; ++qn) {
+                double diff = 0, size = 0, projected = 0;
+                for (int i = 0; i < base.count[qn]; ++i) {
+                    const double fd = (4 * (r[2].x[qn][i] - r[3].x[qn][i]) / e -
+                                       (r[0].x[qn][i] - r[1].x[qn][i]) / (2 * e)) / 3;
+                    diff = fmax(diff, fabs(sens[j].x[qn][i] - fd));
+                    size = fmax(size, fabs(fd));
+                    projected = fmax(projected, fabs(off[j].x[qn][i] - sens[j].x[qn][i]));
+                }
+                printf("  index %d d/d%s of %-6s: difference %.2e relative; seed off the "
+                       "constraint %.1e\n", f ? 2 : 3, j ? "omega0" : "theta0",
+                       (const char *[]){"q", "v", "qdd", "lambda"}[qn], diff / size,
+                       projected / size);
+                assert_true(diff < 1e-7 * size);
+                /* the same to the precision of the start's differences */
+                assert_true(projected < 1e-9 * size);
+            }
+        }
+    }
+    /* refusals */
+    ga_solver *s = NULL;
+    double p[1] = {1.0}, bad[2] = {0.0, NAN};
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_sensitivity_start(s, 0, NULL, NULL), GA_ERR_STATE);
+    assert_non_null(strstr(ga_last_error(s), "before ga_set_sensitivity"));
+    assert_int_equal(ga_set_sensitivity(s, 1, p, NULL, GA_DEPENDS_FORCE), GA_OK);
+    assert_int_equal(ga_set_sensitivity_start(s, 1, NULL, NULL), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "parameter 1"));
+    assert_int_equal(ga_set_sensitivity_start(s, 0, bad, NULL), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "not finite"));
+    ga_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -464,6 +560,7 @@ int main(void)
         cmocka_unit_test(crank_sensitivity),
         cmocka_unit_test(chain_sensitivity),
         cmocka_unit_test(andrews_sensitivity),
+        cmocka_unit_test(initial_values_as_parameters),
         cmocka_unit_test(derivative_callbacks_agree_with_differences),
         cmocka_unit_test(refusals),
         cmocka_unit_test(failed_sensitivity_fails_the_step),

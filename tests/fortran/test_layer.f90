@@ -290,6 +290,8 @@ program test_layer
   call expect(abs(q(1) + sin(2.0d0) / 4.0d0) < 1d-5, 'dx/dk against the exact derivative')
   call expect(abs(q(1) - x / 2d-4) < 1d-7 * abs(q(1)), 'dx/dk against differences of runs')
   call expect(r%get_sensitivity(2, q(1:1)) == GA_ERR_ARG, 'get_sensitivity checks j')
+  call expect(r%set_sensitivity_start(2, [1.0d0]) == GA_ERR_ARG, 'set_sensitivity_start checks j')
+  call ok(r%set_sensitivity_start(1), 'set_sensitivity_start: zero seeds')
   call r%free()
   call ok(r%create(1, 0), 'create for derivative callbacks')
   call ok(r%set_callbacks(unit_mass, spring), 'callbacks')

@@ -179,3 +179,26 @@ def test_identification_example_recovers_the_parameters():
     p, iterations = ic.identify(measured, h=4e-3, t_end=3.0, verbose=False)
     assert np.allclose(p, ic.TRUE, rtol=1e-7)
     assert iterations <= 8
+
+
+def test_initial_values_as_parameters():
+    """d/d omega0 of the pendulum started at rate omega0: v0 = L omega0 (cos, sin)."""
+    def run(omega0, sens):
+        p = np.array([omega0])
+        q0 = np.array([np.sin(1.0), -np.cos(1.0)])
+        v0 = omega0 * np.array([np.cos(1.0), np.sin(1.0)])
+        options = dict(parameters=p) if sens else dict(reuse=galpha.GA_REUSE_NEVER,
+                                                       newton=(1e-13, 30))
+        with pendulum(np.array([1.0, 9.81]), **options) as s:
+            if sens:
+                s.set_sensitivity_start(0, dv0=[np.cos(1.0), np.sin(1.0)])
+                with pytest.raises(galpha.ArgumentError):
+                    s.set_sensitivity_start(1)
+            s.init(0.0, q0, v0)
+            for _ in range(100):
+                s.step(1e-2)
+            return s.q.copy(), (s.sensitivity().dq[:, 0] if sens else None)
+    _, dq = run(0.5, True)
+    e = 1e-5
+    fd = (run(0.5 + e, False)[0] - run(0.5 - e, False)[0]) / (2 * e)
+    assert np.allclose(dq, fd, rtol=0, atol=1e-8 * np.abs(fd).max())

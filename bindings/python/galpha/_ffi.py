@@ -224,6 +224,7 @@ _SIGNATURES = {
     "ga_set_coupling_pattern": (_I, [_S, _I, _I, _P(_I), _P(_I)]),
     "ga_set_sensitivity": (_I, [_S, _I, c_double_p, c_double_p, _I]),
     "ga_set_parameter_derivatives": (_I, [_S, FORCE_P_FN, MASS_P_FN]),
+    "ga_set_sensitivity_start": (_I, [_S, _I, c_double_p, c_double_p]),
     "ga_get_sensitivity": (_I, [_S, _I, c_double_p, c_double_p, c_double_p, c_double_p]),
     "ga_set_sensitivity_method": (_I, [_S, _I, ctypes.c_long]),
     "ga_adjoint_gradient": (_I, [_S, COST_FN, COST_FN, c_double_p, c_double_p]),

@@ -445,6 +445,22 @@ class Solver:
                                                           _cast(cbs[1], _ffi.MASS_P_FN)))
 
     @_serialized
+    def set_sensitivity_start(self, j, dq0=None, dv0=None):
+        """dq0/dp_j and dv0/dp_j (None: zero), for every later init() (see
+        ga_set_sensitivity_start): initial values as parameters."""
+        arrays = []
+        for x in (dq0, dv0):
+            if x is None:
+                arrays.append(None)
+                continue
+            a = np.ascontiguousarray(x, dtype=float).ravel()
+            if a.shape != (self.n,):
+                raise error_for(_ffi.GA_ERR_ARG, "dq0 and dv0 must have shape (%d,)" % self.n)
+            arrays.append(a)
+        self._check(_ffi.ga_set_sensitivity_start(
+            self._handle(), int(j), *[None if a is None else self._dp(a) for a in arrays]))
+
+    @_serialized
     def sensitivity(self):
         """Derivatives of the accepted step's q, v, qdd and lambda with respect to the
         parameters (ga_get_sensitivity): a Sensitivity of arrays dq (n, np), dv (n, np),
