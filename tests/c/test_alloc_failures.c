@@ -83,14 +83,18 @@ static int chain_rate(double t, const double *q, const double *v, const double *
     return 0;
 }
 static const double kY0[1] = {0.5};
-static int g_start_before_steps; /* SET_FIRST_ORDER: the call is made before ga_init_y */
+/* The call is made before the start: 1, ga_init_y (SET_FIRST_ORDER); 2, ga_init (the
+ * sensitivity settings). */
+static int g_start_before_steps;
 
 static void steps(ga_solver *s, double *q)
 {
     if (g_start_before_steps) {
         double q0[N], v0[N];
         chain_initial(&g_chain, q0, v0);
-        assert_int_equal(ga_init_y(s, 0.0, q0, v0, kY0), GA_OK);
+        assert_int_equal(g_start_before_steps == 1 ? ga_init_y(s, 0.0, q0, v0, kY0)
+                                                   : ga_init(s, 0.0, q0, v0),
+                         GA_OK);
     }
     for (int i = 0; i < 5; ++i)
         assert_int_equal(ga_step(s, 1e-3), GA_OK);
@@ -139,13 +143,16 @@ static ga_solver *make_redundant(void)
 
 typedef enum call {
     INIT, INIT_INDEX2, INIT_REDUNDANT, SET_STATE, FORMULATION, TANGENT_MODE, OUTPUT, EVENTS,
-    SET_FIRST_ORDER, INIT_Y
+    SET_FIRST_ORDER, INIT_Y, SET_SENSITIVITY, SENSITIVITY_METHOD, SENSITIVITY_START,
+    INIT_SENSITIVITY
 } call;
 static const char *const kNames[] = {"ga_init", "ga_init (index 2)",
                                      "ga_init (a redundant constraint)", "ga_set_state",
                                      "ga_set_formulation", "ga_set_tangent_mode",
                                      "ga_set_output", "ga_set_events", "ga_set_first_order",
-                                     "ga_init_y"};
+                                     "ga_init_y", "ga_set_sensitivity",
+                                     "ga_set_sensitivity_method", "ga_set_sensitivity_start",
+                                     "ga_init (sensitivities)"};
 
 /* event functions that never fire */
 static int far_away(double t, const double *q, const double *v, const double *lambda,
@@ -172,6 +179,12 @@ static ga_status do_call(ga_solver *s, call c, const double *checkpoint, size_t 
     case EVENTS: return ga_set_events(s, 2, far_away, NULL, NULL, 1);
     case SET_FIRST_ORDER: return ga_set_first_order(s, 1, chain_force_y, chain_rate);
     case INIT_Y: return ga_init_y(s, 0.0, q, v, kY0);
+    case INIT_SENSITIVITY: return ga_init(s, 0.0, q, v);
+    case SET_SENSITIVITY:
+        return ga_set_sensitivity(s, 3, &g_chain.mass, NULL, GA_DEPENDS_FORCE | GA_DEPENDS_MASS);
+    case SENSITIVITY_METHOD:
+        return ga_set_sensitivity_method(s, GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT, 10);
+    case SENSITIVITY_START: return ga_set_sensitivity_start(s, 1, q, v);
     default: return ga_set_output(s, GA_OUTPUT_CONSISTENT);
     }
 }
@@ -193,9 +206,17 @@ static ga_solver *prepare(call c)
         assert_int_equal(ga_set_events(s, 1, far_away, NULL, NULL, 0), GA_OK);
     if (c == INIT_Y)
         assert_int_equal(ga_set_first_order(s, 1, chain_force_y, chain_rate), GA_OK);
-    g_start_before_steps = c == SET_FIRST_ORDER;
+    const int sensitivities = c == SENSITIVITY_METHOD || c == SENSITIVITY_START ||
+                              c == INIT_SENSITIVITY;
+    if (sensitivities)
+        assert_int_equal(ga_set_sensitivity(s, 3, &g_chain.mass, NULL,
+                                            GA_DEPENDS_FORCE | GA_DEPENDS_MASS),
+                         GA_OK);
+    g_start_before_steps = c == SET_FIRST_ORDER ? 1 : sensitivities || c == SET_SENSITIVITY ? 2 : 0;
+    if (c == INIT_SENSITIVITY)
+        g_start_before_steps = 0;
     if (c != INIT && c != INIT_INDEX2 && c != INIT_REDUNDANT && c != SET_STATE &&
-        c != SET_FIRST_ORDER && c != INIT_Y)
+        c != SET_FIRST_ORDER && c != INIT_Y && !g_start_before_steps && c != INIT_SENSITIVITY)
         assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     return s;
 }
@@ -286,6 +307,10 @@ static void output_sweep(void **state) { (void)state; sweep(OUTPUT); }
 static void events_sweep(void **state) { (void)state; sweep(EVENTS); }
 static void first_order_sweep(void **state) { (void)state; sweep(SET_FIRST_ORDER); }
 static void init_y_sweep(void **state) { (void)state; sweep(INIT_Y); }
+static void sensitivity_sweep(void **state) { (void)state; sweep(SET_SENSITIVITY); }
+static void sensitivity_method_sweep(void **state) { (void)state; sweep(SENSITIVITY_METHOD); }
+static void sensitivity_start_sweep(void **state) { (void)state; sweep(SENSITIVITY_START); }
+static void init_sensitivity_sweep(void **state) { (void)state; sweep(INIT_SENSITIVITY); }
 
 int main(void)
 {
@@ -296,6 +321,8 @@ int main(void)
         cmocka_unit_test(formulation_sweep),  cmocka_unit_test(tangent_mode_sweep),
         cmocka_unit_test(output_sweep),       cmocka_unit_test(events_sweep),
         cmocka_unit_test(first_order_sweep),  cmocka_unit_test(init_y_sweep),
+        cmocka_unit_test(sensitivity_sweep),  cmocka_unit_test(sensitivity_method_sweep),
+        cmocka_unit_test(sensitivity_start_sweep), cmocka_unit_test(init_sensitivity_sweep),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
