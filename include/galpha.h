@@ -702,15 +702,17 @@ GA_API ga_status ga_set_events_y(ga_solver *s, int count, ga_event_y_fn fn, cons
 /**@}*/
 
 /* ------------------------------------------------------------------------------------------ */
-/** @name Forward sensitivities
+/** @name Sensitivities
  *  Derivatives of the discrete solution with respect to np parameters p (docs/algorithms.md
- *  sec. 13): after each accepted step, dq/dp_j, dv/dp_j, dqdd/dp_j and dlambda/dp_j of that
- *  step's own q, v, qdd and lambda -- the derivative of what galpha computes (with the step
- *  sizes held fixed as inputs), not of the exact solution. The iteration matrix is factorized
- *  again at each converged step (the next step's Newton iteration starts with it); each
- *  parameter then costs one solve and the parameter derivatives of the residual. Exact to
- *  round-off with exact tangents (ga_set_tangents); with finite-difference tangents, to their
- *  precision. */
+ *  sec. 13), forward (after each accepted step, dq/dp_j, dv/dp_j, dqdd/dp_j and dlambda/dp_j of
+ *  that step's own q, v, qdd and lambda) or by the discrete adjoint of a cost -- the derivative
+ *  of what galpha computes (with the step sizes held fixed as inputs), not of the exact
+ *  solution. The iteration matrix is factorized again at each converged step with every
+ *  tangent (the next step's Newton iteration starts with it); each parameter then costs one
+ *  solve and the parameter derivatives of the residual. Exact to round-off with exact tangents
+ *  (ga_set_tangents); with tangents by central differences (galpha's otherwise), to their
+ *  precision, about eps^(2/3). Not yet with first-order states or parameters in the
+ *  constraints. */
 /**@{*/
 /** What depends on the parameters (flags, or-ed). The others are taken as independent of p:
  *  their derivatives are not evaluated. */
@@ -726,8 +728,8 @@ typedef int (*ga_force_p_fn)(double t, const double *q, const double *v, int j, 
 typedef int (*ga_mass_p_fn)(double t, const double *q, int j, const double *a, double *out,
                             void *user);
 
-/** Forward sensitivities with respect to p[0 .. np-1], before ga_init (they start there: q0
- *  and v0 are taken as independent of p, qdd0 and lambda0 follow from them). p is the array
+/** Sensitivities with respect to p[0 .. np-1], before ga_init (they start there: q0 and v0
+ *  independent of p unless ga_set_sensitivity_start says otherwise, qdd0 and lambda0 follow). p is the array
  *  the callbacks read through their user pointer: without derivative callbacks galpha
  *  perturbs its entries in place (central differences, restored bit for bit before any call
  *  returns), and it must stay valid while the solver lives. p_scale (may be NULL: |p_j|, or 1
@@ -735,7 +737,8 @@ typedef int (*ga_mass_p_fn)(double t, const double *q, int j, const double *a, d
  *  or of ::ga_depends. np = 0 turns sensitivities off; the method is forward again
  *  (ga_set_sensitivity_method). Errors: GA_ERR_ARG (np < 0, p NULL
  *  with np > 0, a p_scale entry not positive and finite, unknown flags, GA_DEPENDS_MASS with
- *  a constant mass), GA_ERR_STATE (after ga_init; with first-order states), GA_ERR_NOMEM. */
+ *  a constant mass), GA_ERR_STATE (after ga_init; with first-order states, not built yet),
+ *  GA_ERR_NOMEM. */
 GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const double *p_scale,
                                     int depends);
 
@@ -789,8 +792,8 @@ typedef int (*ga_cost_fn)(double t, const double *q, const double *v, const doub
  *  (G) may be NULL. The recorded run must not contain Taylor steps or fresh starts after the
  *  first step (ga_step sizes over 100 times shorter or longer than the one before). Leaves the
  *  run as it was (it may be continued and asked again). Errors: GA_ERR_ARG (both NULL),
- *  GA_ERR_STATE (no adjoint recording, before ga_init, a step kind not covered), callback
- *  and linear-algebra errors. */
+ *  GA_ERR_STATE (no adjoint recording, before ga_init, a step kind not covered, dropped
+ *  redundant constraints), callback and linear-algebra errors. */
 GA_API ga_status ga_adjoint_gradient(ga_solver *s, ga_cost_fn running, ga_cost_fn terminal,
                                      double *J, double *dJ_dp);
 /**@}*/
