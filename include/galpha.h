@@ -779,7 +779,8 @@ typedef enum ga_sensitivity_method {
 GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_steps);
 
 /** A cost term: its value at (t, q, v, qdd, lambda) and every partial derivative, in q, v, qdd
- *  (n each), lambda (m) and the parameters p (np); all outputs are written. */
+ *  (n each), lambda (m; lambda and d_lambda are NULL when m = 0) and the parameters p (np); all
+ *  outputs are written. */
 typedef int (*ga_cost_fn)(double t, const double *q, const double *v, const double *qdd,
                           const double *lambda, double *value, double *d_q, double *d_v,
                           double *d_qdd, double *d_lambda, double *d_p, void *user);

@@ -261,7 +261,8 @@ static int adjoint_cost(double t, const double *q, const double *v, const double
     memset(d_q, 0, sizeof(double) * (size_t)md->n);
     memset(d_v, 0, sizeof(double) * (size_t)md->n);
     memset(d_qdd, 0, sizeof(double) * (size_t)md->n);
-    memset(d_lambda, 0, sizeof(double) * (size_t)md->m);
+    if (md->m)  /* (NULL without constraints) */
+        memset(d_lambda, 0, sizeof(double) * (size_t)md->m);
     d_p[0] = d_p[1] = 0.0;
     d_q[0] = 1.0;
     *value = q[0];
