@@ -711,14 +711,15 @@ GA_API ga_status ga_set_events_y(ga_solver *s, int count, ga_event_y_fn fn, cons
  *  tangent (the next step's Newton iteration starts with it); each parameter then costs one
  *  solve and the parameter derivatives of the residual. Exact to round-off with exact tangents
  *  (ga_set_tangents); with tangents by central differences (galpha's otherwise), to their
- *  precision, about eps^(2/3). Not yet with first-order states or parameters in the
- *  constraints. */
+ *  precision, about eps^(2/3). Not yet with parameters in the constraints, nor the adjoint with
+ *  first-order states. */
 /**@{*/
 /** What depends on the parameters (flags, or-ed). The others are taken as independent of p:
  *  their derivatives are not evaluated. */
 typedef enum ga_depends {
     GA_DEPENDS_FORCE = 1, /**< the applied forces f */
-    GA_DEPENDS_MASS = 2   /**< the mass matrix M (not with ga_set_constant_mass) */
+    GA_DEPENDS_MASS = 2,  /**< the mass matrix M (not with ga_set_constant_mass) */
+    GA_DEPENDS_RATE = 4   /**< the rates g of first-order states (central differences) */
 } ga_depends;
 
 /** df/dp_j at (t, q, v) into f_p (length n), for parameter j (0-based). */
@@ -737,8 +738,9 @@ typedef int (*ga_mass_p_fn)(double t, const double *q, int j, const double *a, d
  *  or of ::ga_depends. np = 0 turns sensitivities off; the method is forward again
  *  (ga_set_sensitivity_method). Errors: GA_ERR_ARG (np < 0, p NULL
  *  with np > 0, a p_scale entry not positive and finite, unknown flags, GA_DEPENDS_MASS with
- *  a constant mass), GA_ERR_STATE (after ga_init; with first-order states, not built yet),
- *  GA_ERR_NOMEM. */
+ *  a constant mass), GA_ERR_STATE (after ga_init), GA_ERR_NOMEM. First-order states are declared before
+ *  (ga_set_first_order); their y and y' have derivatives too (ga_get_sensitivity_y), with the
+ *  coupling blocks in the iteration matrix (ga_set_coupling_exact on, the default). */
 GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const double *p_scale,
                                     int depends);
 
@@ -763,6 +765,10 @@ GA_API ga_status ga_set_parameter_derivatives(ga_solver *s, ga_force_p_fn force_
  *  or only the adjoint's record). */
 GA_API ga_status ga_get_sensitivity(const ga_solver *s, int j, double *dq, double *dv,
                                     double *dqdd, double *dlambda);
+
+/** The sensitivities of the first-order states y and their rates y' with respect to p_j
+ *  (length r each; either pointer may be NULL). Errors: as ga_get_sensitivity. */
+GA_API ga_status ga_get_sensitivity_y(const ga_solver *s, int j, double *dy, double *dydot);
 
 /** How sensitivities are computed (flags, or-ed). */
 typedef enum ga_sensitivity_method {

@@ -674,8 +674,8 @@ GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga
             return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after ga_set_events_y: the "
                                "event functions take the states declared before them");
         if (r > 0 && c.sens.active())
-            return c.diag.fail(GA_ERR_STATE, "first-order states with sensitivities are not "
-                               "built yet (ga_set_sensitivity)");
+            return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after ga_set_sensitivity: "
+                               "declare the states first (the sensitivities include theirs)");
         c.set_first_order(r);  // may throw std::bad_alloc before anything below changed
         c.model.cb.force_y = r > 0 ? force : nullptr;
         c.model.cb.rate = r > 0 ? rate : nullptr;
@@ -747,7 +747,7 @@ GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const doubl
             return c.diag.fail(GA_ERR_ARG, "np = %d parameters: must be >= 0", np);
         if (np > 0 && !p)
             return c.diag.fail(GA_ERR_ARG, "np = %d parameters and p is NULL", np);
-        if ((depends & ~(GA_DEPENDS_FORCE | GA_DEPENDS_MASS)) != 0)
+        if ((depends & ~(GA_DEPENDS_FORCE | GA_DEPENDS_MASS | GA_DEPENDS_RATE)) != 0)
             return c.diag.fail(GA_ERR_ARG, "unknown dependence flags 0x%x", static_cast<unsigned>(depends));
         for (int j = 0; p && j < np; ++j)
             if (!std::isfinite(p[j]))
@@ -762,9 +762,6 @@ GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const doubl
         if (c.initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity after ga_init: sensitivities "
                                "start at ga_init");
-        if (c.r() > 0 && np > 0)
-            return c.diag.fail(GA_ERR_STATE, "sensitivities with first-order states are not "
-                               "built yet");
         return c.set_sensitivity(np, p, p_scale, depends);
     });
 }
@@ -808,6 +805,23 @@ GA_API ga_status ga_get_sensitivity(const ga_solver *s, int j, double *dq, doubl
     });
 }
 
+GA_API ga_status ga_get_sensitivity_y(const ga_solver *s, int j, double *dy, double *dydot)
+{
+    return reading(s, "ga_get_sensitivity_y", "j is not the index of a parameter",
+                   [&](const ga::Solver &c) {
+        if (!c.initialized() || !c.sens.active() || !c.sens.forward)
+            return GA_ERR_STATE;
+        if (j < 0 || j >= c.sens.np)
+            return GA_ERR_ARG;
+        const ga::StateDerivative &x = c.sens.accepted[j];
+        if (dy)
+            Eigen::Map<ga::Vec>(dy, x.y.size()) = x.y;
+        if (dydot)
+            Eigen::Map<ga::Vec>(dydot, x.ydot.size()) = x.ydot;
+        return GA_OK;
+    });
+}
+
 GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_steps)
 {
     return guarded(s, [&](ga::Solver &c) {
@@ -821,6 +835,9 @@ GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_s
         if (!c.sens.active())
             return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity_method before "
                                "ga_set_sensitivity with np > 0");
+        if ((methods & GA_SENSITIVITY_ADJOINT) && c.r() > 0)
+            return c.diag.fail(GA_ERR_STATE, "the adjoint with first-order states is not built "
+                               "yet");
         if (c.initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity_method after ga_init");
         return c.set_sensitivity_method(methods, max_steps);

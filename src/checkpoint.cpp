@@ -10,7 +10,8 @@
 //            P_ and O_ (n + m each)
 //   y        with r first-order states only: y, y', w, w_prev and the kept matrix's y, y'
 //            (r each)
-//   sens     with np sensitivity parameters only: d/dp_j of q, v, qdd, lambda, a for each j
+//   sens     with np sensitivity parameters only: d/dp_j of q, v, qdd, lambda, a (and with
+//            first-order states y, y', w) for each j
 // Taking one only reads. Restoring rebuilds the kept matrix from the callbacks at the same
 // iterate and hands every sparse LU its pivots back, so the restored run repeats the run it
 // came from bit for bit (a kept matrix or pivots left out would make the next steps converge
@@ -53,7 +54,8 @@ Layout layout(int n, int m)
 std::size_t Solver::state_size() const
 {
     return layout(n_, m_).end + 6 * static_cast<std::size_t>(r()) +
-           static_cast<std::size_t>(sens.np) * (4 * static_cast<std::size_t>(n_) + m_);
+           static_cast<std::size_t>(sens.np) *
+               (4 * static_cast<std::size_t>(n_) + m_ + 3 * static_cast<std::size_t>(r()));
 }
 
 void Solver::get_state(double *buf) const
@@ -102,7 +104,7 @@ void Solver::get_state(double *buf) const
         p += x->size();
     }
     for (const StateDerivative &d : sens.accepted)
-        for (const Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a}) {
+        for (const Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a, &d.y, &d.ydot, &d.w}) {
             Eigen::Map<Vec>(p, x->size()) = *x;
             p += x->size();
         }
@@ -226,7 +228,7 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
             py += x->size();
         }
         for (StateDerivative &d : sens.accepted)
-            for (Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a}) {
+            for (Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a, &d.y, &d.ydot, &d.w}) {
                 *x = Eigen::Map<const Vec>(py, x->size());
                 py += x->size();
             }
@@ -306,7 +308,7 @@ ga_status Solver::rebuild_matrix()
         st = model.velocity_constraint_tangent(r.t, x.q, x.v, J_, Z_, r.central);
     model.tangent_mode = mode;
     if (!st && this->r() > 0)
-        st = first_order_matrix(r.t, x);
+        st = first_order_matrix(r.t, x, r.central);
     const bool central = r.central;
     if (!st)
         st = factorize(r.t, x, r.h, r.K, r.C, r.Z, 0);

@@ -91,9 +91,9 @@ void Solver::predict_first_order(double h)
 
 // The coupling blocks at the iterate x where the iteration matrix is built (f_, rate_ from the
 // residual there); the Schur complement follows at the first solve with that matrix.
-ga_status Solver::first_order_matrix(double t, const State &x)
+ga_status Solver::first_order_matrix(double t, const State &x, bool central)
 {
-    if (auto st = model.coupling(t, x.q, x.v, x.y, f_, rate_, blocks_))
+    if (auto st = model.coupling(t, x.q, x.v, x.y, f_, rate_, blocks_, central))
         return st;
     schur_valid_ = false;
     return GA_OK;

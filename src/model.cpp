@@ -122,6 +122,7 @@ void Model::allocate_workspace(const ModelMatrix &M, const ModelMatrix &J, const
     J_pert_.copy_layout(J);  // also serves the constraint acceleration term
     y_pert_.setZero(r_);
     rate_pert_.setZero(r_);
+    rate_minus_.setZero(r_);
     if (!g_q_pattern.dense() && g_q_pattern.nnz() > 0 && g_q_groups_.count() == 0)
         g_q_groups_.build(g_q_pattern);
     if (!g_v_pattern.dense() && g_v_pattern.nnz() > 0 && g_v_groups_.count() == 0)
@@ -548,7 +549,7 @@ ga_status Model::rate(double t, const Vec &q, const Vec &v, const Vec &y, Vec &y
 // (a group of columns at once where a pattern is declared), of g_y and f_y from y + e_j (the
 // force sees the perturbed y through y_now).
 ga_status Model::coupling(double t, const Vec &q, const Vec &v, const Vec &y, const Vec &f,
-                          const Vec &ydot, CouplingBlocks &B)
+                          const Vec &ydot, CouplingBlocks &B, bool central)
 {
     count(counters_, GA_COUNT_COUPLING_EVALS);
     if (cb.coupling) {
@@ -566,25 +567,30 @@ ga_status Model::coupling(double t, const Vec &q, const Vec &v, const Vec &y, co
     }
     for (const bool of_q : {true, false})
         if (auto st = coupling_block(t, q, v, y, ydot, of_q, of_q ? g_q_pattern : g_v_pattern,
-                                     of_q ? g_q_groups_ : g_v_groups_, of_q ? B.g_q : B.g_v))
+                                     of_q ? g_q_groups_ : g_v_groups_, of_q ? B.g_q : B.g_v,
+                                     central))
             return st;
     const Vec *y_before = y_now;
     y_pert_ = y;
     y_now = &y_pert_;
     for (int j = 0; j < r_; ++j) {
-        const double e = fd_increment(y[j]);
-        y_pert_[j] += e;
-        ga_status st = rate(t, q, v, y_pert_, rate_pert_);
-        if (!st && cb.force_y)
-            st = force(t, q, v, f_pert_);
+        const double e = central ? central_increment(y[j]) : fd_increment(y[j]);
+        ga_status st = GA_OK;
+        for (int side = 0; side < (central ? 2 : 1) && !st; ++side) {
+            y_pert_[j] = y[j] + (side == 0 ? e : -e);
+            st = rate(t, q, v, y_pert_, side == 0 ? rate_pert_ : rate_minus_);
+            if (!st && cb.force_y)
+                st = force(t, q, v, side == 0 ? f_pert_ : f_minus_);
+        }
         y_pert_[j] = y[j];
         if (st) {
             y_now = y_before;
             return st;
         }
-        B.g_y.col(j) = (rate_pert_ - ydot) / e;
+        const double span = central ? 2.0 * e : e;
+        B.g_y.col(j) = (rate_pert_ - (central ? rate_minus_ : ydot)) / span;
         if (cb.force_y)
-            B.f_y.col(j) = (f_pert_ - f) / e;
+            B.f_y.col(j) = (f_pert_ - (central ? f_minus_ : f)) / span;
         else
             B.f_y.col(j).setZero();
     }
@@ -598,22 +604,27 @@ namespace ga {
 
 ga_status Model::coupling_block(double t, const Vec &q, const Vec &v, const Vec &y,
                                 const Vec &ydot, bool of_q, const ModelMatrix &pattern,
-                                const ColumnGroups &groups, Mat &G)
+                                const ColumnGroups &groups, Mat &G, bool central)
 {
     Vec &x = of_q ? q_pert_ : v_pert_;
     x = of_q ? q : v;
-    const auto evaluate = [&] {
-        return of_q ? rate(t, q_pert_, v, y, rate_pert_) : rate(t, q, v_pert_, y, rate_pert_);
+    const auto evaluate = [&](Vec &out) {
+        return of_q ? rate(t, q_pert_, v, y, out) : rate(t, q, v_pert_, y, out);
     };
+    const double span = central ? 2.0 : 1.0;
     if (pattern.dense()) {
         for (int j = 0; j < n_; ++j) {
-            const double e = fd_increment(x[j]), keep = x[j];
-            x[j] += e;
-            const ga_status st = evaluate();
+            const double e = central ? central_increment(x[j]) : fd_increment(x[j]), keep = x[j];
+            x[j] = keep + e;
+            ga_status st = evaluate(rate_pert_);
+            if (!st && central) {
+                x[j] = keep - e;
+                st = evaluate(rate_minus_);
+            }
             x[j] = keep;
             if (st)
                 return st;
-            G.col(j) = (rate_pert_ - ydot) / e;
+            G.col(j) = (rate_pert_ - (central ? rate_minus_ : ydot)) / (span * e);
         }
         return GA_OK;
     }
@@ -621,19 +632,22 @@ ga_status Model::coupling_block(double t, const Vec &q, const Vec &v, const Vec 
     const auto &rows = pattern.row_index();
     const auto &cols = pattern.col_index();
     for (int g = 0; g < groups.count(); ++g) {
-        for (int k = groups.start[g]; k < groups.start[g + 1]; ++k) {
-            const int j = groups.cols[k];
-            step_[j] = fd_increment(x[j]);
-            x[j] += step_[j];
+        for (int side = 0; side < (central ? 2 : 1); ++side) {
+            for (int k = groups.start[g]; k < groups.start[g + 1]; ++k) {
+                const int j = groups.cols[k];
+                step_[j] = central ? central_increment(x[j]) : fd_increment(x[j]);
+                x[j] = (of_q ? q[j] : v[j]) + (side == 0 ? step_[j] : -step_[j]);
+            }
+            const ga_status st = evaluate(side == 0 ? rate_pert_ : rate_minus_);
+            for (int k = groups.start[g]; k < groups.start[g + 1]; ++k)
+                x[groups.cols[k]] = of_q ? q[groups.cols[k]] : v[groups.cols[k]];
+            if (st)
+                return st;
         }
-        const ga_status st = evaluate();
-        for (int k = groups.start[g]; k < groups.start[g + 1]; ++k)
-            x[groups.cols[k]] = of_q ? q[groups.cols[k]] : v[groups.cols[k]];
-        if (st)
-            return st;
+        const Vec &base = central ? rate_minus_ : ydot;
         for (int k = groups.entry_start[g]; k < groups.entry_start[g + 1]; ++k) {
             const int e = groups.entries[k], i = rows[e], j = cols[e];
-            G(i, j) = (rate_pert_[i] - ydot[i]) / step_[j];
+            G(i, j) = (rate_pert_[i] - base[i]) / (span * step_[j]);
         }
     }
     return GA_OK;

@@ -99,7 +99,7 @@ public:
     // The coupling blocks at (t, q, v, y): the callback, or forward differences from f and
     // g there (f = f(t, q, v, y), ydot = g(t, q, v, y)).
     ga_status coupling(double t, const Vec &q, const Vec &v, const Vec &y, const Vec &f,
-                       const Vec &ydot, CouplingBlocks &B);
+                       const Vec &ydot, CouplingBlocks &B, bool central = false);
     bool uses_tangents() const { return tangent_mode != GA_TANGENT_NEGLECT; }
     // applied forces exist: the callback of ga_set_callbacks, or with first-order states theirs
     bool has_force() const { return cb.force || (r_ > 0 && cb.force_y); }
@@ -202,12 +202,12 @@ private:
     Vec q_pert_, v_pert_, f_pert_, r_pert_, r_minus_, f_minus_, phi_plus_, phi_minus_, g_plus_,
         g_minus_, step_;
     int r_ = 0;
-    Vec y_pert_, rate_pert_;  // first-order differences
+    Vec y_pert_, rate_pert_, rate_minus_;  // first-order differences
     ColumnGroups g_q_groups_, g_v_groups_;
     // one block of g_q or g_v (column j from the states perturbed in x) by differences
     ga_status coupling_block(double t, const Vec &q, const Vec &v, const Vec &y, const Vec &ydot,
                              bool of_q, const ModelMatrix &pattern, const ColumnGroups &groups,
-                             Mat &G);
+                             Mat &G, bool central);
     ModelMatrix M_pert_, J_pert_;
     ColumnGroups k_groups_, c_groups_;
 };

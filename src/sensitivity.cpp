@@ -17,13 +17,15 @@ namespace {
 const double kEps = std::numeric_limits<double>::epsilon();
 }
 
-void Sensitivities::allocate(int n, int m)
+void Sensitivities::allocate(int n, int m, int r)
 {
     for (auto *set : {&accepted, &trial, &start}) {
         set->resize(np);
         for (StateDerivative &x : *set)
-            x.allocate(n, m);
+            x.allocate(n, m, r);
     }
+    for (Vec *x : {&ry, &dy, &gy, &w0, &rate_plus, &rate_minus})
+        x->setZero(r);
     for (Vec *x : {&rq, &d, &w, &f_plus, &f_minus, &bt, &a0, &xq, &xv})
         x->setZero(n);
     seed_q.assign(np, Vec::Zero(n));
@@ -53,10 +55,11 @@ ga_status Solver::set_sensitivity(int np, double *p, const double *p_scale, int 
     for (int j = 0; j < np; ++j)
         s.scale[j] = p_scale ? p_scale[j] : (p[j] != 0.0 ? std::fabs(p[j]) : 1.0);
     if (np > 0) {
-        s.allocate(n_, m_);
+        s.allocate(n_, m_, r());
         if (workspace_ready_)
             s.allocate_matrices(M_, J_);
         sens_scratch_.allocate(n_, m_);
+        sens_scratch_.allocate_first_order(r());
     }
     sens = std::move(s);
     adjoint_ = AdjointRecord{};  // the method is forward again (ga_set_sensitivity_method)
@@ -123,6 +126,9 @@ ga_status Solver::sensitivity_start(const State &x)
     if (sparse_backend_ && ((!K_.zero() && K_.dense()) || (damped && !C_.zero() && C_.dense())))
         return diag.fail(GA_ERR_ARG, "sensitivities on the sparse path need the patterns of K_t "
                          "and C_t (ga_set_pattern; an empty pattern declares a zero matrix)");
+    if (r() > 0 && !coupling_exact)
+        return diag.fail(GA_ERR_ARG, "sensitivities with first-order states need the coupling "
+                         "blocks in the iteration matrix (ga_set_coupling_exact)");
     Sensitivities &z = sens;
     for (int j = 0; j < z.np; ++j) {
         StateDerivative &s = z.trial[j];
@@ -144,7 +150,10 @@ ga_status Solver::sensitivity_start(const State &x)
             SaddleWorkspace w{S_, M_, J_, f_, c_, rq_};
             Vec &qdd = side == 0 ? s.qdd : z.d;
             Vec &lambda = side == 0 ? s.lambda : z.dl;
-            return acceleration_level(x.t, z.xq, z.xv, w, qdd, lambda);
+            ga_status st = acceleration_level(x.t, z.xq, z.xv, w, qdd, lambda);
+            if (!st && r() > 0)  // y'_0 = g(t0, q0, v0, y0), y0 independent of p
+                st = model.rate(x.t, z.xq, z.xv, x.y, side == 0 ? z.rate_plus : z.rate_minus);
+            return st;
         };
         const ga_status st = central_difference(j, perturb, evaluate, span);
         jacobian_valid_ = false;  // S_ holds another matrix now
@@ -156,6 +165,11 @@ ga_status Solver::sensitivity_start(const State &x)
         s.qdd = (s.qdd - z.d) / span;
         s.lambda = (s.lambda - z.dl) / span;
         s.a = s.qdd;  // a_0 = qdd_0
+        if (r() > 0) {
+            s.y.setZero();
+            s.ydot = (z.rate_plus - z.rate_minus) / span;
+            s.w = s.ydot;  // w_0 = y'_0
+        }
     }
     return GA_OK;
 }
@@ -210,6 +224,12 @@ void Solver::shift_state(const State &from, const StateDerivative &s, double shi
     to.lambda = from.lambda + shift * s.lambda;
     to.a = from.a + shift * s.a;
     to.a_prev = from.a_prev;
+    if (s.y.size() > 0) {
+        to.y = from.y + shift * s.y;
+        to.ydot = from.ydot + shift * s.ydot;
+        to.w = from.w + shift * s.w;
+        to.w_prev = from.w_prev;
+    }
 }
 
 // A fresh start (the first step's corrected starting values, a step after Taylor steps, a
@@ -243,10 +263,17 @@ ga_status Solver::sensitivity_by_differences(double h, bool taylor_step, bool re
                 take(out.qdd, trial_.qdd);
                 take(out.lambda, trial_.lambda);
                 take(out.a, trial_.a);
+                if (r() > 0) {
+                    take(out.y, trial_.y);
+                    take(out.ydot, trial_.ydot);
+                    take(out.w, trial_.w);
+                }
             } else {
                 take(out.v, *v_start_);
                 take(out.a, *a_start_);
                 take(out.qdd, *qdd_start_);
+                if (r() > 0)
+                    take(out.w, *w_start_);
             }
             return GA_OK;
         };
@@ -259,9 +286,12 @@ ga_status Solver::sensitivity_by_differences(double h, bool taylor_step, bool re
         out.v /= span;
         out.a /= span;
         out.qdd /= span;
+        out.w /= span;
         if (taylor_step) {
             out.q /= span;
             out.lambda /= span;
+            out.y /= span;
+            out.ydot /= span;
         }
     }
     if (taylor_step)
@@ -310,6 +340,23 @@ ga_status Solver::parameter_residual(int j, double t, const State &x)
             z.rq += z.f_plus / span;
         }
     }
+    return GA_OK;
+}
+
+// d/dp_j of r^y = y' - g: -dg/dp_j by central differences of the rate (GA_DEPENDS_RATE), into
+// sens.ry (added).
+ga_status Solver::rate_parameter_residual(int j, double t, const State &x)
+{
+    Sensitivities &z = sens;
+    if (!(z.depends & GA_DEPENDS_RATE))
+        return GA_OK;
+    double span = 0.0;
+    const auto evaluate = [&](int side) {
+        return model.rate(t, x.q, x.v, x.y, side == 0 ? z.rate_plus : z.rate_minus);
+    };
+    if (auto st = central_difference(j, [](bool, double) {}, evaluate, span))
+        return st;
+    z.ry -= (z.rate_plus - z.rate_minus) / span;
     return GA_OK;
 }
 
@@ -391,9 +438,13 @@ ga_status Solver::sensitivity_step(double h)
     // starts with it.
     bool K = false, C = false, Z = false;
     ga_status st = exact_tangents(t1, x, K, C, Z);
+    if (!st && r() > 0)  // the coupling blocks likewise, and the Schur complement on y
+        st = first_order_matrix(t1, x, true);
     if (!st)
         st = factorize(t1, x, h, K, C, Z, 0);
     recipe_.central = !st;
+    if (!st && r() > 0)
+        st = first_order_schur(h, c);
     if (st) {
         diag.append(" (the exact iteration matrix for the sensitivities)");
         return st;
@@ -412,6 +463,20 @@ ga_status Solver::sensitivity_step(double h)
         } else if (a_start_ != &s.a) {  // a_n rescaled to h
             z.a0 = sn.qdd + (h / s.h_last) * (sn.a - sn.qdd);
             sa = &z.a0;
+        }
+        // first-order states: the w the step started from, and the predictor with y' = 0
+        const FirstOrderParams &p1 = params1;
+        const Vec *sw = &sn.w;
+        if (r() > 0) {
+            if (z.start_given) {
+                sw = &z.start[j].w;
+            } else if (w_start_ != &s.w) {  // w_n rescaled to h (first_order_start)
+                z.w0 = sn.ydot + (h / s.h_last) * (sn.w - sn.ydot);
+                sw = &z.w0;
+            }
+            s1.ydot.setZero();
+            s1.w = (p1.alpha_f * sn.ydot - p1.alpha_m * *sw) / (1.0 - p1.alpha_m);
+            s1.y = sn.y + h * ((1.0 - p1.gamma) * *sw + p1.gamma * s1.w);
         }
         // predictor, eqs. (3)-(5) with qdd_{n+1} = 0
         s1.qdd.setZero();
@@ -434,6 +499,15 @@ ga_status Solver::sensitivity_step(double h)
             K_.multiply_add(1.0, s1.q, z.rq);
         if (C)
             C_.multiply_add(1.0, s1.v, z.rq);
+        if (r() > 0) {  // r^q sees y through f; r^y = y' - g(t, q, v, y)
+            z.rq.noalias() -= blocks_.f_y * s1.y;
+            z.ry = s1.ydot;
+            z.ry.noalias() -= blocks_.g_q * s1.q;
+            z.ry.noalias() -= blocks_.g_v * s1.v;
+            z.ry.noalias() -= blocks_.g_y * s1.y;
+            if ((st = rate_parameter_residual(j, t1, x)))
+                return st;
+        }
         z.rl.setZero();
         J_.multiply_add(1.0, s1.q, z.rl);
         if (index2) {
@@ -444,6 +518,22 @@ ga_status Solver::sensitivity_step(double h)
             S2_.solve(z.rq, z.rl, z.rv, p, h, B_, z.d, z.w, z.dl, z.e);
         } else {
             S_.solve(z.rq, z.rl, z.d, z.dl, row_scale);
+        }
+        if (r() > 0) {  // elimination onto y (first_order.cpp): dy, then x0 - Z dy
+            z.gy = -z.ry;
+            z.gy.noalias() += blocks_.g_q * z.d;
+            z.gy.noalias() += c.gamma_prime * (blocks_.g_v * (index2 ? z.w : z.d));
+            z.dy = C1_lu_.solve(z.gy);
+            if (forces_see_y()) {
+                z.d.noalias() -= Zq_ * z.dy;
+                z.dl.noalias() -= Zl_ * z.dy;
+                if (index2)
+                    z.w.noalias() -= Zw_ * z.dy;
+            }
+            s1.y += z.dy;
+            s1.ydot = first_order_newton_coefficient(p1, h) * z.dy;
+            s1.w = (p1.alpha_f * sn.ydot - p1.alpha_m * *sw + (1.0 - p1.alpha_f) * s1.ydot) /
+                   (1.0 - p1.alpha_m);
         }
         const Vec &dw = index2 ? z.w : z.d;
         s1.q += z.d;

@@ -11,16 +11,21 @@
 
 namespace ga {
 
-// d/dp_j of the quantities a step carries from one state to the next.
+// d/dp_j of the quantities a step carries from one state to the next (with r first-order
+// states also y, y' and w).
 struct StateDerivative {
     Vec q, v, qdd, lambda, a;
-    void allocate(int n, int m)
+    Vec y, ydot, w;
+    void allocate(int n, int m, int r = 0)
     {
         q.setZero(n);
         v.setZero(n);
         qdd.setZero(n);
         lambda.setZero(m);
         a.setZero(n);
+        y.setZero(r);
+        ydot.setZero(r);
+        w.setZero(r);
     }
 };
 
@@ -43,12 +48,13 @@ struct Sensitivities {
 
     // scratch of one step
     Vec rq, rl, rv, d, w, dl, e, f_plus, f_minus, bt, a0, xq, xv;
+    Vec ry, dy, gy, w0, rate_plus, rate_minus;  // first-order states (r)
     ModelMatrix M_pert, J_pert;
 
     bool active() const { return np > 0; }
     // Sizes the vectors, and the matrices in the layouts of M and Phi_q (at setup, when the
     // patterns are known); throw std::bad_alloc.
-    void allocate(int n, int m);
+    void allocate(int n, int m, int r);
     void allocate_matrices(const ModelMatrix &M, const ModelMatrix &J);
     // The perturbation of p_j for central differences.
     double increment(int j) const;

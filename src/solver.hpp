@@ -216,7 +216,7 @@ private:
     // first_order.cpp: the parts of a step that concern first-order states.
     void first_order_start(double h);
     void predict_first_order(double h);
-    ga_status first_order_matrix(double t, const State &x);
+    ga_status first_order_matrix(double t, const State &x, bool central = false);
     // The mechanical update depends on dy: f_y is in the Newton system (Z = Sol(f_y) != 0).
     bool forces_see_y() const { return coupling_exact && model.cb.force_y != nullptr; }
     ga_status first_order_schur(double h, const NewtonCoefficients &c);
@@ -240,6 +240,7 @@ private:
     static void shift_state(const State &from, const StateDerivative &s, double shift, State &to);
     ga_status sensitivity_by_differences(double h, bool taylor_step, bool restart_short);
     ga_status parameter_residual(int j, double t, const State &x);
+    ga_status rate_parameter_residual(int j, double t, const State &x);
     ga_status correction_derivative(double t, const Vec &q, const Vec &eta, const Vec &s,
                                     Vec &out);
     ga_status sensitivity_step(double h);

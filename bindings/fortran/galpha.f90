@@ -38,7 +38,8 @@ module galpha
   integer(c_int), parameter, public :: GA_INIT_PROJECT = 0, GA_INIT_REFUSE = 1
   integer(c_int), parameter, public :: GA_OUTPUT_CONSISTENT = 0, GA_OUTPUT_STEP = 1
   integer(c_int), parameter, public :: GA_COUPLING_G_Q = 0, GA_COUPLING_G_V = 1
-  integer(c_int), parameter, public :: GA_DEPENDS_FORCE = 1, GA_DEPENDS_MASS = 2
+  integer(c_int), parameter, public :: GA_DEPENDS_FORCE = 1, GA_DEPENDS_MASS = 2, &
+       GA_DEPENDS_RATE = 4
   integer(c_int), parameter, public :: GA_SENSITIVITY_FORWARD = 1, GA_SENSITIVITY_ADJOINT = 2
   integer(c_int), parameter, public :: GA_EVENT_BOTH = 0, GA_EVENT_RISING = 1, &
        GA_EVENT_FALLING = -1, GA_EVENT_LOG = 64
@@ -514,6 +515,13 @@ module galpha
        type(c_ptr), value :: s
        type(c_funptr), value :: force_p, mass_p
      end function ga_set_parameter_derivatives
+     integer(c_int) function ga_get_sensitivity_y(s, j, dy, dydot) &
+          bind(C, name="ga_get_sensitivity_y")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       integer(c_int), value :: j
+       real(c_double), intent(out), optional :: dy(*), dydot(*)  ! absent: NULL
+     end function ga_get_sensitivity_y
      integer(c_int) function ga_set_sensitivity_start(s, j, dq0, dv0) &
           bind(C, name="ga_set_sensitivity_start")
        import :: c_int, c_ptr, c_double
@@ -564,7 +572,7 @@ module galpha
        ga_get_event, ga_set_first_order, ga_set_coupling, ga_set_coupling_exact, ga_init_y, &
        ga_get_y, ga_interpolate_y, ga_set_events_y, ga_set_coupling_pattern, &
        ga_set_sensitivity, ga_set_parameter_derivatives, ga_get_sensitivity, &
-       ga_set_sensitivity_start, &
+       ga_set_sensitivity_start, ga_get_sensitivity_y, &
        ga_set_sensitivity_method, ga_adjoint_gradient
 
   ! ---- the Fortran layer --------------------------------------------------------------------
@@ -680,6 +688,8 @@ module galpha
      !> get_sensitivity(j, dq, dv, dqdd, dlambda): d/dp_j (j 1-based) of the accepted step's
      !> q, v, qdd, lambda (each optional)
      procedure :: get_sensitivity => solver_get_sensitivity
+     !> get_sensitivity_y(j, dy, dydot): d/dp_j of the first-order states and their rates
+     procedure :: get_sensitivity_y => solver_get_sensitivity_y
      !> set_sensitivity_start(j, dq0, dv0): dq0/dp_j and dv0/dp_j (j 1-based; either optional:
      !> zero) for every later init
      procedure :: set_sensitivity_start => solver_set_sensitivity_start
@@ -946,6 +956,17 @@ contains
     if (present(mass_p)) m = c_funloc(mass_p)
     status = ga_set_parameter_derivatives(this%handle, f, m)
   end function solver_set_parameter_derivatives
+
+  integer(c_int) function solver_get_sensitivity_y(this, j, dy, dydot) result(status)
+    class(galpha_solver), intent(in) :: this
+    integer, intent(in) :: j
+    real(c_double), intent(out), optional :: dy(:), dydot(:)
+    real(c_double) :: a(max(this%r, 1)), b(max(this%r, 1))
+    status = ga_get_sensitivity_y(this%handle, int(j - 1, c_int), a, b)
+    if (status /= GA_OK) return
+    if (present(dy)) dy(1:this%r) = a(1:this%r)
+    if (present(dydot)) dydot(1:this%r) = b(1:this%r)
+  end function solver_get_sensitivity_y
 
   integer(c_int) function solver_set_sensitivity_start(this, j, dq0, dv0) result(status)
     class(galpha_solver), intent(inout) :: this

@@ -533,8 +533,9 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
     if (pick(&md, 3) == 0) {  /* a first-order state in a third of the runs */
         md.r = 1;
         SEQ_REQUIRE(ga_set_first_order(s, 1, force_y, rate) == GA_OK);
-    } else if (pick(&md, 3) == 0) {  /* else sensitivities in a third: forward, adjoint, both */
-        const int methods = 1 + pick(&md, 3);
+    }
+    if (pick(&md, 3) == 0) {  /* sensitivities in a third: forward, adjoint (not with y), both */
+        const int methods = md.r ? GA_SENSITIVITY_FORWARD : 1 + pick(&md, 3);
         md.sens = 1;
         md.sens_forward = methods & GA_SENSITIVITY_FORWARD;
         md.sens_adjoint = (methods & GA_SENSITIVITY_ADJOINT) != 0;

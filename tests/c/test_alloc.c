@@ -406,7 +406,8 @@ static void no_allocation_with_events(void **state)
 }
 
 /* First-order states: coupling blocks by differences and by callback, both formulations, fixed
- * and adaptive steps, dense and sparse, rate callbacks that fail now and then. */
+ * and adaptive steps, dense and sparse, rate callbacks that fail now and then; with forward
+ * sensitivities. */
 static int rate_failure;
 static int sometimes_failing_rate(double t, const double *q, const double *v, const double *y,
                                   double *ydot, void *u)
@@ -417,9 +418,10 @@ static int sometimes_failing_rate(double t, const double *q, const double *v, co
 static void no_allocation_with_first_order_states(void **state)
 {
     (void)state;
-    for (int mode = 0; mode < 6; ++mode) {  /* modes 4, 5: the sparse path */
+    for (int variant = 0; variant < 12; ++variant) {  /* 6 ... 11: with sensitivities */
+        const int mode = variant % 6, sensitivities = variant >= 6;
         ga_solver *s = NULL;
-        const int sparse = mode >= 4;
+        const int sparse = mode >= 4; /* modes 4, 5: the sparse path */
         assert_int_equal(ga_create(EM_N, EM_M, &s), GA_OK);
         if (sparse)
             assert_int_equal(em_declare_sparse(s), GA_OK);
@@ -427,6 +429,11 @@ static void no_allocation_with_first_order_states(void **state)
                                           sparse ? em_jacobian_values : em_jacobian, NULL),
                          GA_OK);
         assert_int_equal(ga_set_first_order(s, EM_R, em_force, sometimes_failing_rate), GA_OK);
+        static double unread[1] = {1.0}; /* sensitivities in a parameter nothing reads */
+        if (sensitivities)
+            assert_int_equal(ga_set_sensitivity(s, 1, unread, NULL,
+                                                GA_DEPENDS_FORCE | GA_DEPENDS_RATE),
+                             GA_OK);
         if (mode & 1)
             assert_int_equal(ga_set_coupling(s, em_coupling), GA_OK);
         if (mode >= 2)
@@ -448,7 +455,8 @@ static void no_allocation_with_first_order_states(void **state)
         }
         armed = 0;
         rate_failure = 0;
-        printf("  mode %d: %ld failed calls, %ld allocations\n", mode, failed, allocations);
+        printf("  mode %d%s: %ld failed calls, %ld allocations\n", mode,
+               sensitivities ? " with sensitivities" : "", failed, allocations);
         assert_true(failed > 0);
         assert_int_equal(allocations, 0);
         ga_free(s);

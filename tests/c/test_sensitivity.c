@@ -20,6 +20,7 @@
 
 #include "electromech.h"
 #include "scene_catalog.h"
+#include "scenes/slider_crank_motor.h"
 
 enum { kMaxSteps = 20000, kMaxP = 3, kQuantities = 4 };
 enum { kLadder = 5 };
@@ -317,7 +318,7 @@ static void refusals(void **state)
     assert_non_null(strstr(ga_last_error(s), "np = -1"));
     assert_int_equal(ga_set_sensitivity(s, 2, NULL, NULL, GA_DEPENDS_FORCE), GA_ERR_ARG);
     assert_non_null(strstr(ga_last_error(s), "p is NULL"));
-    assert_int_equal(ga_set_sensitivity(s, 2, p, NULL, 4), GA_ERR_ARG);
+    assert_int_equal(ga_set_sensitivity(s, 2, p, NULL, 8), GA_ERR_ARG);
     assert_non_null(strstr(ga_last_error(s), "flags"));
     assert_int_equal(ga_set_sensitivity(s, 3, p, bad_scale, GA_DEPENDS_FORCE), GA_ERR_ARG);
     assert_non_null(strstr(ga_last_error(s), "p_scale[1]"));
@@ -332,9 +333,9 @@ static void refusals(void **state)
     assert_int_equal(ga_set_sensitivity(s, 2, p, NULL, GA_DEPENDS_MASS), GA_OK);
     assert_int_equal(ga_set_constant_mass(s, 1), GA_ERR_STATE);
     assert_non_null(strstr(ga_last_error(s), "GA_DEPENDS_MASS"));
-    /* first-order states: not with sensitivities yet, in either order */
+    /* first-order states are declared before the sensitivities */
     assert_int_equal(ga_set_first_order(s, 1, NULL, em_rate), GA_ERR_STATE);
-    assert_non_null(strstr(ga_last_error(s), "not built"));
+    assert_non_null(strstr(ga_last_error(s), "declare the states first"));
     /* the set of the last successful call is the one in use */
     assert_int_equal(ga_init(s, 0.0, sc.q0, sc.v0), GA_OK);
     assert_int_equal(ga_step(s, 1e-3), GA_OK);
@@ -348,11 +349,18 @@ static void refusals(void **state)
     assert_non_null(strstr(ga_last_error(s), "after ga_init"));
     ga_free(s);
 
+    /* with them: the coupling blocks must be in the matrix; no adjoint yet */
     ga_solver *f = NULL;
+    const double q0[EM_N] = {0, 0}, y0[EM_R] = {0, 0};
     assert_int_equal(ga_create(EM_N, EM_M, &f), GA_OK);
+    assert_int_equal(ga_set_callbacks(f, em_mass, NULL, em_constraint, em_jacobian, NULL), GA_OK);
     assert_int_equal(ga_set_first_order(f, EM_R, em_force, em_rate), GA_OK);
-    assert_int_equal(ga_set_sensitivity(f, 1, p, NULL, GA_DEPENDS_FORCE), GA_ERR_STATE);
+    assert_int_equal(ga_set_sensitivity(f, 1, p, NULL, GA_DEPENDS_FORCE), GA_OK);
+    assert_int_equal(ga_set_sensitivity_method(f, GA_SENSITIVITY_ADJOINT, 10), GA_ERR_STATE);
     assert_non_null(strstr(ga_last_error(f), "first-order"));
+    assert_int_equal(ga_set_coupling_exact(f, 0), GA_OK);
+    assert_int_equal(ga_init_y(f, 0.0, q0, q0, y0), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(f), "ga_set_coupling_exact"));
     ga_free(f);
 
     /* the sparse path without a pattern of K_t has no place for the exact tangent */
@@ -553,6 +561,165 @@ static void initial_values_as_parameters(void **state)
     ga_free(s);
 }
 
+
+/* ---- first-order states: the motor-driven slider-crank ---- */
+
+/* The motor's Kt, Ke, R, L, Kp, Ki as parameters (Kt in the forces, the others in the rates):
+ * the final q, v, qdd, lambda, y, y' of a run, and with sensitivities their derivatives.
+ * coupling: the blocks by the scene's callback (else central differences). */
+static sc_motor g_motor_p;
+typedef struct motor_result {
+    double x[6][SC_N];
+} motor_result;
+
+static void motor_run(const double *p, int formulation, int sens, int coupling,
+                      motor_result *out, motor_result *d)
+{
+    g_motor_p = sc_motor_default();
+    memcpy(&g_motor_p.Kt, p, 6 * sizeof(double));
+    ga_solver *s = NULL;
+    double q[SC_N], v[SC_N];
+    const double y[SCM_R] = {0.0, 0.0};
+    assert_int_equal(ga_create(SC_N, SC_M, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, sc_mass, NULL, sc_constraint, sc_jacobian, &g_motor_p),
+                     GA_OK);
+    assert_int_equal(ga_set_constraint_accel(s, sc_constraint_accel), GA_OK);
+    assert_int_equal(ga_set_constraint_dt(s, sc_constraint_dt), GA_OK);
+    assert_int_equal(ga_set_first_order(s, SCM_R, scm_force, scm_rate), GA_OK);
+    if (coupling)
+        assert_int_equal(ga_set_coupling(s, scm_coupling), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    assert_int_equal(ga_set_output(s, GA_OUTPUT_STEP), GA_OK);
+    if (sens) {
+        assert_int_equal(ga_set_sensitivity(s, 6, &g_motor_p.Kt, NULL,
+                                            GA_DEPENDS_FORCE | GA_DEPENDS_RATE),
+                         GA_OK);
+    } else {
+        assert_int_equal(ga_set_jacobian_reuse(s, GA_REUSE_NEVER), GA_OK);
+        assert_int_equal(ga_set_newton(s, 1e-13, 30), GA_OK);
+    }
+    sc_initial(&g_motor_p.crank, M_PI / 2, q, v);
+    assert_int_equal(ga_init_y(s, 0.0, q, v, y), GA_OK);
+    /* index 3: longer steps, so that whole-run differences resolve qdd, lambda and y' (their
+     * round-off, eps / (beta h^2), is large against these fast states) */
+    const int steps = formulation == GA_INDEX3 ? 50 : 200;
+    for (int k = 0; k < steps; ++k)
+        assert_int_equal(ga_step(s, 0.2 / steps), GA_OK);
+    memset(out, 0, sizeof *out);
+    assert_int_equal(ga_get_q(s, out->x[0]), GA_OK);
+    assert_int_equal(ga_get_v(s, out->x[1]), GA_OK);
+    assert_int_equal(ga_get_qdd(s, out->x[2]), GA_OK);
+    assert_int_equal(ga_get_lambda(s, out->x[3]), GA_OK);
+    assert_int_equal(ga_get_y(s, out->x[4], out->x[5]), GA_OK);
+    for (int j = 0; sens && j < 6; ++j) {
+        memset(&d[j], 0, sizeof d[j]);
+        assert_int_equal(ga_get_sensitivity(s, j, d[j].x[0], d[j].x[1], d[j].x[2], d[j].x[3]),
+                         GA_OK);
+        assert_int_equal(ga_get_sensitivity_y(s, j, d[j].x[4], d[j].x[5]), GA_OK);
+    }
+    ga_free(s);
+}
+
+static void first_order_states(void **state)
+{
+    (void)state;
+    const sc_motor m0 = sc_motor_default();
+    const double *p0 = &m0.Kt;
+    const int len[6] = {SC_N, SC_N, SC_N, SC_M, SCM_R, SCM_R};
+    static const char *const names[6] = {"q", "v", "qdd", "lambda", "y", "y'"};
+    for (int f = 0; f < 2; ++f) {
+        const int formulation = f ? GA_INDEX2_STABILIZED : GA_INDEX3;
+        motor_result base, sens[6], exact[6], r[4];
+        motor_run(p0, formulation, 1, 0, &base, sens);
+        motor_run(p0, formulation, 1, 1, &base, exact);
+        for (int j = 0; j < 6; ++j) {
+            const double e = 1e-2 * fabs(p0[j]), shift[4] = {e, -e, 0.5 * e, -0.5 * e};
+            for (int k = 0; k < 4; ++k) {
+                double p[6];
+                memcpy(p, p0, sizeof p);
+                p[j] += shift[k];
+                motor_run(p, formulation, 0, 0, &r[k], NULL);
+            }
+            double worst = 0.0, worst_exact = 0.0;
+            for (int qn = 0; qn < 6; ++qn) {
+                double diff = 0, size = 0, by_callback = 0;
+                for (int i = 0; i < len[qn]; ++i) {
+                    const double fd = (4 * (r[2].x[qn][i] - r[3].x[qn][i]) / e -
+                                       (r[0].x[qn][i] - r[1].x[qn][i]) / (2 * e)) / 3;
+                    diff = fmax(diff, fabs(sens[j].x[qn][i] - fd));
+                    by_callback = fmax(by_callback, fabs(exact[j].x[qn][i] - sens[j].x[qn][i]));
+                    size = fmax(size, fabs(fd));
+                }
+                /* index 3: qdd, lambda and y' carry eps / (beta h^2) of round-off, which the
+                 * whole-run differences of these fast states do not resolve below 1e-6 (their
+                 * disagreement grows as h shrinks: 7e-7, 1.2e-6, 4.6e-6 at 25, 50, 100 steps):
+                 * compared, not asserted */
+                const int resolved = f || qn == 0 || qn == 1 || qn == 4;
+                printf("  index %d p%d %-6s |d/dp| %.3e difference %.2e%s, blocks by callback "
+                       "against differences %.1e\n", f ? 2 : 3, j, names[qn], size, diff / size,
+                       resolved ? "" : " (not resolved by the reference)", by_callback / size);
+                if (resolved)
+                    worst = fmax(worst, diff / size);
+                worst_exact = fmax(worst_exact, by_callback / size);
+            }
+            assert_true(worst < 1e-7);
+            assert_true(worst_exact < 1e-7);
+        }
+    }
+}
+
+
+/* A checkpoint of a run with first-order states and sensitivities: the restored run goes on
+ * bit for bit (the kept matrix rebuilt with central differences of tangents and coupling). */
+static ga_solver *motor_sens_solver(void)
+{
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(SC_N, SC_M, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, sc_mass, NULL, sc_constraint, sc_jacobian, &g_motor_p),
+                     GA_OK);
+    assert_int_equal(ga_set_constraint_accel(s, sc_constraint_accel), GA_OK);
+    assert_int_equal(ga_set_first_order(s, SCM_R, scm_force, scm_rate), GA_OK);
+    assert_int_equal(ga_set_sensitivity(s, 6, &g_motor_p.Kt, NULL,
+                                        GA_DEPENDS_FORCE | GA_DEPENDS_RATE),
+                     GA_OK);
+    return s;
+}
+
+static void first_order_checkpoint(void **state)
+{
+    (void)state;
+    g_motor_p = sc_motor_default();
+    double q[SC_N], v[SC_N];
+    const double y0[SCM_R] = {0.0, 0.0};
+    sc_initial(&g_motor_p.crank, M_PI / 2, q, v);
+    ga_solver *a = motor_sens_solver(), *b = motor_sens_solver();
+    assert_int_equal(ga_init_y(a, 0.0, q, v, y0), GA_OK);
+    for (int k = 0; k < 30; ++k)
+        assert_int_equal(ga_step(a, 1e-3), GA_OK);
+    size_t len = 0;
+    assert_int_equal(ga_state_size(a, &len), GA_OK);
+    double *buf = malloc(len * sizeof(double));
+    assert_int_equal(ga_get_state(a, buf, len), GA_OK);
+    assert_int_equal(ga_set_state(b, buf, len), GA_OK);
+    for (int k = 0; k < 30; ++k) {
+        assert_int_equal(ga_step(a, 1e-3), GA_OK);
+        assert_int_equal(ga_step(b, 1e-3), GA_OK);
+    }
+    for (int j = 0; j < 6; ++j) {
+        double x[2][2 * SC_N + 2 * SCM_R] = {{0}};
+        for (int k = 0; k < 2; ++k) {
+            ga_solver *s = k ? b : a;
+            assert_int_equal(ga_get_sensitivity(s, j, x[k], x[k] + SC_N, NULL, NULL), GA_OK);
+            assert_int_equal(ga_get_sensitivity_y(s, j, x[k] + 2 * SC_N, x[k] + 2 * SC_N + SCM_R),
+                             GA_OK);
+        }
+        assert_memory_equal(x[0], x[1], sizeof x[0]);
+    }
+    free(buf);
+    ga_free(a);
+    ga_free(b);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -561,6 +728,8 @@ int main(void)
         cmocka_unit_test(chain_sensitivity),
         cmocka_unit_test(andrews_sensitivity),
         cmocka_unit_test(initial_values_as_parameters),
+        cmocka_unit_test(first_order_states),
+        cmocka_unit_test(first_order_checkpoint),
         cmocka_unit_test(derivative_callbacks_agree_with_differences),
         cmocka_unit_test(refusals),
         cmocka_unit_test(failed_sensitivity_fails_the_step),

@@ -291,6 +291,7 @@ program test_layer
   call expect(abs(q(1) - x / 2d-4) < 1d-7 * abs(q(1)), 'dx/dk against differences of runs')
   call expect(r%get_sensitivity(2, q(1:1)) == GA_ERR_ARG, 'get_sensitivity checks j')
   call expect(r%set_sensitivity_start(2, [1.0d0]) == GA_ERR_ARG, 'set_sensitivity_start checks j')
+  call ok(r%get_sensitivity_y(1), 'get_sensitivity_y without first-order states')
   call ok(r%set_sensitivity_start(1), 'set_sensitivity_start: zero seeds')
   call r%free()
   call ok(r%create(1, 0), 'create for derivative callbacks')

@@ -202,3 +202,33 @@ def test_initial_values_as_parameters():
     e = 1e-5
     fd = (run(0.5 + e, False)[0] - run(0.5 - e, False)[0]) / (2 * e)
     assert np.allclose(dq, fd, rtol=0, atol=1e-8 * np.abs(fd).max())
+
+
+def test_first_order_states():
+    """x'' = -x + y, y' = -c y (c the parameter, read by the rate): dy/dc and dx/dc against
+    central differences of whole runs."""
+    def run(c, sens):
+        p = np.array([c])
+
+        def mass(t, q, M):
+            M[0, 0] = 1.0
+
+        def force_y(t, q, v, y, f):
+            f[0] = -q[0] + y[0]
+
+        def rate(t, q, v, y, ydot):
+            ydot[0] = -p[0] * y[0]
+
+        options = (dict(parameters=p, depends=("rate",)) if sens
+                   else dict(reuse=galpha.GA_REUSE_NEVER, newton=(1e-13, 30)))
+        with galpha.Solver(1, 0, mass, r=1, rate=rate, force_y=force_y, **options) as s:
+            s.init(0.0, [0.0], [0.0], [1.0])
+            for _ in range(200):
+                s.step(5e-3)
+            return s.q.copy(), s.y.copy(), (s.sensitivity() if sens else None)
+    q, y, S = run(2.0, True)
+    assert S.dy.shape == (1, 1) and S.dydot.shape == (1, 1)
+    e = 1e-5
+    (qa, ya, _), (qb, yb, _) = run(2.0 + e, False), run(2.0 - e, False)
+    assert S.dq[0, 0] == pytest.approx((qa[0] - qb[0]) / (2 * e), rel=1e-6)
+    assert S.dy[0, 0] == pytest.approx((ya[0] - yb[0]) / (2 * e), rel=1e-6)

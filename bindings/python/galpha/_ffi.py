@@ -128,6 +128,7 @@ GA_EVENT = 1  # not an error: a stepping call stopped at an event
 # Sensitivity dependence flags (ga_depends).
 GA_DEPENDS_FORCE = 1
 GA_DEPENDS_MASS = 2
+GA_DEPENDS_RATE = 4
 GA_SENSITIVITY_FORWARD = 1
 GA_SENSITIVITY_ADJOINT = 2
 
@@ -226,6 +227,7 @@ _SIGNATURES = {
     "ga_set_parameter_derivatives": (_I, [_S, FORCE_P_FN, MASS_P_FN]),
     "ga_set_sensitivity_start": (_I, [_S, _I, c_double_p, c_double_p]),
     "ga_get_sensitivity": (_I, [_S, _I, c_double_p, c_double_p, c_double_p, c_double_p]),
+    "ga_get_sensitivity_y": (_I, [_S, _I, c_double_p, c_double_p]),
     "ga_set_sensitivity_method": (_I, [_S, _I, ctypes.c_long]),
     "ga_adjoint_gradient": (_I, [_S, COST_FN, COST_FN, c_double_p, c_double_p]),
 }

@@ -39,7 +39,7 @@ _MASS_P = ctypes.CFUNCTYPE(_i, _d, _vp, _i, _vp, _vp, _vp)
 _COST = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp)
 
 # The derivatives of the accepted step in the sensitivity parameters (Solver.sensitivity).
-Sensitivity = collections.namedtuple("Sensitivity", "dq dv dqdd dlam")
+Sensitivity = collections.namedtuple("Sensitivity", "dq dv dqdd dlam dy dydot")
 
 
 def _cast(fn, ctype):
@@ -164,8 +164,8 @@ class Solver:
         Forward sensitivities (ga_set_sensitivity): `parameters` is the 1-D float64 array the
         callbacks read the model's parameters from at every call -- galpha perturbs its entries
         in place for differences (restoring them before any call returns), so the callbacks
-        must read it, not a copy. `depends` is a subset of ("force", "mass") (default
-        ("force",)): what the parameters enter. `force_p` and `mass_p` optionally give df/dp_j
+        must read it, not a copy. `depends` is a subset of ("force", "mass", "rate") (default
+        ("force",)): what the parameters enter (rate: the first-order states' g). `force_p` and `mass_p` optionally give df/dp_j
         and (dM/dp_j) a exactly (central differences otherwise). Read the derivatives of the
         accepted step with sensitivity().
     sensitivity_method, max_steps
@@ -417,10 +417,12 @@ class Solver:
             raise ValueError("parameters must be the writeable, contiguous 1-D float64 array "
                              "the callbacks read (galpha perturbs it in place)")
         flags = 0
+        known = {"force": _ffi.GA_DEPENDS_FORCE, "mass": _ffi.GA_DEPENDS_MASS,
+                 "rate": _ffi.GA_DEPENDS_RATE}
         for name in depends:
-            if name not in ("force", "mass"):
-                raise ValueError(f"unknown dependence {name!r} (force or mass)")
-            flags |= _ffi.GA_DEPENDS_FORCE if name == "force" else _ffi.GA_DEPENDS_MASS
+            if name not in known:
+                raise ValueError(f"unknown dependence {name!r} (force, mass or rate)")
+            flags |= known[name]
         sc = None
         if scale is not None:
             sc = np.ascontiguousarray(scale, dtype=float).ravel()
@@ -463,8 +465,9 @@ class Solver:
     @_serialized
     def sensitivity(self):
         """Derivatives of the accepted step's q, v, qdd and lambda with respect to the
-        parameters (ga_get_sensitivity): a Sensitivity of arrays dq (n, np), dv (n, np),
-        dqdd (n, np), dlam (m, np); column j is d/dp_j."""
+        parameters (ga_get_sensitivity, ga_get_sensitivity_y): a Sensitivity of arrays dq
+        (n, np), dv (n, np), dqdd (n, np), dlam (m, np), dy and dydot (r, np); column j is
+        d/dp_j."""
         if self._parameters is None:
             raise error_for(_ffi.GA_ERR_STATE, "no sensitivities: Solver(parameters=...)")
         n, m, npar = self.n, self.m, self._parameters[0].size
@@ -473,7 +476,13 @@ class Solver:
             self._check(_ffi.ga_get_sensitivity(self._handle(), j,
                                                 *[self._dp(x[j]) for x in out]))
         dq, dv, dqdd, dlam = (x[:, :k].T.copy() for x, k in zip(out, (n, n, n, m)))
-        return Sensitivity(dq, dv, dqdd, dlam)
+        r = self.r
+        ys = [np.empty((npar, max(r, 1))) for _ in range(2)]
+        for j in range(npar):
+            self._check(_ffi.ga_get_sensitivity_y(self._handle(), j,
+                                                  *[self._dp(x[j]) for x in ys]))
+        dy, dydot = (x[:, :r].T.copy() for x in ys)
+        return Sensitivity(dq, dv, dqdd, dlam, dy, dydot)
 
     @_serialized
     @_runs_callbacks
