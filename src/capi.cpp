@@ -160,6 +160,28 @@ ga_status change_tangents(ga::Solver &c, Change &&change)
 }
 }  // namespace
 
+namespace {
+// The checks both sensitivity reads share; `copy` reads the accepted step's derivatives.
+template <class Copy>
+ga_status read_sensitivity(const ga_solver *s, const char *name, int j, Copy &&copy)
+{
+    return reading(s, name, "j is not the index of a parameter", [&](const ga::Solver &c) {
+        if (!c.initialized() || !c.sens.active() || !c.sens.forward)
+            return GA_ERR_STATE;
+        if (j < 0 || j >= c.sens.np)
+            return GA_ERR_ARG;
+        copy(c.sens.accepted[j]);
+        return GA_OK;
+    });
+}
+
+void put(const ga::Vec &from, double *to)
+{
+    if (to)
+        Eigen::Map<ga::Vec>(to, from.size()) = from;
+}
+}  // namespace
+
 extern "C" {
 
 GA_API const char *ga_version(void)
@@ -792,33 +814,23 @@ GA_API ga_status ga_set_parameter_derivatives(ga_solver *s, ga_force_p_fn force_
     });
 }
 
+
 GA_API ga_status ga_get_sensitivity(const ga_solver *s, int j, double *dq, double *dv,
                                     double *dqdd, double *dlambda)
 {
-    return reading(s, "ga_get_sensitivity", "j is not the index of a parameter",
-                   [&](const ga::Solver &c) {
-        if (!c.initialized() || !c.sens.active() || !c.sens.forward)
-            return GA_ERR_STATE;
-        if (j < 0 || j >= c.sens.np)
-            return GA_ERR_ARG;
-        return c.get_sensitivity(j, dq, dv, dqdd, dlambda);
+    return read_sensitivity(s, "ga_get_sensitivity", j, [&](const ga::StateDerivative &x) {
+        put(x.q, dq);
+        put(x.v, dv);
+        put(x.qdd, dqdd);
+        put(x.lambda, dlambda);
     });
 }
 
 GA_API ga_status ga_get_sensitivity_y(const ga_solver *s, int j, double *dy, double *dydot)
 {
-    return reading(s, "ga_get_sensitivity_y", "j is not the index of a parameter",
-                   [&](const ga::Solver &c) {
-        if (!c.initialized() || !c.sens.active() || !c.sens.forward)
-            return GA_ERR_STATE;
-        if (j < 0 || j >= c.sens.np)
-            return GA_ERR_ARG;
-        const ga::StateDerivative &x = c.sens.accepted[j];
-        if (dy)
-            Eigen::Map<ga::Vec>(dy, x.y.size()) = x.y;
-        if (dydot)
-            Eigen::Map<ga::Vec>(dydot, x.ydot.size()) = x.ydot;
-        return GA_OK;
+    return read_sensitivity(s, "ga_get_sensitivity_y", j, [&](const ga::StateDerivative &x) {
+        put(x.y, dy);
+        put(x.ydot, dydot);
     });
 }
 

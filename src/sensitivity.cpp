@@ -75,21 +75,6 @@ ga_status Solver::set_sensitivity_start(int j, const double *dq0, const double *
     return GA_OK;
 }
 
-ga_status Solver::get_sensitivity(int j, double *dq, double *dv, double *dqdd,
-                                  double *dlambda) const
-{
-    const StateDerivative &x = sens.accepted[j];
-    const auto put = [](const Vec &from, double *to) {
-        if (to)
-            Eigen::Map<Vec>(to, from.size()) = from;
-    };
-    put(x.q, dq);
-    put(x.v, dv);
-    put(x.qdd, dqdd);
-    put(x.lambda, dlambda);
-    return GA_OK;
-}
-
 // Runs `evaluate` with p_j at p_j + e and at p_j - e (and, through `perturb`, the state moved
 // by the same multiple of its derivative); p_j is restored bit for bit whatever happens.
 // Returns the divisor of the central difference in `span`.

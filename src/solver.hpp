@@ -132,7 +132,6 @@ public:
     // (std::bad_alloc leaves the set before).
     Sensitivities sens;
     ga_status set_sensitivity(int np, double *p, const double *p_scale, int depends);
-    ga_status get_sensitivity(int j, double *dq, double *dv, double *dqdd, double *dlambda) const;
     ga_status set_sensitivity_start(int j, const double *dq0, const double *dv0);
     // adjoint.cpp
     ga_status set_sensitivity_method(int methods, long max_steps);

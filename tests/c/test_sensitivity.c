@@ -572,29 +572,36 @@ typedef struct motor_result {
     double x[6][SC_N];
 } motor_result;
 
-static void motor_run(const double *p, int formulation, int sens, int coupling,
-                      motor_result *out, motor_result *d)
+/* The motor scene's solver, with sensitivities in its six motor parameters if asked. */
+static ga_solver *motor_solver(int sens)
 {
-    g_motor_p = sc_motor_default();
-    memcpy(&g_motor_p.Kt, p, 6 * sizeof(double));
     ga_solver *s = NULL;
-    double q[SC_N], v[SC_N];
-    const double y[SCM_R] = {0.0, 0.0};
     assert_int_equal(ga_create(SC_N, SC_M, &s), GA_OK);
     assert_int_equal(ga_set_callbacks(s, sc_mass, NULL, sc_constraint, sc_jacobian, &g_motor_p),
                      GA_OK);
     assert_int_equal(ga_set_constraint_accel(s, sc_constraint_accel), GA_OK);
     assert_int_equal(ga_set_constraint_dt(s, sc_constraint_dt), GA_OK);
     assert_int_equal(ga_set_first_order(s, SCM_R, scm_force, scm_rate), GA_OK);
+    if (sens)
+        assert_int_equal(ga_set_sensitivity(s, 6, &g_motor_p.Kt, NULL,
+                                            GA_DEPENDS_FORCE | GA_DEPENDS_RATE),
+                         GA_OK);
+    return s;
+}
+
+static void motor_run(const double *p, int formulation, int sens, int coupling,
+                      motor_result *out, motor_result *d)
+{
+    g_motor_p = sc_motor_default();
+    memcpy(&g_motor_p.Kt, p, 6 * sizeof(double));
+    double q[SC_N], v[SC_N];
+    const double y[SCM_R] = {0.0, 0.0};
+    ga_solver *s = motor_solver(sens);
     if (coupling)
         assert_int_equal(ga_set_coupling(s, scm_coupling), GA_OK);
     assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
     assert_int_equal(ga_set_output(s, GA_OUTPUT_STEP), GA_OK);
-    if (sens) {
-        assert_int_equal(ga_set_sensitivity(s, 6, &g_motor_p.Kt, NULL,
-                                            GA_DEPENDS_FORCE | GA_DEPENDS_RATE),
-                         GA_OK);
-    } else {
+    if (!sens) {
         assert_int_equal(ga_set_jacobian_reuse(s, GA_REUSE_NEVER), GA_OK);
         assert_int_equal(ga_set_newton(s, 1e-13, 30), GA_OK);
     }
@@ -671,20 +678,6 @@ static void first_order_states(void **state)
 
 /* A checkpoint of a run with first-order states and sensitivities: the restored run goes on
  * bit for bit (the kept matrix rebuilt with central differences of tangents and coupling). */
-static ga_solver *motor_sens_solver(void)
-{
-    ga_solver *s = NULL;
-    assert_int_equal(ga_create(SC_N, SC_M, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, sc_mass, NULL, sc_constraint, sc_jacobian, &g_motor_p),
-                     GA_OK);
-    assert_int_equal(ga_set_constraint_accel(s, sc_constraint_accel), GA_OK);
-    assert_int_equal(ga_set_first_order(s, SCM_R, scm_force, scm_rate), GA_OK);
-    assert_int_equal(ga_set_sensitivity(s, 6, &g_motor_p.Kt, NULL,
-                                        GA_DEPENDS_FORCE | GA_DEPENDS_RATE),
-                     GA_OK);
-    return s;
-}
-
 static void first_order_checkpoint(void **state)
 {
     (void)state;
@@ -692,7 +685,7 @@ static void first_order_checkpoint(void **state)
     double q[SC_N], v[SC_N];
     const double y0[SCM_R] = {0.0, 0.0};
     sc_initial(&g_motor_p.crank, M_PI / 2, q, v);
-    ga_solver *a = motor_sens_solver(), *b = motor_sens_solver();
+    ga_solver *a = motor_solver(1), *b = motor_solver(1);
     assert_int_equal(ga_init_y(a, 0.0, q, v, y0), GA_OK);
     for (int k = 0; k < 30; ++k)
         assert_int_equal(ga_step(a, 1e-3), GA_OK);
