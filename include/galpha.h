@@ -711,15 +711,15 @@ GA_API ga_status ga_set_events_y(ga_solver *s, int count, ga_event_y_fn fn, cons
  *  tangent (the next step's Newton iteration starts with it); each parameter then costs one
  *  solve and the parameter derivatives of the residual. Exact to round-off with exact tangents
  *  (ga_set_tangents); with tangents by central differences (galpha's otherwise), to their
- *  precision, about eps^(2/3). Not yet with parameters in the constraints, nor the adjoint with
- *  first-order states. */
+ *  precision, about eps^(2/3). Not yet the adjoint with first-order states. */
 /**@{*/
 /** What depends on the parameters (flags, or-ed). The others are taken as independent of p:
  *  their derivatives are not evaluated. */
 typedef enum ga_depends {
     GA_DEPENDS_FORCE = 1, /**< the applied forces f */
     GA_DEPENDS_MASS = 2,  /**< the mass matrix M (not with ga_set_constant_mass) */
-    GA_DEPENDS_RATE = 4   /**< the rates g of first-order states (central differences) */
+    GA_DEPENDS_RATE = 4,  /**< the rates g of first-order states (central differences) */
+    GA_DEPENDS_CONSTRAINT = 8 /**< the constraints Phi (and so Phi_q, Phi_t) */
 } ga_depends;
 
 /** df/dp_j at (t, q, v) into f_p (length n), for parameter j (0-based). */
@@ -728,6 +728,13 @@ typedef int (*ga_force_p_fn)(double t, const double *q, const double *v, int j, 
 /** (dM/dp_j)(q) a into out (length n). */
 typedef int (*ga_mass_p_fn)(double t, const double *q, int j, const double *a, double *out,
                             void *user);
+
+/** The derivatives of the constraints in p_j at (t, q): dPhi/dp_j into phi_p (length m), the
+ *  derivative of Phi_q into Phi_q_p (in the layout of the Jacobian callback: dense column-major
+ *  m x n, or the values of its pattern) and, when Phi_t_p is not NULL (stabilized index 2),
+ *  that of Phi_t into Phi_t_p (length m; zeros for constraints that do not depend on t). */
+typedef int (*ga_constraint_p_fn)(double t, const double *q, int j, double *phi_p,
+                                  double *Phi_q_p, double *Phi_t_p, void *user);
 
 /** Sensitivities with respect to p[0 .. np-1], before ga_init (they start there: q0 and v0
  *  independent of p unless ga_set_sensitivity_start says otherwise, qdd0 and lambda0 follow). p is the array
@@ -758,6 +765,13 @@ GA_API ga_status ga_set_sensitivity_start(ga_solver *s, int j, const double *dq0
  *  (from a callback). */
 GA_API ga_status ga_set_parameter_derivatives(ga_solver *s, ga_force_p_fn force_p,
                                               ga_mass_p_fn mass_p);
+
+/** The constraints' derivative callback, for GA_DEPENDS_CONSTRAINT (NULL: central differences
+ *  of Phi, Phi_q and Phi_t in p, the default). Where the constraints depend on p, q0 and v0
+ *  that satisfy them at p do not at p + dp: their derivatives are those of the start's
+ *  minimum-norm projection, Phi_q dq0 = -dPhi/dp and the like for v0. Errors: GA_ERR_STATE
+ *  (from a callback). */
+GA_API ga_status ga_set_constraint_parameter_derivative(ga_solver *s, ga_constraint_p_fn fn);
 
 /** The sensitivities of the accepted step with respect to p_j (lengths n, n, n, m; any pointer
  *  may be NULL). qdd and lambda are the step's own (GA_OUTPUT_STEP), whatever ga_set_output

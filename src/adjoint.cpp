@@ -336,10 +336,15 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
         J_.multiply_transpose_add(1.0, w.rv, w.vp);
     }
     for (int j = 0; j < w.np; ++j) {
-        sens.rq.setZero();
+        Sensitivities &z = sens;
+        if ((st = constraint_parameter_terms(j, t1, x, index2, index2, e0[0], q_n, w.eta)))
+            return st;
+        z.rq = z.cq;
         if ((st = parameter_residual(j, t1, x)))
             return st;
-        w.dJ[j] += w.rr.dot(sens.rq);
+        w.dJ[j] += w.rr.dot(z.rq) + w.rl.dot(z.cl) + w.qp.dot(z.cbt);
+        if (index2 && m > 0)
+            w.dJ[j] += w.rv.dot(z.cv);
     }
     // P^T: a_p = (af sqdd - am sa) / (1 - am), q_p = s_q + h sv + h^2 ((1/2 - beta) sa + beta a_p)
     // (- in index 2 the derivative of B^T eta_bar along s_q), v_p = sv + h ((1 - gamma) sa +

@@ -769,7 +769,8 @@ GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const doubl
             return c.diag.fail(GA_ERR_ARG, "np = %d parameters: must be >= 0", np);
         if (np > 0 && !p)
             return c.diag.fail(GA_ERR_ARG, "np = %d parameters and p is NULL", np);
-        if ((depends & ~(GA_DEPENDS_FORCE | GA_DEPENDS_MASS | GA_DEPENDS_RATE)) != 0)
+        if ((depends & ~(GA_DEPENDS_FORCE | GA_DEPENDS_MASS | GA_DEPENDS_RATE |
+                         GA_DEPENDS_CONSTRAINT)) != 0)
             return c.diag.fail(GA_ERR_ARG, "unknown dependence flags 0x%x", static_cast<unsigned>(depends));
         for (int j = 0; p && j < np; ++j)
             if (!std::isfinite(p[j]))
@@ -814,6 +815,13 @@ GA_API ga_status ga_set_parameter_derivatives(ga_solver *s, ga_force_p_fn force_
     });
 }
 
+GA_API ga_status ga_set_constraint_parameter_derivative(ga_solver *s, ga_constraint_p_fn fn)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        c.model.cb.constraint_p = fn;
+        return GA_OK;
+    });
+}
 
 GA_API ga_status ga_get_sensitivity(const ga_solver *s, int j, double *dq, double *dv,
                                     double *dqdd, double *dlambda)

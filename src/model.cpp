@@ -228,6 +228,25 @@ ga_status Model::mass_p(double t, const Vec &q, int j, const Vec &a, Vec &out)
     return check_finite(out.data(), n_, 0, "(dM/dp) a", t);
 }
 
+ga_status Model::constraint_p(double t, const Vec &q, int j, Vec &phi_p, ModelMatrix &J_p,
+                              Vec *phi_tp)
+{
+    count(counters_, GA_COUNT_CONSTRAINT_EVALS);
+    if (auto st = callback_status(user([&] {
+                                      return cb.constraint_p(t, q.data(), j, phi_p.data(),
+                                                             J_p.data(),
+                                                             phi_tp ? phi_tp->data() : nullptr,
+                                                             cb.user);
+                                  }),
+                                  "constraint_p", t))
+        return st;
+    if (auto st = check_finite(phi_p.data(), m_, 0, "dPhi/dp", t))
+        return st;
+    if (auto st = check_finite(J_p.data(), J_p.size(), message_rows(J_p), "dPhi_q/dp", t))
+        return st;
+    return phi_tp ? check_finite(phi_tp->data(), m_, 0, "dPhi_t/dp", t) : GA_OK;
+}
+
 ga_status Model::cost(ga_cost_fn fn, double t, const double *q, const double *v,
                       const double *qdd, const double *lambda, double &value, Vec &d_q,
                       Vec &d_v, Vec &d_qdd, Vec &d_lambda, Vec &d_p)

@@ -31,6 +31,7 @@ struct Callbacks {
     // parameter derivatives (ga_set_parameter_derivatives)
     ga_force_p_fn force_p = nullptr;
     ga_mass_p_fn mass_p = nullptr;
+    ga_constraint_p_fn constraint_p = nullptr;  // ga_set_constraint_parameter_derivative
     void *user = nullptr;
 };
 
@@ -141,6 +142,10 @@ public:
     // df/dp_j, and (dM/dp_j) a, by the callbacks of ga_set_parameter_derivatives.
     ga_status force_p(double t, const Vec &q, const Vec &v, int j, Vec &out);
     ga_status mass_p(double t, const Vec &q, int j, const Vec &a, Vec &out);
+    // dPhi/dp_j, dPhi_q/dp_j (layout of J) and, when phi_tp is given, dPhi_t/dp_j, by the
+    // callback of ga_set_constraint_parameter_derivative.
+    ga_status constraint_p(double t, const Vec &q, int j, Vec &phi_p, ModelMatrix &J_p,
+                           Vec *phi_tp);
     // A cost term of ga_adjoint_gradient (q, v, qdd, lambda as recorded): its value and its
     // gradients, checked.
     ga_status cost(ga_cost_fn fn, double t, const double *q, const double *v, const double *qdd,

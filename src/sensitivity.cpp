@@ -6,6 +6,7 @@
 // with the exact iteration matrix there, and the update of eq. (7). Starts that are not this
 // linear map (the consistent start, corrected starting values, Taylor steps) are
 // differentiated by central differences of their own computation.
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -24,13 +25,14 @@ void Sensitivities::allocate(int n, int m, int r)
         for (StateDerivative &x : *set)
             x.allocate(n, m, r);
     }
+    wide.allocate(n, m, r);
     for (Vec *x : {&ry, &dy, &gy, &w0, &rate_plus, &rate_minus})
         x->setZero(r);
-    for (Vec *x : {&rq, &d, &w, &f_plus, &f_minus, &bt, &a0, &xq, &xv})
+    for (Vec *x : {&rq, &d, &w, &f_plus, &f_minus, &bt, &a0, &xq, &xv, &cq, &cbt, &cq2, &cbt2})
         x->setZero(n);
     seed_q.assign(np, Vec::Zero(n));
     seed_v.assign(np, Vec::Zero(n));
-    for (Vec *x : {&rl, &rv, &dl, &e})
+    for (Vec *x : {&rl, &rv, &dl, &e, &cl, &cv, &phi, &cl2, &cv2})
         x->setZero(m);
 }
 
@@ -44,6 +46,19 @@ double Sensitivities::increment(int j) const
 {
     return std::cbrt(kEps) * scale[j];
 }
+
+double Sensitivities::extrapolated_increment(int j) const
+{
+    return std::pow(kEps, 0.2) * scale[j];
+}
+
+namespace {
+// half = (4 D(e/2) - D(e)) / 3 from half = D(e/2) and wide = D(e)
+void extrapolate(Vec &half, const Vec &wide)
+{
+    half = (4.0 / 3.0) * half - (1.0 / 3.0) * wide;
+}
+}  // namespace
 
 ga_status Solver::set_sensitivity(int np, double *p, const double *p_scale, int depends)
 {
@@ -80,10 +95,10 @@ ga_status Solver::set_sensitivity_start(int j, const double *dq0, const double *
 // Returns the divisor of the central difference in `span`.
 template <class Perturb, class Evaluate>
 ga_status Solver::central_difference(int j, Perturb &&perturb, Evaluate &&evaluate,
-                                     double &span)
+                                     double &span, double increment)
 {
     double &pj = sens.p[j];
-    const double p0 = pj, e = sens.increment(j);
+    const double p0 = pj, e = increment > 0.0 ? increment : sens.increment(j);
     const double plus = p0 + e, minus = p0 - e;
     span = plus - minus;
     ga_status st = GA_OK;
@@ -119,8 +134,9 @@ ga_status Solver::sensitivity_start(const State &x)
         StateDerivative &s = z.trial[j];
         s.q = z.seed_q[j];
         s.v = z.seed_v[j];
-        if (m_ > 0 && (!s.q.isZero(0.0) || !s.v.isZero(0.0)))
-            if (auto st = project_seeds(x, s)) {
+        const bool moves = (z.depends & GA_DEPENDS_CONSTRAINT) != 0;
+        if (m_ > 0 && (moves || !s.q.isZero(0.0) || !s.v.isZero(0.0)))
+            if (auto st = project_seeds(x, j, s)) {
                 diag.append(" (the start's derivative in parameter %d)", j);
                 return st;
             }
@@ -140,31 +156,51 @@ ga_status Solver::sensitivity_start(const State &x)
                 st = model.rate(x.t, z.xq, z.xv, x.y, side == 0 ? z.rate_plus : z.rate_minus);
             return st;
         };
-        const ga_status st = central_difference(j, perturb, evaluate, span);
+        // extrapolated differences: in index 3 the start's error reaches dqdd/dp / (beta h^2)
+        const auto pass = [&](double increment) {
+            if (auto st = central_difference(j, perturb, evaluate, span, increment))
+                return st;
+            s.qdd = (s.qdd - z.d) / span;
+            s.lambda = (s.lambda - z.dl) / span;
+            if (r() > 0)
+                s.ydot = (z.rate_plus - z.rate_minus) / span;
+            return GA_OK;
+        };
+        const double e = z.extrapolated_increment(j);
+        ga_status st = pass(e);
+        if (!st) {
+            z.wide.swap(s);
+            s.q.swap(z.wide.q);  // (the projected seeds stay)
+            s.v.swap(z.wide.v);
+            st = pass(0.5 * e);
+        }
         jacobian_valid_ = false;  // S_ holds another matrix now
         mass_valid_ = false;      // and M_ was evaluated with p perturbed
         if (st) {
             diag.append(" (sensitivity of the consistent start to parameter %d)", j);
             return st;
         }
-        s.qdd = (s.qdd - z.d) / span;
-        s.lambda = (s.lambda - z.dl) / span;
+        extrapolate(s.qdd, z.wide.qdd);
+        extrapolate(s.lambda, z.wide.lambda);
         s.a = s.qdd;  // a_0 = qdd_0
         if (r() > 0) {
+            extrapolate(s.ydot, z.wide.ydot);
             s.y.setZero();
-            s.ydot = (z.rate_plus - z.rate_minus) / span;
             s.w = s.ydot;  // w_0 = y'_0
         }
     }
     return GA_OK;
 }
 
-// The seeds (s.q, s.v) onto the linearized position and velocity constraints at the start x:
-// [I Phi_q^T; Phi_q 0] [dq; mu] = [dq0; 0], then [dv; mu] = [dv0; -Z dq] with
-// Z dq = d/de (Phi_q(q + e dq) v + Phi_t(q + e dq)) by central differences.
-ga_status Solver::project_seeds(const State &x, StateDerivative &s)
+// The seeds (s.q, s.v) of parameter j onto the linearized position and velocity constraints
+// at the start x: [I Phi_q^T; Phi_q 0] [dq; mu] = [dq0; -Phi_p], then [dv; mu] = [dv0; -Z dq
+// - (Phi_q v + Phi_t)_p] with Z dq = d/de (Phi_q(q + e dq) v + Phi_t(q + e dq)) by central
+// differences (the _p terms where the constraints depend on p_j).
+ga_status Solver::project_seeds(const State &x, int j, StateDerivative &s)
 {
     Sensitivities &z = sens;
+    if (auto st = constraint_parameter_terms(j, x.t, x, true, false, x.t, x.q, x.lambda))
+        return st;
     if (auto st = model.jacobian(x.t, x.q, J_))
         return st;
     count(counters, GA_COUNT_FACTORIZATIONS);
@@ -173,10 +209,10 @@ ga_status Solver::project_seeds(const State &x, StateDerivative &s)
         return diag.fail(GA_ERR_SINGULAR, "cannot project the start's derivative: Phi_q is rank "
                          "deficient (rcond of [I Phi_q^T; Phi_q 0] = %.3g)", S_.rcond());
     z.rq = -s.q;
-    z.rl.setZero();
+    z.rl = z.cl;
     S_.solve(z.rq, z.rl, z.d, z.dl);
     s.q = z.d;
-    z.rl.setZero();
+    z.rl = z.cv;
     const double s_max = s.q.lpNorm<Eigen::Infinity>();
     if (s_max > 0.0) {
         const double e = std::cbrt(kEps) * std::max(x.q.lpNorm<Eigen::Infinity>(), 1.0) / s_max;
@@ -262,22 +298,46 @@ ga_status Solver::sensitivity_by_differences(double h, bool taylor_step, bool re
             }
             return GA_OK;
         };
-        double span = 0.0;
-        if (auto st = central_difference(j, perturb, evaluate, span)) {
+        // extrapolated differences (sensitivity_start)
+        const bool first_order = r() > 0;
+        const auto fields = [&](StateDerivative &x) {
+            std::array<Vec *, 8> f{&x.v, &x.a, &x.qdd, nullptr, nullptr, nullptr, nullptr, nullptr};
+            if (first_order)
+                f[3] = &x.w;
+            if (taylor_step) {
+                f[4] = &x.q;
+                f[5] = &x.lambda;
+                if (first_order) {
+                    f[6] = &x.y;
+                    f[7] = &x.ydot;
+                }
+            }
+            return f;
+        };
+        const auto pass = [&](double increment) {
+            double span = 0.0;
+            if (auto st = central_difference(j, perturb, evaluate, span, increment))
+                return st;
+            for (Vec *f : fields(out))
+                if (f)
+                    *f /= span;
+            return GA_OK;
+        };
+        const double e = sens.extrapolated_increment(j);
+        ga_status st = pass(e);
+        if (!st) {
+            out.swap(sens.wide);
+            st = pass(0.5 * e);
+        }
+        if (st) {
             diag.append(" (sensitivity of the %s to parameter %d)",
                         taylor_step ? "short step" : "start of the step", j);
             return st;
         }
-        out.v /= span;
-        out.a /= span;
-        out.qdd /= span;
-        out.w /= span;
-        if (taylor_step) {
-            out.q /= span;
-            out.lambda /= span;
-            out.y /= span;
-            out.ydot /= span;
-        }
+        const auto half = fields(out), wide = fields(sens.wide);
+        for (std::size_t k = 0; k < half.size(); ++k)
+            if (half[k])
+                extrapolate(*half[k], *wide[k]);
     }
     if (taylor_step)
         sens.step_done = true;
@@ -342,6 +402,73 @@ ga_status Solver::rate_parameter_residual(int j, double t, const State &x)
     if (auto st = central_difference(j, [](bool, double) {}, evaluate, span))
         return st;
     z.ry -= (z.rate_plus - z.rate_minus) / span;
+    return GA_OK;
+}
+
+// The constraints' share of R_p (GA_DEPENDS_CONSTRAINT) at the converged step x: into sens.cq
+// d/dp_j (Phi_q^T lambda), into sens.cl dPhi/dp_j and, with `velocity`, into sens.cv
+// d/dp_j (Phi_q v + Phi_t); with `correction` (index 2) into sens.cbt the derivative of the
+// position correction -B^T eta_bar, B = Phi_q(q_n) at t_n. Zero without that flag.
+ga_status Solver::constraint_parameter_terms(int j, double t, const State &x, bool velocity,
+                                             bool correction, double t_n, const Vec &q_n,
+                                             const Vec &eta)
+{
+    Sensitivities &z = sens;
+    for (Vec *c : {&z.cq, &z.cl, &z.cv, &z.cbt})
+        c->setZero();
+    if (!(z.depends & GA_DEPENDS_CONSTRAINT) || m_ == 0)
+        return GA_OK;
+    ModelMatrix &Jp = z.J_pert;
+    if (model.cb.constraint_p) {
+        if (auto st = model.constraint_p(t, x.q, j, z.cl, Jp, velocity ? &z.cv : nullptr))
+            return st;
+        Jp.multiply_transpose_add(1.0, x.lambda, z.cq);
+        if (velocity)
+            Jp.multiply_add(1.0, x.v, z.cv);
+        if (correction) {
+            if (auto st = model.constraint_p(t_n, q_n, j, z.phi, Jp, nullptr))
+                return st;
+            Jp.multiply_transpose_add(-1.0, eta, z.cbt);
+        }
+        return GA_OK;
+    }
+    // Extrapolated central differences, (4 D(e/2) - D(e)) / 3 with e = eps^(1/5) p_scale:
+    // error O(eps^(4/5)), not eps^(2/3). In index 3 dPhi/dp enters dqdd/dp and dlambda/dp
+    // divided by beta h^2.
+    const auto evaluate = [&](int side) {
+        const double sign = side == 0 ? 1.0 : -1.0;
+        if (auto st = model.constraint(t, x.q, z.phi))
+            return st;
+        z.cl += sign * z.phi;
+        if (auto st = model.jacobian(t, x.q, Jp))
+            return st;
+        Jp.multiply_transpose_add(sign, x.lambda, z.cq);
+        if (velocity) {
+            if (auto st = model.constraint_dt(t, x.q, z.phi))
+                return st;
+            z.cv += sign * z.phi;
+            Jp.multiply_add(sign, x.v, z.cv);
+        }
+        if (correction) {
+            if (auto st = model.jacobian(t_n, q_n, Jp))
+                return st;
+            Jp.multiply_transpose_add(-sign, eta, z.cbt);
+        }
+        return GA_OK;
+    };
+    Vec *terms[] = {&z.cq, &z.cl, &z.cv, &z.cbt}, *wide[] = {&z.cq2, &z.cl2, &z.cv2, &z.cbt2};
+    const double e = z.extrapolated_increment(j);
+    double span = 0.0, half = 0.0;
+    if (auto st = central_difference(j, [](bool, double) {}, evaluate, span, e))
+        return st;
+    for (int k = 0; k < 4; ++k) {
+        wide[k]->swap(*terms[k]);
+        terms[k]->setZero();
+    }
+    if (auto st = central_difference(j, [](bool, double) {}, evaluate, half, 0.5 * e))
+        return st;
+    for (int k = 0; k < 4; ++k)
+        *terms[k] = (4.0 / (3.0 * half)) * *terms[k] - (1.0 / (3.0 * span)) * *wide[k];
     return GA_OK;
 }
 
@@ -469,13 +596,20 @@ ga_status Solver::sensitivity_step(double h)
         s1.a = (p.alpha_f * sqdd - p.alpha_m * *sa) / (1.0 - p.alpha_m);
         s1.q = sn.q + h * sv + (h * h) * ((0.5 - p.beta) * *sa + p.beta * s1.a);
         s1.v = sv + h * ((1.0 - p.gamma) * *sa + p.gamma * s1.a);
+        // the constraints' parameter terms (zero unless they depend on p)
+        if ((st = constraint_parameter_terms(j, t1, x, index2, index2, b_t_, s.q,
+                                             eta_total_))) {
+            diag.append(" (derivative of the constraints in parameter %d)", j);
+            return st;
+        }
         if (index2 && m_ > 0) {
             if ((st = correction_derivative(b_t_, s.q, eta_total_, sn.q, z.bt)))
                 return st;
             s1.q += z.bt;
+            s1.q += z.cbt;
         }
         // the residual linearized at the converged step
-        z.rq.setZero();
+        z.rq = z.cq;
         if ((st = parameter_residual(j, t1, x))) {
             diag.append(" (derivative of the residual in parameter %d)", j);
             return st;
@@ -493,10 +627,10 @@ ga_status Solver::sensitivity_step(double h)
             if ((st = rate_parameter_residual(j, t1, x)))
                 return st;
         }
-        z.rl.setZero();
+        z.rl = z.cl;
         J_.multiply_add(1.0, s1.q, z.rl);
         if (index2) {
-            z.rv.setZero();
+            z.rv = z.cv;
             if (Z)
                 Z_.multiply_add(1.0, s1.q, z.rv);
             J_.multiply_add(1.0, s1.v, z.rv);

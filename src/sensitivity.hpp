@@ -3,6 +3,7 @@
 // the scratch of their step. The mathematics is in sensitivity.cpp (Solver members).
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "galpha.h"
@@ -27,6 +28,12 @@ struct StateDerivative {
         ydot.setZero(r);
         w.setZero(r);
     }
+    void swap(StateDerivative &o)
+    {
+        for (auto [a, b] : {std::pair{&q, &o.q}, {&v, &o.v}, {&qdd, &o.qdd}, {&lambda, &o.lambda},
+                            {&a, &o.a}, {&y, &o.y}, {&ydot, &o.ydot}, {&w, &o.w}})
+            a->swap(*b);
+    }
 };
 
 struct Sensitivities {
@@ -43,12 +50,17 @@ struct Sensitivities {
     // The step's start (v_n, a_n, qdd_n as the step uses them) when it is not the accepted
     // state's own: fresh starts and their corrected values, by differences.
     std::vector<StateDerivative> start;
+    StateDerivative wide;  // a difference at the wider increment (extrapolated differences)
     bool start_given = false;  // start holds this step's
     bool step_done = false;    // a Taylor step (sliver): trial holds its derivative already
 
     // scratch of one step
     Vec rq, rl, rv, d, w, dl, e, f_plus, f_minus, bt, a0, xq, xv;
     Vec ry, dy, gy, w0, rate_plus, rate_minus;  // first-order states (r)
+    // the constraints' parameter terms (GA_DEPENDS_CONSTRAINT): in r^q, Phi, the velocity
+    // constraint and the index-2 position correction; phi is scratch
+    Vec cq, cl, cv, cbt, phi;
+    Vec cq2, cl2, cv2, cbt2;  // the same at the wider increment (extrapolation)
     ModelMatrix M_pert, J_pert;
 
     bool active() const { return np > 0; }
@@ -56,8 +68,10 @@ struct Sensitivities {
     // patterns are known); throw std::bad_alloc.
     void allocate(int n, int m, int r);
     void allocate_matrices(const ModelMatrix &M, const ModelMatrix &J);
-    // The perturbation of p_j for central differences.
+    // The perturbation of p_j for central differences, and the wider one of extrapolated
+    // differences, (4 D(e/2) - D(e)) / 3 with error O(eps^(4/5)).
     double increment(int j) const;
+    double extrapolated_increment(int j) const;
 };
 
 }  // namespace ga

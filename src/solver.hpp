@@ -233,13 +233,17 @@ private:
     }
     // sensitivity.cpp
     template <class Perturb, class Evaluate>
-    ga_status central_difference(int j, Perturb &&perturb, Evaluate &&evaluate, double &span);
+    ga_status central_difference(int j, Perturb &&perturb, Evaluate &&evaluate, double &span,
+                                 double increment = 0.0);
     ga_status sensitivity_start(const State &x);
-    ga_status project_seeds(const State &x, StateDerivative &s);
+    ga_status project_seeds(const State &x, int j, StateDerivative &s);
     static void shift_state(const State &from, const StateDerivative &s, double shift, State &to);
     ga_status sensitivity_by_differences(double h, bool taylor_step, bool restart_short);
     ga_status parameter_residual(int j, double t, const State &x);
     ga_status rate_parameter_residual(int j, double t, const State &x);
+    ga_status constraint_parameter_terms(int j, double t, const State &x, bool velocity,
+                                         bool correction, double t_n, const Vec &q_n,
+                                         const Vec &eta);
     ga_status correction_derivative(double t, const Vec &q, const Vec &eta, const Vec &s,
                                     Vec &out);
     ga_status sensitivity_step(double h);

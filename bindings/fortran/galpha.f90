@@ -39,7 +39,7 @@ module galpha
   integer(c_int), parameter, public :: GA_OUTPUT_CONSISTENT = 0, GA_OUTPUT_STEP = 1
   integer(c_int), parameter, public :: GA_COUPLING_G_Q = 0, GA_COUPLING_G_V = 1
   integer(c_int), parameter, public :: GA_DEPENDS_FORCE = 1, GA_DEPENDS_MASS = 2, &
-       GA_DEPENDS_RATE = 4
+       GA_DEPENDS_RATE = 4, GA_DEPENDS_CONSTRAINT = 8
   integer(c_int), parameter, public :: GA_SENSITIVITY_FORWARD = 1, GA_SENSITIVITY_ADJOINT = 2
   integer(c_int), parameter, public :: GA_EVENT_BOTH = 0, GA_EVENT_RISING = 1, &
        GA_EVENT_FALLING = -1, GA_EVENT_LOG = 64
@@ -132,6 +132,16 @@ module galpha
        real(c_double), intent(out) :: out(*)
        type(c_ptr), value :: user
      end function ga_mass_p_fn
+     ! dPhi/dp_j (m), dPhi_q/dp_j (the Jacobian's layout) and, where phi_tp is not
+     ! c_null_ptr (stabilized index 2), dPhi_t/dp_j there (m; c_f_pointer)
+     integer(c_int) function ga_constraint_p_fn(t, q, j, phi_p, jac_p, phi_tp, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*)
+       integer(c_int), value :: j
+       real(c_double), intent(out) :: phi_p(*), jac_p(*)
+       type(c_ptr), value :: phi_tp, user
+     end function ga_constraint_p_fn
      ! a cost term of ga_adjoint_gradient: its value and every partial derivative
      integer(c_int) function ga_cost_fn(t, q, v, qdd, lambda, value, d_q, d_v, d_qdd, &
           d_lambda, d_p, user) bind(C)
@@ -143,7 +153,8 @@ module galpha
      end function ga_cost_fn
   end interface
   public :: ga_mass_fn, ga_force_fn, ga_constraint_fn, ga_stiffness_fn, ga_event_fn, &
-       ga_force_y_fn, ga_coupling_fn, ga_event_y_fn, ga_force_p_fn, ga_mass_p_fn, ga_cost_fn
+       ga_force_y_fn, ga_coupling_fn, ga_event_y_fn, ga_force_p_fn, ga_mass_p_fn, ga_cost_fn, &
+       ga_constraint_p_fn
 
   ! ---- the C API, one to one ----------------------------------------------------------------
   interface
@@ -515,6 +526,12 @@ module galpha
        type(c_ptr), value :: s
        type(c_funptr), value :: force_p, mass_p
      end function ga_set_parameter_derivatives
+     integer(c_int) function ga_set_constraint_parameter_derivative(s, fn) &
+          bind(C, name="ga_set_constraint_parameter_derivative")
+       import :: c_int, c_ptr, c_funptr
+       type(c_ptr), value :: s
+       type(c_funptr), value :: fn
+     end function ga_set_constraint_parameter_derivative
      integer(c_int) function ga_get_sensitivity_y(s, j, dy, dydot) &
           bind(C, name="ga_get_sensitivity_y")
        import :: c_int, c_ptr, c_double
@@ -572,6 +589,7 @@ module galpha
        ga_get_event, ga_set_first_order, ga_set_coupling, ga_set_coupling_exact, ga_init_y, &
        ga_get_y, ga_interpolate_y, ga_set_events_y, ga_set_coupling_pattern, &
        ga_set_sensitivity, ga_set_parameter_derivatives, ga_get_sensitivity, &
+       ga_set_constraint_parameter_derivative, &
        ga_set_sensitivity_start, ga_get_sensitivity_y, &
        ga_set_sensitivity_method, ga_adjoint_gradient
 
@@ -680,11 +698,15 @@ module galpha
      procedure :: set_events_y => solver_set_events_y
      !> set_sensitivity(p, depends, p_scale): forward sensitivities with respect to p, the
      !> (target, contiguous) array the callbacks read and galpha perturbs in place; depends an
-     !> ior of GA_DEPENDS_FORCE and GA_DEPENDS_MASS; before init
+     !> ior of GA_DEPENDS_FORCE, _MASS, _RATE and _CONSTRAINT; before init
      procedure :: set_sensitivity => solver_set_sensitivity
      !> set_parameter_derivatives(force_p, mass_p): exact df/dp_j, (dM/dp_j) a (either
      !> optional: central differences)
      procedure :: set_parameter_derivatives => solver_set_parameter_derivatives
+     !> set_constraint_parameter_derivative(fn): exact dPhi/dp_j, dPhi_q/dp_j, dPhi_t/dp_j
+     !> (absent: central differences)
+     procedure :: set_constraint_parameter_derivative => &
+          solver_set_constraint_parameter_derivative
      !> get_sensitivity(j, dq, dv, dqdd, dlambda): d/dp_j (j 1-based) of the accepted step's
      !> q, v, qdd, lambda (each optional)
      procedure :: get_sensitivity => solver_get_sensitivity
@@ -956,6 +978,15 @@ contains
     if (present(mass_p)) m = c_funloc(mass_p)
     status = ga_set_parameter_derivatives(this%handle, f, m)
   end function solver_set_parameter_derivatives
+
+  integer(c_int) function solver_set_constraint_parameter_derivative(this, fn) result(status)
+    class(galpha_solver), intent(inout) :: this
+    procedure(ga_constraint_p_fn), optional :: fn
+    type(c_funptr) :: f
+    f = c_null_funptr
+    if (present(fn)) f = c_funloc(fn)
+    status = ga_set_constraint_parameter_derivative(this%handle, f)
+  end function solver_set_constraint_parameter_derivative
 
   integer(c_int) function solver_get_sensitivity_y(this, j, dy, dydot) result(status)
     class(galpha_solver), intent(in) :: this

@@ -463,9 +463,10 @@ static void no_allocation_with_first_order_states(void **state)
     }
 }
 
-/* Forward sensitivities: the pendulum's mass as parameter (it enters M and f: differences of
- * both), index 3 and 2, fixed and adaptive steps, forces that fail now and then (the step and
- * its sensitivities are dropped); the chain on the sparse path; the adjoint record, with and
+/* Forward sensitivities: the pendulum's mass and length as parameters (they enter M, f and
+ * Phi: differences of each), index 3 and 2, fixed and adaptive steps, forces that fail now and then (the step and
+ * its sensitivities are dropped); the chain on the sparse path (its link length, mass,
+ * inertia and gravity); the adjoint record, with and
  * without forward sensitivities. */
 static void no_allocation_with_sensitivities(void **state)
 {
@@ -485,16 +486,18 @@ static void no_allocation_with_sensitivities(void **state)
                                               chain_jacobian, &c),
                              GA_OK);
             assert_int_equal(chain_declare_patterns(&c, s), GA_OK);
-            assert_int_equal(ga_set_sensitivity(s, 3, &c.mass, NULL,
-                                                GA_DEPENDS_FORCE | GA_DEPENDS_MASS),
+            assert_int_equal(ga_set_sensitivity(s, 4, &c.length, NULL,
+                                                GA_DEPENDS_FORCE | GA_DEPENDS_MASS |
+                                                    GA_DEPENDS_CONSTRAINT),
                              GA_OK);
         } else {
             pendulum_state(&p, 1.0, 0.5, q, v);
             assert_int_equal(ga_set_callbacks(s, pendulum_mass, force_maybe_failing,
                                               pendulum_constraint, pendulum_jacobian, &p),
                              GA_OK);
-            assert_int_equal(ga_set_sensitivity(s, 1, &p.mass, NULL,
-                                                GA_DEPENDS_FORCE | GA_DEPENDS_MASS),
+            assert_int_equal(ga_set_sensitivity(s, 2, &p.mass, NULL,
+                                                GA_DEPENDS_FORCE | GA_DEPENDS_MASS |
+                                                    GA_DEPENDS_CONSTRAINT),
                              GA_OK);
         }
         if (record)

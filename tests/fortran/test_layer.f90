@@ -95,6 +95,56 @@ contains
     d_p(1) = 0.0d0
     final_position = 0
   end function final_position
+
+  ! a parameter in the constraints: the particle of unit mass on the rail x = c under the
+  ! force (-x, -y), so that x = c and lambda = -c for all t: dx/dc = 1, dlambda/dc = -1
+  integer(c_int) function plane_mass(t, q, M, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*)
+    real(c_double), intent(out) :: M(*)
+    type(c_ptr), value :: user
+    M(1:4) = [1.0d0, 0.0d0, 0.0d0, 1.0d0]
+    plane_mass = 0
+  end function plane_mass
+  integer(c_int) function plane_force(t, q, v, f, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*)
+    real(c_double), intent(out) :: f(*)
+    type(c_ptr), value :: user
+    f(1:2) = -q(1:2)
+    plane_force = 0
+  end function plane_force
+  integer(c_int) function rail(t, q, phi, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*)
+    real(c_double), intent(out) :: phi(*)
+    type(c_ptr), value :: user
+    phi(1) = q(1) - stiffness(1)
+    rail = 0
+  end function rail
+  integer(c_int) function rail_jacobian(t, q, J, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*)
+    real(c_double), intent(out) :: J(*)
+    type(c_ptr), value :: user
+    J(1:2) = [1.0d0, 0.0d0]
+    rail_jacobian = 0
+  end function rail_jacobian
+  integer(c_int) function rail_p(t, q, j, phi_p, jac_p, phi_tp, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*)
+    integer(c_int), value :: j
+    real(c_double), intent(out) :: phi_p(*), jac_p(*)
+    type(c_ptr), value :: phi_tp, user
+    real(c_double), pointer :: tp(:)
+    phi_p(1) = -1.0d0
+    jac_p(1:2) = 0.0d0
+    if (c_associated(phi_tp)) then
+       call c_f_pointer(phi_tp, tp, [1])
+       tp(1) = 0.0d0
+    end if
+    rail_p = merge(0, -1, j == 0)
+  end function rail_p
 end module layer_events
 
 program test_layer
@@ -318,6 +368,26 @@ program test_layer
   call ok(r%adjoint_gradient(x, q2(1:1), terminal=final_position), 'adjoint_gradient')
   call ok(r%get_sensitivity(1, q(1:1)), 'get_sensitivity')
   call expect(abs(q2(1) - q(1)) < 1d-12 * abs(q(1)), 'adjoint dJ/dk = forward dx/dk')
+  ! a parameter in the constraints, by differences and by the callback (index 2)
+  do i = 0, 1
+     call r%free()
+     stiffness(1) = 0.5d0
+     call ok(r%create(2, 1), 'create for a constraint parameter')
+     call ok(r%set_callbacks(plane_mass, plane_force, rail, rail_jacobian), 'callbacks')
+     call ok(r%set_formulation(GA_INDEX2_STABILIZED), 'index 2')
+     call ok(r%set_sensitivity(stiffness, ior(GA_DEPENDS_FORCE, GA_DEPENDS_CONSTRAINT)), &
+          'set_sensitivity (constraint)')
+     if (i == 1) call ok(r%set_constraint_parameter_derivative(rail_p), &
+          'set_constraint_parameter_derivative')
+     call ok(r%init(0.0d0, [0.5d0, 1.0d0], [0.0d0, 0.0d0]), 'init on the rail')
+     do index = 1, 100
+        call ok(r%step(1d-2), 'step on the rail')
+     end do
+     call ok(r%get_sensitivity(1, q(1:2), dlambda=v(1:1)), 'get_sensitivity (rail)')
+     call expect(abs(q(1) - 1.0d0) < 1d-9 .and. abs(q(2)) < 1d-9, 'dq/dc = (1, 0)')
+     call expect(abs(v(1) + 1.0d0) < 1d-8, 'dlambda/dc = -1')
+  end do
+  stiffness(1) = 4.0d0
   call expect(r%adjoint_gradient(x, q2(1:1)) == GA_ERR_ARG, 'adjoint_gradient needs a cost')
 
   call s%free()

@@ -61,6 +61,63 @@ def test_sensitivities_are_derivatives_of_the_discrete_solution():
                 assert np.allclose(d[:, j], fd, rtol=0, atol=1e-7 * max(1.0, np.abs(fd).max()))
 
 
+def length_pendulum(p, **options):
+    """The pendulum of unit mass, length p[0] (in the constraint only) and gravity p[1]."""
+    def mass(t, q, M):
+        M[:] = np.eye(2)
+
+    def force(t, q, v, f):
+        f[:] = (0.0, -p[1])
+
+    def constraint(t, q, phi):
+        phi[0] = 0.5 * (q @ q - p[0] * p[0])
+
+    def jacobian(t, q, J):
+        J[0, :] = q
+
+    return galpha.Solver(2, 1, mass, force, constraint, jacobian, **options)
+
+
+def length_run(p, **options):
+    with length_pendulum(p, **options) as s:
+        s.init(0.0, Q0, V0)  # consistent at L = 1 only: the start projects it
+        for _ in range(100):
+            s.step(1e-2)
+        return s.q.copy(), s.v.copy(), (s.sensitivity() if "parameters" in options else None)
+
+
+def test_parameters_in_the_constraints():
+    """depends=("constraint",): against whole-run central differences (index 2), and the
+    constraint_p callback against galpha's differences."""
+    p = np.array([1.0, 9.81])
+    asked = []
+
+    def constraint_p(t, q, j, phi_p, Phi_q_p, Phi_t_p):
+        asked.append(Phi_t_p is not None)
+        phi_p[0] = -p[0] if j == 0 else 0.0
+        Phi_q_p[:] = 0.0
+        if Phi_t_p is not None:
+            Phi_t_p[0] = 0.0
+
+    f = galpha.GA_INDEX2_STABILIZED
+    deps = ("force", "constraint")
+    q, v, sens = length_run(p, parameters=p, depends=deps, formulation=f)
+    e = 1e-4
+    runs = []
+    for sign in (1, -1):
+        pp = p.copy()
+        pp[0] += sign * e
+        runs.append(length_run(pp, reuse=galpha.GA_REUSE_NEVER, newton=(1e-13, 30),
+                               formulation=f))
+    for k, d in enumerate((sens.dq, sens.dv)):
+        fd = (runs[0][k] - runs[1][k]) / (2 * e)
+        assert np.allclose(d[:, 0], fd, rtol=0, atol=1e-6 * np.abs(fd).max())
+    exact = length_run(p, parameters=p, depends=deps, formulation=f, constraint_p=constraint_p)
+    assert True in asked and False in asked  # dPhi_t/dp where index 2 needs it, only there
+    for a, b in zip(sens, exact[2]):
+        assert np.allclose(a, b, rtol=1e-8, atol=1e-10)
+
+
 def test_derivative_callbacks():
     """df/dp and (dM/dp) a by callbacks give what central differences give."""
     p = np.array([1.0, 9.81])
@@ -84,7 +141,7 @@ def test_refusals():
     with pytest.raises(ValueError, match="float64"):
         pendulum(None, parameters=np.array([1, 2]))
     with pytest.raises(ValueError, match="dependence"):
-        pendulum(None, parameters=np.array([1.0]), depends=("constraint",))
+        pendulum(None, parameters=np.array([1.0]), depends=("constraints",))
     with pytest.raises(ValueError, match="shape"):
         pendulum(None, parameters=np.array([1.0]), parameter_scale=[1.0, 2.0])
     with pytest.raises(galpha.ArgumentError, match="p_scale"):

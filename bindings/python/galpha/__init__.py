@@ -10,7 +10,8 @@ M(q) q'' = f(q, q', t) - Phi_q^T lambda, Phi(q, t) = 0 -- Python bindings over c
 or, for time histories, galpha.integrate(...). The low-level mirror of the C API is
 galpha._ffi (one function per C function)."""
 from . import _ffi
-from ._ffi import (GA_DEPENDS_FORCE, GA_DEPENDS_MASS, GA_SENSITIVITY_ADJOINT,  # noqa: F401
+from ._ffi import (GA_DEPENDS_CONSTRAINT, GA_DEPENDS_FORCE, GA_DEPENDS_MASS,  # noqa: F401
+                   GA_SENSITIVITY_ADJOINT,  # noqa: F401
                    GA_SENSITIVITY_FORWARD, GA_EVENT_BOTH, GA_EVENT_FALLING, GA_EVENT_RISING,  # noqa: F401
                    GA_INDEX2_STABILIZED, GA_INDEX3, GA_INFO_ERROR_ESTIMATE,  # noqa: F401
                    GA_INFO_H_NEXT, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_RCOND,

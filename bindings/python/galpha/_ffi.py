@@ -104,6 +104,8 @@ FORCE_P_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_doubl
                               c_double_p, ctypes.c_void_p)  # (t, q, v, j, f_p, user)
 MASS_P_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, ctypes.c_int, c_double_p,
                              c_double_p, ctypes.c_void_p)   # (t, q, j, a, out, user)
+CONSTRAINT_P_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, ctypes.c_int,
+                                   c_double_p, c_double_p, c_double_p, ctypes.c_void_p)
 COST_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
                            c_double_p, c_double_p, c_double_p, c_double_p, c_double_p,
                            c_double_p, c_double_p, ctypes.c_void_p)
@@ -129,6 +131,7 @@ GA_EVENT = 1  # not an error: a stepping call stopped at an event
 GA_DEPENDS_FORCE = 1
 GA_DEPENDS_MASS = 2
 GA_DEPENDS_RATE = 4
+GA_DEPENDS_CONSTRAINT = 8
 GA_SENSITIVITY_FORWARD = 1
 GA_SENSITIVITY_ADJOINT = 2
 
@@ -225,6 +228,7 @@ _SIGNATURES = {
     "ga_set_coupling_pattern": (_I, [_S, _I, _I, _P(_I), _P(_I)]),
     "ga_set_sensitivity": (_I, [_S, _I, c_double_p, c_double_p, _I]),
     "ga_set_parameter_derivatives": (_I, [_S, FORCE_P_FN, MASS_P_FN]),
+    "ga_set_constraint_parameter_derivative": (_I, [_S, CONSTRAINT_P_FN]),
     "ga_set_sensitivity_start": (_I, [_S, _I, c_double_p, c_double_p]),
     "ga_get_sensitivity": (_I, [_S, _I, c_double_p, c_double_p, c_double_p, c_double_p]),
     "ga_get_sensitivity_y": (_I, [_S, _I, c_double_p, c_double_p]),

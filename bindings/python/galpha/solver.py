@@ -36,6 +36,7 @@ _COUPLING = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp)
 _EVENT_Y = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp)
 _FORCE_P = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _i, _vp, _vp)
 _MASS_P = ctypes.CFUNCTYPE(_i, _d, _vp, _i, _vp, _vp, _vp)
+_CONSTRAINT_P = ctypes.CFUNCTYPE(_i, _d, _vp, _i, _vp, _vp, _vp, _vp)
 _COST = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp)
 
 # The derivatives of the accepted step in the sensitivity parameters (Solver.sensitivity).
@@ -160,14 +161,17 @@ class Solver:
         cols)} declares where those blocks may be nonzero (0-based; empty: zero), so that their
         finite differences take one rate call per group of columns (ga_set_coupling_pattern).
         Start with init(t0, q0, v0, y0); read `y`, `ydot` and interpolate_y(t).
-    parameters, depends, parameter_scale, force_p(t, q, v, j, f_p), mass_p(t, q, j, a, out)
+    parameters, depends, parameter_scale, force_p(t, q, v, j, f_p), mass_p(t, q, j, a, out),
+    constraint_p(t, q, j, phi_p, Phi_q_p, Phi_t_p)
         Forward sensitivities (ga_set_sensitivity): `parameters` is the 1-D float64 array the
         callbacks read the model's parameters from at every call -- galpha perturbs its entries
         in place for differences (restoring them before any call returns), so the callbacks
-        must read it, not a copy. `depends` is a subset of ("force", "mass", "rate") (default
-        ("force",)): what the parameters enter (rate: the first-order states' g). `force_p` and `mass_p` optionally give df/dp_j
-        and (dM/dp_j) a exactly (central differences otherwise). Read the derivatives of the
-        accepted step with sensitivity().
+        must read it, not a copy. `depends` is a subset of ("force", "mass", "rate",
+        "constraint") (default ("force",)): what the parameters enter (rate: the first-order
+        states' g; constraint: Phi, and so Phi_q and Phi_t). `force_p` and `mass_p`
+        optionally give df/dp_j and (dM/dp_j) a exactly, `constraint_p` dPhi/dp_j, dPhi_q/dp_j
+        (shaped as the jacobian's J) and, unless Phi_t_p is None, dPhi_t/dp_j (central
+        differences otherwise). Read the derivatives of the accepted step with sensitivity().
     sensitivity_method, max_steps
         A subset of ("forward", "adjoint") (ga_set_sensitivity_method; default ("forward",)):
         with "adjoint" the run from init() on is recorded, up to max_steps steps, for
@@ -191,7 +195,7 @@ class Solver:
                  step_limits=None, initial_step=None, output=None, patterns=None,
                  r=0, rate=None, force_y=None, coupling=None, coupling_exact=None,
                  coupling_patterns=None, parameters=None, depends=("force",),
-                 parameter_scale=None, force_p=None, mass_p=None,
+                 parameter_scale=None, force_p=None, mass_p=None, constraint_p=None,
                  sensitivity_method=("forward",), max_steps=None, zero_copy=False):
         self._ptr = None
         self._lock = threading.RLock()  # see _serialized
@@ -301,6 +305,7 @@ class Solver:
         self._event_cb = None
         self._event_fns = ()
         sM, sJ = shape("mass", (n, n)), shape("jacobian", (m, n))
+        self._jacobian_shape = sJ
         sK, sC = shape("stiffness", (n, n)), shape("damping", (n, n))
         self._cbs = [
             _MASS(lambda t, q, M, u: call(mass, M, sM, t, (q, n))),
@@ -367,7 +372,8 @@ class Solver:
             self._check(_ffi.ga_set_coupling_exact(self._ptr, int(bool(coupling_exact))))
         self._parameters = None
         if parameters is not None:
-            self._set_sensitivity(parameters, depends, parameter_scale, force_p, mass_p)
+            self._set_sensitivity(parameters, depends, parameter_scale, force_p, mass_p,
+                                  constraint_p)
             methods = 0
             for name in sensitivity_method:
                 if name not in ("forward", "adjoint"):
@@ -410,7 +416,7 @@ class Solver:
         if initial_step is not None:
             self._check(_ffi.ga_set_initial_step(self._ptr, float(initial_step)))
 
-    def _set_sensitivity(self, parameters, depends, scale, force_p, mass_p):
+    def _set_sensitivity(self, parameters, depends, scale, force_p, mass_p, constraint_p):
         p = parameters
         if (not isinstance(p, np.ndarray) or p.dtype != np.float64 or p.ndim != 1 or
                 not p.flags.c_contiguous or not p.flags.writeable):
@@ -418,10 +424,11 @@ class Solver:
                              "the callbacks read (galpha perturbs it in place)")
         flags = 0
         known = {"force": _ffi.GA_DEPENDS_FORCE, "mass": _ffi.GA_DEPENDS_MASS,
-                 "rate": _ffi.GA_DEPENDS_RATE}
+                 "rate": _ffi.GA_DEPENDS_RATE, "constraint": _ffi.GA_DEPENDS_CONSTRAINT}
         for name in depends:
             if name not in known:
-                raise ValueError(f"unknown dependence {name!r} (force, mass or rate)")
+                raise ValueError(f"unknown dependence {name!r} (force, mass, rate or "
+                                 "constraint)")
             flags |= known[name]
         sc = None
         if scale is not None:
@@ -445,6 +452,19 @@ class Solver:
             self._check(_ffi.ga_set_parameter_derivatives(self._ptr,
                                                           _cast(cbs[0], _ffi.FORCE_P_FN),
                                                           _cast(cbs[1], _ffi.MASS_P_FN)))
+        if constraint_p:
+            m, sJ = self.m, self._jacobian_shape
+
+            def trampoline(t, q, j, phi_p, J_p, phi_tp, u):
+                places = (phi_p, J_p) + ((phi_tp,) if phi_tp else ())
+                shapes = ((m,), sJ) + (((m,),) if phi_tp else ())
+                return call(lambda t, q, outs: constraint_p(
+                    t, q, j, outs[0], outs[1], outs[2] if len(outs) > 2 else None),
+                    places, shapes, t, (q, n))
+            cb = _CONSTRAINT_P(trampoline)
+            self._cbs.append(cb)
+            self._check(_ffi.ga_set_constraint_parameter_derivative(
+                self._ptr, _cast(cb, _ffi.CONSTRAINT_P_FN)))
 
     @_serialized
     def set_sensitivity_start(self, j, dq0=None, dv0=None):
