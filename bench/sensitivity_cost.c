@@ -1,6 +1,7 @@
 /* What sensitivities cost. Per scene, runs of the same steps: plain, with forward sensitivities
  * in 1 ... P parameters, and recorded for the adjoint followed by ga_adjoint_gradient (a running
- * cost: the kinetic energy) in 1 ... P parameters. Each round runs them all in turn and gives
+ * cost: the kinetic energy) in 1 ... P parameters, and the same with checkpoints every
+ * sqrt(steps) steps (ga_set_adjoint_checkpoints) in 1 parameter. Each round runs them all in turn and gives
  * their times relative to the plain run of that round; the medians over the rounds are robust
  * to this machine's drifts of speed. Scenes: the paper's slider-crank (parameters m1, m2, m3,
  * m4 and the torque: M and f; exact tangents by its callback), the slider-crank of IDAS's
@@ -104,14 +105,19 @@ static double run(int scene, int method, int np)
         g_mass_diag[i] = 1.0; /* (the cost's weights: any will do for timing) */
     if (method > 0 && ga_set_sensitivity(s, np, p, NULL, depends) != GA_OK)
         return -1;
-    if (method == 2 && ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, kSteps[scene]) != GA_OK)
+    if (method >= 2 && ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, kSteps[scene]) != GA_OK)
+        return -1;
+    /* method 3: checkpoints every sqrt(steps) steps, the sweep computing segments again */
+    const long interval = (long)sqrt((double)kSteps[scene]);
+    if (method == 3 &&
+        ga_set_adjoint_checkpoints(s, interval, kSteps[scene] / interval + 1) != GA_OK)
         return -1;
     const double t0 = now();
     ga_status st = ga_init(s, 0.0, q, v);
     for (int k = 0; k < kSteps[scene] && !st; ++k)
         st = ga_step(s, h);
     double J, dJ[MAX_P];
-    if (!st && method == 2)
+    if (!st && method >= 2)
         st = ga_adjoint_gradient(s, energy, NULL, &J, dJ);
     const double seconds = now() - t0;
     if (st)
@@ -128,27 +134,29 @@ int main(int argc, char **argv)
     printf("scene,steps,us_plain,method,parameters,median_ratio,lower_quartile,upper_quartile\n");
     for (int scene = 0; scene < SCENES; ++scene) {
         const int P = kParameters[scene];
-        static double ratio[2][MAX_P + 1][MAX_ROUNDS];
+        static double ratio[3][MAX_P + 1][MAX_ROUNDS];
         double best_plain = 1e300;
         for (int r = 0; r < rounds; ++r) {
             const double plain = run(scene, 0, 0);
             if (plain < 0)
                 return 1;
             best_plain = plain < best_plain ? plain : best_plain;
-            for (int method = 1; method <= 2; ++method)
-                for (int np = 1; np <= P; ++np) {
+            for (int method = 1; method <= 3; ++method)
+                for (int np = 1; np <= (method == 3 ? 1 : P); ++np) {
                     const double t = run(scene, method, np);
                     if (t < 0)
                         return 1;
                     ratio[method - 1][np][r] = t / plain;
                 }
         }
-        for (int method = 1; method <= 2; ++method)
-            for (int np = 1; np <= P; ++np) {
+        for (int method = 1; method <= 3; ++method)
+            for (int np = 1; np <= (method == 3 ? 1 : P); ++np) {
                 double *x = ratio[method - 1][np];
                 qsort(x, rounds, sizeof(double), by_value);
                 printf("%s,%d,%.1f,%s,%d,%.3f,%.3f,%.3f\n", kNames[scene], kSteps[scene],
-                       1e6 * best_plain, method == 1 ? "forward" : "adjoint", np, x[rounds / 2],
+                       1e6 * best_plain,
+                       (const char *[]){"forward", "adjoint", "adjoint_checkpoints"}[method - 1],
+                       np, x[rounds / 2],
                        x[rounds / 4], x[(3 * rounds) / 4]);
             }
         fflush(stdout);

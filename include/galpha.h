@@ -798,6 +798,22 @@ typedef enum ga_sensitivity_method {
  *  GA_ERR_NOMEM. */
 GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_steps);
 
+/** Checkpointing for runs whose adjoint record does not fit: the record keeps the steps of one
+ *  segment of `interval` steps, and a checkpoint of the solver (ga_state_size doubles) after
+ *  every interval-th step, `count` of them, for runs of up to interval * count steps (plus 11
+ *  doubles per step: each step's size, time and how it was attempted). ga_adjoint_gradient
+ *  computes each earlier segment again from its checkpoint: one more forward pass. Memory
+ *  (3 n + 2 m + 4) (interval + 1) + count ga_state_size + 11 N doubles instead of
+ *  (3 n + 2 m + 4) N; interval = sqrt(N ga_state_size / (3 n + 2 m + 4)) makes the first two
+ *  equal. The recomputed steps are the recorded ones bit for bit: each begins with the
+ *  kept matrix and reuse state its original began with (in runs recorded for the adjoint a
+ *  rejected step drops the kept matrix, so that this is known). The callbacks must give the
+ *  same values when called again, and the options stay as they were during the run. interval = 0 returns to the full record of
+ *  ga_set_sensitivity_method's max_steps. After ga_set_sensitivity_method with
+ *  GA_SENSITIVITY_ADJOINT, before ga_init. Errors: GA_ERR_ARG (interval < 0, count < 1 with
+ *  interval > 0), GA_ERR_STATE (no adjoint method, after ga_init), GA_ERR_NOMEM. */
+GA_API ga_status ga_set_adjoint_checkpoints(ga_solver *s, long interval, long count);
+
 /** A cost term: its value at (t, q, v, qdd, lambda) and every partial derivative, in q, v, qdd
  *  (n each), lambda (m; lambda and d_lambda are NULL when m = 0) and the parameters p (np); all
  *  outputs are written. */

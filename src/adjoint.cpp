@@ -6,6 +6,7 @@
 // state: a transposed solve), then the transposed tangents K^T, C^T, Phi_q^T (and Z^T in
 // index 2), then P^T -- one transposed solve per step, whatever the number of parameters.
 // The parameters enter through R_p of each step and the start's derivatives.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -22,7 +23,10 @@ void AdjointRecord::allocate(int n_, int m_, int np, long capacity_)
     n = n_;
     m = m_;
     capacity = capacity_;
+    max_steps = capacity_;
     steps = 0;
+    base = 0;
+    interval = 0;
     unsupported_at = -1;
     data.assign((static_cast<std::size_t>(capacity_) + 1) * stride(), 0.0);
     for (auto *set : {&sigma0, &start0}) {
@@ -30,6 +34,31 @@ void AdjointRecord::allocate(int n_, int m_, int np, long capacity_)
         for (StateDerivative &x : *set)
             x.allocate(n_, m_);
     }
+}
+
+void AdjointRecord::allocate_checkpointed(int n_, int m_, int np, long interval_, long count,
+                                          std::size_t state_size)
+{
+    const long full = max_steps;
+    allocate(n_, m_, np, interval_);
+    max_steps = full;
+    interval = interval_;
+    capacity = interval_ * count;
+    checkpoint_size = state_size;
+    checkpoints.assign(static_cast<std::size_t>(count) * state_size, 0.0);
+    log.assign(static_cast<std::size_t>(capacity) * kLog, 0.0);
+}
+
+ga_status Solver::set_adjoint_checkpoints(long interval, long count)
+{
+    AdjointRecord record;  // built aside: a failed allocation leaves the one before
+    record.max_steps = adjoint_.max_steps;
+    if (interval > 0)
+        record.allocate_checkpointed(n_, m_, sens.np, interval, count, state_size());
+    else
+        record.allocate(n_, m_, sens.np, adjoint_.max_steps);
+    adjoint_ = std::move(record);
+    return GA_OK;
 }
 
 ga_status Solver::set_sensitivity_method(int methods, long max_steps)
@@ -56,7 +85,10 @@ void Solver::record_start()
     AdjointRecord &r = adjoint_;
     const State &x = accepted_;
     r.steps = 0;
+    r.base = 0;
     r.unsupported_at = -1;
+    if (r.interval > 0)
+        get_state(r.checkpoint(0));
     double *e = r.entry(0);
     e[0] = x.t;
     e[1] = e[2] = e[3] = 0.0;
@@ -79,11 +111,23 @@ void Solver::record_step()
 {
     AdjointRecord &r = adjoint_;
     const State &x = accepted_;
-    double *e = r.entry(++r.steps);
+    const long k = ++r.steps;
+    if (r.interval > 0 && k - r.base > r.interval) {  // a new segment starts at step k - 1
+        std::copy_n(r.entry(k - 1), r.stride(), r.data.data());
+        r.base = k - 1;
+    }
+    double *e = r.entry(k);
     e[0] = x.t;
     e[1] = x.h_last;
     e[2] = r.pending_rho;
     e[3] = r.pending_kind;
+    if (r.interval > 0) {
+        double *l = r.log_entry(k);
+        std::copy_n(e, 4, l);
+        l[4] = r.pending_tol;
+        l[5] = r.pending_sliver ? 1.0 : 0.0;
+        std::copy_n(r.pending_reuse, 5, l + 6);
+    }
     e += 4;
     for (const Vec *v : {&x.q, &x.v, &x.qdd, &x.lambda})
         put(*v, e);
@@ -99,6 +143,8 @@ void Solver::record_step()
         }
     if (r.pending_kind == AdjointRecord::Unsupported && r.unsupported_at < 0)
         r.unsupported_at = r.steps;
+    if (r.interval > 0 && k % r.interval == 0 && k < r.capacity)
+        get_state(r.checkpoint(k / r.interval));
 }
 
 // The sweep's state and scratch: the adjoint variables of the state derivative (q, v, qdd,
@@ -375,8 +421,95 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     return GA_OK;
 }
 
+// Checkpointing: segment s (steps s K + 1 ... s K + K, or to the last) computed again from
+// the checkpoint after step s K into the record's entries, as commit would have written them.
+// The steps are attempted as they were (h, Newton tolerance, Taylor steps allowed) and, with
+// forward sensitivities, followed by theirs, whose matrix the next step's Newton uses.
+ga_status Solver::replay_segment(long s)
+{
+    AdjointRecord &r = adjoint_;
+    const long first = s * r.interval, last = std::min(first + r.interval, r.steps);
+    if (auto st = set_state(r.checkpoint(s), r.checkpoint_size, true))
+        return st;
+    r.base = first;
+    double *e = r.entry(first);
+    e[0] = accepted_.t;
+    e += 4;
+    for (const Vec *v : {&accepted_.q, &accepted_.v, &accepted_.qdd, &accepted_.lambda})
+        put(*v, e);
+    for (long k = first + 1; k <= last; ++k) {
+        const double *l = r.log_entry(k);
+        const double h = l[1];
+        if (l[6] == 0.0)  // the matrix the attempt began with, and its reuse state
+            invalidate_jacobian();
+        theta_prev_ = l[7];
+        refresh_steps_left_ = static_cast<int>(l[8]);
+        reuse_backoff_ = static_cast<int>(l[9]);
+        fd_tangents_ = l[10] != 0.0;
+        ga_status st = attempt_step(h, l[4], l[5] != 0.0);
+        if (!st)
+            st = sensitivity_step(h);
+        if (st) {
+            diag.append(" (recomputing step %ld from its checkpoint for the adjoint sweep)", k);
+            return st;
+        }
+        sens.accepted.swap(sens.trial);
+        accepted_.swap(trial_);
+        accepted_.t = l[0];
+        start_pending_ = false;
+        double *x = r.entry(k);
+        std::copy_n(l, 4, x);
+        x += 4;
+        for (const Vec *v : {&accepted_.q, &accepted_.v, &accepted_.qdd, &accepted_.lambda})
+            put(*v, x);
+        if (formulation == GA_INDEX2_STABILIZED)
+            Eigen::Map<Vec>(x, m_) = eta_total_;
+        else
+            Eigen::Map<Vec>(x, m_).setZero();
+    }
+    return GA_OK;
+}
+
 ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, double *J,
                                    double *dJ)
+{
+    if (adjoint_.interval == 0)
+        return adjoint_sweep(running, terminal, J, dJ);
+    // The sweep recomputes segments in place: the run is restored afterwards as it was --
+    // its state and kept matrix from a checkpoint of it, the rest as saved here.
+    AdjointRecord &r = adjoint_;
+    std::vector<double> here(state_size());
+    get_state(here.data());
+    const State previous = previous_;
+    const bool previous_valid = previous_valid_, start_pending = start_pending_;
+    const EventSet events = events_;
+    const long state_id = state_id_, output_for = output_for_, base = r.base;
+    const std::vector<double> segment = r.data;
+    replaying_ = true;
+    const ga_status st = adjoint_sweep(running, terminal, J, dJ);
+    replaying_ = false;
+    char message[Diagnostics::kSize];
+    diag.copy_to(message);
+    const ga_status back = set_state(here.data(), here.size(), true);
+    previous_ = previous;
+    previous_valid_ = previous_valid;
+    start_pending_ = start_pending;
+    events_ = events;
+    state_id_ = state_id;
+    output_for_ = output_for;
+    r.data = segment;
+    r.base = base;
+    if (st) {
+        diag.restore(message);
+        return st;
+    }
+    if (back)  // the state is restored; its kept matrix is dropped, as by a failed step
+        diag.append(" (rebuilding the kept iteration matrix after the adjoint sweep: the next "
+                    "step starts with a fresh one)");
+    return back;
+}
+
+ga_status Solver::adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ)
 {
     AdjointRecord &r = adjoint_;
     if (r.unsupported_at >= 0)
@@ -408,10 +541,11 @@ ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, doub
             w.dJ[j] += weight * w.cp[j];
         return GA_OK;
     };
-    // trapezoidal weights of the recorded steps
+    // trapezoidal weights of the recorded steps (their sizes from the log with checkpoints)
+    const auto size = [&](long k) { return r.interval > 0 ? r.log_entry(k)[1] : r.entry(k)[1]; };
     const auto weight = [&](long k) {
-        const double before = k > 0 ? r.entry(k)[1] : 0.0;
-        const double after = k < N ? r.entry(k + 1)[1] : 0.0;
+        const double before = k > 0 ? size(k) : 0.0;
+        const double after = k < N ? size(k + 1) : 0.0;
         return 0.5 * (before + after);
     };
     double total = 0.0;
@@ -422,6 +556,9 @@ ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, doub
     for (long k = N; k >= 0; --k) {
         if (running)
             if (auto st = cost(running, k, weight(k), total))
+                return st;
+        if (k - 1 < r.base && k > 0)  // (checkpointing) the segment that ends at step k
+            if (auto st = replay_segment((k - 1) / r.interval))
                 return st;
         if (k == 0) {  // x_0 itself: sigma_0 (the start without a step, or L at t0)
             for (int j = 0; j < w.np; ++j) {

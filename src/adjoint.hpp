@@ -18,23 +18,43 @@ struct AdjointRecord {
     enum Kind { Regular = 0, First = 1, Unsupported = 2 };
     long capacity = 0;  // steps
     long steps = 0;     // recorded since ga_init
+    long max_steps = 0; // of the full record (ga_set_sensitivity_method)
     int n = 0, m = 0;
-    std::vector<double> data;  // capacity + 1 entries of stride()
+    std::vector<double> data;  // capacity + 1 entries of stride(), or interval + 1
+    // Checkpointing (ga_set_adjoint_checkpoints): `data` holds the entries of steps base ...
+    // base + interval only; the solver's state after steps 0, interval, 2 interval, ... is
+    // kept in `checkpoints`, and the sweep recomputes each earlier segment from its own.
+    long interval = 0;  // 0: the whole run in data
+    long base = 0;
+    std::size_t checkpoint_size = 0;
+    std::vector<double> checkpoints;
+    // per step k >= 1 (with checkpointing): t, h, rho, kind, Newton tolerance, sliver allowed,
+    // and the kept matrix's reuse state as the accepted attempt began (valid, theta,
+    // refresh steps left, backoff, finite-difference tangents)
+    static constexpr std::size_t kLog = 11;
+    std::vector<double> log;
     std::vector<StateDerivative> sigma0, start0;  // per parameter
     long unsupported_at = -1;  // the first step of a kind not covered (-1: none)
     // the step being taken, until commit
     Kind pending_kind = Regular;
     double pending_rho = 1.0;
+    double pending_tol = 0.0;  // how the step was attempted (attempt_step), for its replay
+    bool pending_sliver = true;
+    double pending_reuse[5] = {0, 0, 0, 0, 0};
 
     std::size_t stride() const { return 4 + 3 * static_cast<std::size_t>(n) + 2 * m; }
     // entry k: [t, h of the step ending here, rho, kind, q, v, qdd (n each), lambda, eta (m)]
-    double *entry(long k) { return data.data() + static_cast<std::size_t>(k) * stride(); }
+    double *entry(long k) { return data.data() + static_cast<std::size_t>(k - base) * stride(); }
     const double *entry(long k) const
     {
-        return data.data() + static_cast<std::size_t>(k) * stride();
+        return data.data() + static_cast<std::size_t>(k - base) * stride();
     }
-    // Throws std::bad_alloc.
+    double *checkpoint(long c) { return checkpoints.data() + c * checkpoint_size; }
+    double *log_entry(long k) { return log.data() + (k - 1) * kLog; }
+    // Throw std::bad_alloc.
     void allocate(int n_, int m_, int np, long capacity_);
+    void allocate_checkpointed(int n_, int m_, int np, long interval_, long count,
+                               std::size_t state_size);
 };
 
 }  // namespace ga

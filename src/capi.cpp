@@ -864,6 +864,24 @@ GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_s
     });
 }
 
+GA_API ga_status ga_set_adjoint_checkpoints(ga_solver *s, long interval, long count)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (interval < 0 || (interval > 0 && count < 1))
+            return c.diag.fail(GA_ERR_ARG, "interval = %ld, count = %ld: interval >= 0 steps, "
+                               "and with interval > 0 at least one checkpoint", interval, count);
+        if (interval > 0 && count > LONG_MAX / interval)
+            return c.diag.fail(GA_ERR_ARG, "interval = %ld times count = %ld steps overflows",
+                               interval, count);
+        if (!c.sens.adjoint)
+            return c.diag.fail(GA_ERR_STATE, "ga_set_adjoint_checkpoints before "
+                               "ga_set_sensitivity_method with GA_SENSITIVITY_ADJOINT");
+        if (c.initialized())
+            return c.diag.fail(GA_ERR_STATE, "ga_set_adjoint_checkpoints after ga_init");
+        return c.set_adjoint_checkpoints(interval, count);
+    });
+}
+
 GA_API ga_status ga_adjoint_gradient(ga_solver *s, ga_cost_fn running, ga_cost_fn terminal,
                                      double *J, double *dJ_dp)
 {

@@ -110,7 +110,7 @@ void Solver::get_state(double *buf) const
         }
 }
 
-ga_status Solver::set_state(const double *buf, std::size_t len)
+ga_status Solver::set_state(const double *buf, std::size_t len, bool internal)
 {
     const bool layout2 = len >= 2 && buf[0] == kStateMagic && buf[1] == 2.0;
     const Layout l = layout(n_, m_);
@@ -172,7 +172,7 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
     }
     if (!model.ready())
         return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
-    if (sens.adjoint)
+    if (sens.adjoint && !internal)
         return diag.fail(GA_ERR_STATE, "ga_set_state on a run recorded for the adjoint: the "
                          "record starts at ga_init (restoring into it is not built)");
     if (auto st = setup())
@@ -267,8 +267,11 @@ ga_status Solver::set_state(const double *buf, std::size_t len)
         }
         // A callback that fails now costs the restored run its bit-identity only: it goes on
         // as after a restart (layout 2), with a fresh matrix and the reuse history forgotten.
-        if (rebuild_matrix() != GA_OK) {
+        // The adjoint sweep's own restores need the matrix, and say so.
+        if (const ga_status st = rebuild_matrix()) {
             invalidate_jacobian();
+            if (internal)
+                return st;
             diag.clear();
             return GA_OK;
         }

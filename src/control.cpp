@@ -201,6 +201,8 @@ ga_status Solver::adaptive_step(double t_stop)
                 return GA_OK;
             }
             count(counters, GA_COUNT_REJECTED_STEPS);
+            if (sens.adjoint)  // (a replay from a checkpoint cannot know the matrix it left)
+                invalidate_jacobian();
             h *= std::max(kMinShrink, kSafety * std::pow(err, -1.0 / 3.0));
         } else if (recoverable(st)) {
             count(counters, GA_COUNT_FAILED_STEPS);

@@ -520,7 +520,7 @@ ga_status Solver::sensitivity_step(double h)
     if (!sens.active())
         return GA_OK;
     const State &s = accepted_;
-    if (sens.adjoint) {  // how the step began, for the record (adjoint.cpp; commit keeps it)
+    if (sens.adjoint && !replaying_) {  // how the step began, for the record (adjoint.cpp)
         AdjointRecord &r = adjoint_;
         if (r.steps >= r.capacity)
             return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (%ld steps: "

@@ -390,6 +390,15 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
 {
     if (formulation == GA_INDEX2_STABILIZED && !S2_.ready())
         return diag.fail(GA_ERR_INTERNAL, "the stabilized index-2 system was not set up");
+    if (adjoint_.interval > 0) {  // how to repeat it (adjoint checkpointing)
+        AdjointRecord &r = adjoint_;
+        r.pending_tol = tol;
+        r.pending_sliver = sliver_allowed;
+        const double reuse[5] = {jacobian_valid_ ? 1.0 : 0.0, theta_prev_,
+                                 static_cast<double>(refresh_steps_left_),
+                                 static_cast<double>(reuse_backoff_), fd_tangents_ ? 1.0 : 0.0};
+        std::copy_n(reuse, 5, r.pending_reuse);
+    }
     if (pivots_forgotten_)  // after a layout-2 checkpoint: pivots as a new solver picks them
         forget_pivots();
     const State &s = accepted_;

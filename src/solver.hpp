@@ -136,6 +136,7 @@ public:
     // adjoint.cpp
     ga_status set_sensitivity_method(int methods, long max_steps);
     ga_status adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ);
+    ga_status set_adjoint_checkpoints(long interval, long count);
 
     // Events (events.cpp): the functions watched, where their search stands, the last log.
     EventSet &events() { return events_; }
@@ -176,7 +177,8 @@ public:
     // Layout 2 (galpha 0.2: the state and the control only) is read as a restart.
     std::size_t state_size() const;
     void get_state(double *buf) const;
-    ga_status set_state(const double *buf, std::size_t len);
+    // internal: the adjoint sweep's own restores into a recorded run
+    ga_status set_state(const double *buf, std::size_t len, bool internal = false);
 
 private:
     ga_status setup();  // chooses the backend and allocates everything; throws std::bad_alloc
@@ -254,6 +256,9 @@ private:
     void record_step();    // the accepted step, at commit
     struct AdjointWork;
     ga_status adjoint_step(long k, AdjointWork &w);
+    ga_status adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ);
+    ga_status replay_segment(long s);
+    bool replaying_ = false;  // a sweep recomputes a segment of the recorded run
     Vec eta_total_;       // index 2: the converged step's eta_bar (sum of its increments)
     ga_status factorize(double t, const State &x, double h, bool tangents_K, bool tangents_C,
                         bool tangent_Z, int iter);

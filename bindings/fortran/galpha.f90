@@ -560,6 +560,12 @@ module galpha
        integer(c_int), value :: methods
        integer(c_long), value :: max_steps
      end function ga_set_sensitivity_method
+     integer(c_int) function ga_set_adjoint_checkpoints(s, interval, count) &
+          bind(C, name="ga_set_adjoint_checkpoints")
+       import :: c_int, c_ptr, c_long
+       type(c_ptr), value :: s
+       integer(c_long), value :: interval, count
+     end function ga_set_adjoint_checkpoints
      integer(c_int) function ga_adjoint_gradient(s, running, terminal, J, dJ_dp) &
           bind(C, name="ga_adjoint_gradient")
        import :: c_int, c_ptr, c_funptr, c_double
@@ -591,7 +597,7 @@ module galpha
        ga_set_sensitivity, ga_set_parameter_derivatives, ga_get_sensitivity, &
        ga_set_constraint_parameter_derivative, &
        ga_set_sensitivity_start, ga_get_sensitivity_y, &
-       ga_set_sensitivity_method, ga_adjoint_gradient
+       ga_set_sensitivity_method, ga_adjoint_gradient, ga_set_adjoint_checkpoints
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
@@ -718,6 +724,9 @@ module galpha
      !> set_sensitivity_method(methods, max_steps): an ior of GA_SENSITIVITY_FORWARD and
      !> GA_SENSITIVITY_ADJOINT (the run recorded for adjoint_gradient, up to max_steps steps)
      procedure :: set_sensitivity_method => solver_set_sensitivity_method
+     !> set_adjoint_checkpoints(interval, count): the record keeps one segment of interval
+     !> steps and a checkpoint after every interval-th step (count of them)
+     procedure :: set_adjoint_checkpoints => solver_set_adjoint_checkpoints
      !> adjoint_gradient(J, dJ_dp, running, terminal): the cost and its gradient by the
      !> discrete adjoint of the recorded run (running and terminal optional, one needed)
      procedure :: adjoint_gradient => solver_adjoint_gradient
@@ -1029,6 +1038,12 @@ contains
     integer, intent(in) :: max_steps
     status = ga_set_sensitivity_method(this%handle, methods, int(max_steps, c_long))
   end function solver_set_sensitivity_method
+
+  integer(c_int) function solver_set_adjoint_checkpoints(this, interval, count) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer, intent(in) :: interval, count
+    status = ga_set_adjoint_checkpoints(this%handle, int(interval, c_long), int(count, c_long))
+  end function solver_set_adjoint_checkpoints
 
   integer(c_int) function solver_adjoint_gradient(this, J, dJ_dp, running, terminal) &
        result(status)

@@ -471,9 +471,9 @@ static void no_allocation_with_first_order_states(void **state)
 static void no_allocation_with_sensitivities(void **state)
 {
     (void)state;
-    for (int mode = 0; mode < 8; ++mode) { /* 6, 7: the adjoint record, with and without */
+    for (int mode = 0; mode < 9; ++mode) { /* 6, 7: the adjoint record, with and without */
         const int adaptive = mode & 1, index2 = (mode >> 1) & 1, sparse = mode == 4 || mode == 5;
-        const int record = mode >= 6;
+        const int record = mode >= 6; /* 8: the record with checkpoints, fixed steps */
         pendulum p = {1.0, 1.0, 9.81};
         chain c = chain_make(8);
         const int n = sparse ? 24 : 2, m = sparse ? 16 : 1;
@@ -505,6 +505,8 @@ static void no_allocation_with_sensitivities(void **state)
                                  s, (mode == 6 ? GA_SENSITIVITY_FORWARD : 0) |
                                         GA_SENSITIVITY_ADJOINT, 1000),
                              GA_OK);
+        if (mode == 8)
+            assert_int_equal(ga_set_adjoint_checkpoints(s, 16, 40), GA_OK);
         assert_int_equal(ga_set_formulation(s, index2 ? GA_INDEX2_STABILIZED : GA_INDEX3),
                          GA_OK);
         assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);

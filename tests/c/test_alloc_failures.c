@@ -144,7 +144,7 @@ static ga_solver *make_redundant(void)
 typedef enum call {
     INIT, INIT_INDEX2, INIT_REDUNDANT, SET_STATE, FORMULATION, TANGENT_MODE, OUTPUT, EVENTS,
     SET_FIRST_ORDER, INIT_Y, SET_SENSITIVITY, SENSITIVITY_METHOD, SENSITIVITY_START,
-    INIT_SENSITIVITY
+    INIT_SENSITIVITY, ADJOINT_CHECKPOINTS
 } call;
 static const char *const kNames[] = {"ga_init", "ga_init (index 2)",
                                      "ga_init (a redundant constraint)", "ga_set_state",
@@ -152,7 +152,7 @@ static const char *const kNames[] = {"ga_init", "ga_init (index 2)",
                                      "ga_set_output", "ga_set_events", "ga_set_first_order",
                                      "ga_init_y", "ga_set_sensitivity",
                                      "ga_set_sensitivity_method", "ga_set_sensitivity_start",
-                                     "ga_init (sensitivities)"};
+                                     "ga_init (sensitivities)", "ga_set_adjoint_checkpoints"};
 
 /* event functions that never fire */
 static int far_away(double t, const double *q, const double *v, const double *lambda,
@@ -185,6 +185,7 @@ static ga_status do_call(ga_solver *s, call c, const double *checkpoint, size_t 
     case SENSITIVITY_METHOD:
         return ga_set_sensitivity_method(s, GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT, 10);
     case SENSITIVITY_START: return ga_set_sensitivity_start(s, 1, q, v);
+    case ADJOINT_CHECKPOINTS: return ga_set_adjoint_checkpoints(s, 2, 3);
     default: return ga_set_output(s, GA_OUTPUT_CONSISTENT);
     }
 }
@@ -207,11 +208,13 @@ static ga_solver *prepare(call c)
     if (c == INIT_Y)
         assert_int_equal(ga_set_first_order(s, 1, chain_force_y, chain_rate), GA_OK);
     const int sensitivities = c == SENSITIVITY_METHOD || c == SENSITIVITY_START ||
-                              c == INIT_SENSITIVITY;
+                              c == INIT_SENSITIVITY || c == ADJOINT_CHECKPOINTS;
     if (sensitivities)
         assert_int_equal(ga_set_sensitivity(s, 3, &g_chain.mass, NULL,
                                             GA_DEPENDS_FORCE | GA_DEPENDS_MASS),
                          GA_OK);
+    if (c == ADJOINT_CHECKPOINTS)
+        assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 10), GA_OK);
     g_start_before_steps = c == SET_FIRST_ORDER ? 1 : sensitivities || c == SET_SENSITIVITY ? 2 : 0;
     if (c == INIT_SENSITIVITY)
         g_start_before_steps = 0;
@@ -311,6 +314,7 @@ static void sensitivity_sweep(void **state) { (void)state; sweep(SET_SENSITIVITY
 static void sensitivity_method_sweep(void **state) { (void)state; sweep(SENSITIVITY_METHOD); }
 static void sensitivity_start_sweep(void **state) { (void)state; sweep(SENSITIVITY_START); }
 static void init_sensitivity_sweep(void **state) { (void)state; sweep(INIT_SENSITIVITY); }
+static void adjoint_checkpoints_sweep(void **state) { (void)state; sweep(ADJOINT_CHECKPOINTS); }
 
 int main(void)
 {
@@ -323,6 +327,7 @@ int main(void)
         cmocka_unit_test(first_order_sweep),  cmocka_unit_test(init_y_sweep),
         cmocka_unit_test(sensitivity_sweep),  cmocka_unit_test(sensitivity_method_sweep),
         cmocka_unit_test(sensitivity_start_sweep), cmocka_unit_test(init_sensitivity_sweep),
+        cmocka_unit_test(adjoint_checkpoints_sweep),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

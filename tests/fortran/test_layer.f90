@@ -368,6 +368,20 @@ program test_layer
   call ok(r%adjoint_gradient(x, q2(1:1), terminal=final_position), 'adjoint_gradient')
   call ok(r%get_sensitivity(1, q(1:1)), 'get_sensitivity')
   call expect(abs(q2(1) - q(1)) < 1d-12 * abs(q(1)), 'adjoint dJ/dk = forward dx/dk')
+  ! with checkpoints every 30 steps: the same gradient, bit for bit
+  call r%free()
+  call ok(r%create(1, 0), 'create for adjoint checkpoints')
+  call ok(r%set_callbacks(unit_mass, spring), 'callbacks')
+  call ok(r%set_sensitivity(stiffness, GA_DEPENDS_FORCE), 'set_sensitivity')
+  call ok(r%set_sensitivity_method(ior(GA_SENSITIVITY_FORWARD, GA_SENSITIVITY_ADJOINT), 1000), &
+          'set_sensitivity_method')
+  call ok(r%set_adjoint_checkpoints(30, 34), 'set_adjoint_checkpoints')
+  call ok(r%init(0.0d0, [1.0d0], [0.0d0]), 'init')
+  do i = 1, 1000
+     call ok(r%step(1d-3), 'step with checkpoints')
+  end do
+  call ok(r%adjoint_gradient(am, v2(1:1), terminal=final_position), 'adjoint_gradient (checkpoints)')
+  call expect(am == x .and. v2(1) == q2(1), 'checkpointed adjoint = full record')
   ! a parameter in the constraints, by differences and by the callback (index 2)
   do i = 0, 1
      call r%free()

@@ -204,6 +204,16 @@ def test_adjoint_gradient_equals_forward():
         J, dJ = s.adjoint_gradient(running, terminal)
     assert J == pytest.approx(J_fwd, rel=1e-12)
     assert np.allclose(dJ, dJ_fwd, rtol=1e-9, atol=1e-12)
+    # checkpointing: segments of 8 steps recomputed from checkpoints, the same numbers
+    with pendulum(p, parameters=p, depends=("force", "mass"),
+                  sensitivity_method=("forward", "adjoint"),
+                  max_steps=steps, adjoint_checkpoints=(8, 13),
+                  output=galpha.GA_OUTPUT_STEP) as s:
+        s.init(0.0, Q0, V0)
+        for _ in range(steps):
+            s.step(h)
+        J2, dJ2 = s.adjoint_gradient(running, terminal)
+    assert J2 == J and np.array_equal(dJ2, dJ)
 
 
 def test_adjoint_refusals_and_errors():

@@ -233,6 +233,7 @@ _SIGNATURES = {
     "ga_get_sensitivity": (_I, [_S, _I, c_double_p, c_double_p, c_double_p, c_double_p]),
     "ga_get_sensitivity_y": (_I, [_S, _I, c_double_p, c_double_p]),
     "ga_set_sensitivity_method": (_I, [_S, _I, ctypes.c_long]),
+    "ga_set_adjoint_checkpoints": (_I, [_S, ctypes.c_long, ctypes.c_long]),
     "ga_adjoint_gradient": (_I, [_S, COST_FN, COST_FN, c_double_p, c_double_p]),
 }
 

@@ -176,6 +176,10 @@ class Solver:
         A subset of ("forward", "adjoint") (ga_set_sensitivity_method; default ("forward",)):
         with "adjoint" the run from init() on is recorded, up to max_steps steps, for
         adjoint_gradient().
+    adjoint_checkpoints : (interval, count)
+        Checkpointing for records that do not fit (ga_set_adjoint_checkpoints): one segment
+        of `interval` steps kept, a checkpoint after every interval-th step, runs of up to
+        interval * count steps; adjoint_gradient() computes earlier segments again.
     zero_copy : bool
         False (default): callbacks get copies of their inputs and an array of their own to
         fill, so what they keep stays valid and unchanged after the call. True: views of the
@@ -196,7 +200,8 @@ class Solver:
                  r=0, rate=None, force_y=None, coupling=None, coupling_exact=None,
                  coupling_patterns=None, parameters=None, depends=("force",),
                  parameter_scale=None, force_p=None, mass_p=None, constraint_p=None,
-                 sensitivity_method=("forward",), max_steps=None, zero_copy=False):
+                 sensitivity_method=("forward",), max_steps=None, adjoint_checkpoints=None,
+                 zero_copy=False):
         self._ptr = None
         self._lock = threading.RLock()  # see _serialized
         self._pending = None          # exception raised inside a callback
@@ -385,6 +390,10 @@ class Solver:
                     raise ValueError("the adjoint record needs max_steps")
                 self._check(_ffi.ga_set_sensitivity_method(self._ptr, methods,
                                                            int(max_steps or 0)))
+            if adjoint_checkpoints is not None:
+                interval, count = adjoint_checkpoints
+                self._check(_ffi.ga_set_adjoint_checkpoints(self._ptr, int(interval),
+                                                            int(count)))
         if rho_inf is not None:
             self.set_rho_inf(rho_inf)
         if params is not None:
