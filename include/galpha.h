@@ -711,7 +711,7 @@ GA_API ga_status ga_set_events_y(ga_solver *s, int count, ga_event_y_fn fn, cons
  *  tangent (the next step's Newton iteration starts with it); each parameter then costs one
  *  solve and the parameter derivatives of the residual. Exact to round-off with exact tangents
  *  (ga_set_tangents); with tangents by central differences (galpha's otherwise), to their
- *  precision, about eps^(2/3). Not yet the adjoint with first-order states. */
+ *  precision, about eps^(2/3). */
 /**@{*/
 /** What depends on the parameters (flags, or-ed). The others are taken as independent of p:
  *  their derivatives are not evaluated. */

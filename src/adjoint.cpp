@@ -18,10 +18,11 @@
 
 namespace ga {
 
-void AdjointRecord::allocate(int n_, int m_, int np, long capacity_)
+void AdjointRecord::allocate(int n_, int m_, int r_, int np, long capacity_)
 {
     n = n_;
     m = m_;
+    r = r_;
     capacity = capacity_;
     max_steps = capacity_;
     steps = 0;
@@ -32,15 +33,15 @@ void AdjointRecord::allocate(int n_, int m_, int np, long capacity_)
     for (auto *set : {&sigma0, &start0}) {
         set->resize(np);
         for (StateDerivative &x : *set)
-            x.allocate(n_, m_);
+            x.allocate(n_, m_, r_);
     }
 }
 
-void AdjointRecord::allocate_checkpointed(int n_, int m_, int np, long interval_, long count,
-                                          std::size_t state_size)
+void AdjointRecord::allocate_checkpointed(int n_, int m_, int r_, int np, long interval_,
+                                          long count, std::size_t state_size)
 {
     const long full = max_steps;
-    allocate(n_, m_, np, interval_);
+    allocate(n_, m_, r_, np, interval_);
     max_steps = full;
     interval = interval_;
     capacity = interval_ * count;
@@ -54,9 +55,9 @@ ga_status Solver::set_adjoint_checkpoints(long interval, long count)
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
     record.max_steps = adjoint_.max_steps;
     if (interval > 0)
-        record.allocate_checkpointed(n_, m_, sens.np, interval, count, state_size());
+        record.allocate_checkpointed(n_, m_, r(), sens.np, interval, count, state_size());
     else
-        record.allocate(n_, m_, sens.np, adjoint_.max_steps);
+        record.allocate(n_, m_, r(), sens.np, adjoint_.max_steps);
     adjoint_ = std::move(record);
     return GA_OK;
 }
@@ -65,7 +66,7 @@ ga_status Solver::set_sensitivity_method(int methods, long max_steps)
 {
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
     if (methods & GA_SENSITIVITY_ADJOINT)
-        record.allocate(n_, m_, sens.np, max_steps);
+        record.allocate(n_, m_, r(), sens.np, max_steps);
     adjoint_ = std::move(record);
     sens.forward = (methods & GA_SENSITIVITY_FORWARD) != 0;
     sens.adjoint = (methods & GA_SENSITIVITY_ADJOINT) != 0;
@@ -96,6 +97,9 @@ void Solver::record_start()
     for (const Vec *v : {&x.q, &x.v, &x.qdd, &x.lambda})
         put(*v, e);
     Eigen::Map<Vec>(e, m_).setZero();
+    e += m_;
+    put(x.y, e);
+    put(x.ydot, e);
     for (int j = 0; j < sens.np; ++j) {
         const StateDerivative &s = sens.accepted[j];
         StateDerivative &d = r.sigma0[j];
@@ -104,6 +108,9 @@ void Solver::record_start()
         d.qdd = s.qdd;
         d.lambda = s.lambda;
         d.a = s.a;
+        d.y = s.y;
+        d.ydot = s.ydot;
+        d.w = s.w;
     }
 }
 
@@ -135,11 +142,15 @@ void Solver::record_step()
         Eigen::Map<Vec>(e, m_) = eta_total_;
     else
         Eigen::Map<Vec>(e, m_).setZero();
+    e += m_;
+    put(x.y, e);
+    put(x.ydot, e);
     if (r.pending_kind == AdjointRecord::First)
         for (int j = 0; j < sens.np; ++j) {
             r.start0[j].v = sens.start[j].v;
             r.start0[j].a = sens.start[j].a;
             r.start0[j].qdd = sens.start[j].qdd;
+            r.start0[j].w = sens.start[j].w;
         }
     if (r.pending_kind == AdjointRecord::Unsupported && r.unsupported_at < 0)
         r.unsupported_at = r.steps;
@@ -155,6 +166,7 @@ struct Solver::AdjointWork {
     Vec yq, yl, ye, zq, zl, ze;    // right-hand side and solution of S^T z = y
     Vec rr, rl, rv, qp, vp, tmp;   // adjoints of the linearized residual and the predictor
     Vec eta;
+    Vec my, mydot, mw, ry, yp;      // first-order states (r): adjoints of y, y', w; r^y, y_p
     std::vector<double> dJ;
     State x;                        // a recorded state
     // S, sparse on the sparse path (its pattern ordered once per sweep: the entries come from
@@ -168,8 +180,11 @@ struct Solver::AdjointWork {
     Eigen::PartialPivLU<Mat> dense_lu;
     std::vector<Eigen::Triplet<double>> entries;
     int np = 0;
-    void allocate(int n, int m, int p)
+    void allocate(int n, int m, int r, int p)
     {
+        for (Vec *v : {&my, &mydot, &mw, &ry, &yp})
+            v->setZero(r);
+        x.allocate_first_order(r);
         for (Vec *v : {&mq, &mv, &mqdd, &ma, &cq, &cv, &cqdd, &yq, &zq, &rr, &qp, &vp, &tmp})
             v->setZero(n);
         for (Vec *v : {&ml, &cl, &yl, &ye, &zl, &ze, &rl, &rv, &eta})
@@ -177,6 +192,7 @@ struct Solver::AdjointWork {
         cp.setZero(p);
         dJ.assign(p, 0.0);
         x.allocate(n, m);
+        x.allocate_first_order(r);
         np = p;
     }
 };
@@ -248,8 +264,16 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     }
     x.lambda = Eigen::Map<const Vec>(src, m);
     w.eta = Eigen::Map<const Vec>(src + m, m);
+    const int R = this->r();
+    x.y = Eigen::Map<const Vec>(src + 2 * m, R);
+    x.ydot = Eigen::Map<const Vec>(src + 2 * m + R, R);
     bool K = false, C = false, Z = false;
     ga_status st = exact_tangents(t1, x, K, C, Z);
+    if (!st && R > 0) {  // the coupling blocks at the recorded state (f_ and g there)
+        st = model.rate(t1, x.q, x.v, x.y, rate_);
+        if (!st)
+            st = first_order_matrix(t1, x, true);
+    }
     const Vec q_n = Eigen::Map<const Vec>(e0 + 4, n);
     if (!st && index2 && m > 0)
         st = model.jacobian(e0[0], q_n, B_);
@@ -259,6 +283,27 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     // S, scaled: rows (beta h^2, 1[, beta h / gamma]), unknowns (d or w, beta h^2 dlambda[, e])
     const int N = n + (index2 ? 2 * m : m);
     const double s3 = p.beta * h / p.gamma;
+    // First-order states: dy as unknown beside them (rows of r^y = y' - g, scale 1), the
+    // f_y column in the rows of r^q; y-rows -g_q dq - gamma' g_v dw + (c1 I - g_y) dy with
+    // dq = w - B^T e, dw = w in index 2 (first_order.cpp eliminates it; here it is assembled).
+    const FirstOrderParams &p1 = params1;
+    const double c1 = R > 0 ? first_order_newton_coefficient(p1, h) : 0.0;
+    Mat Fy, Gw, Ge, Gy;
+    if (R > 0) {
+        const CouplingBlocks &b = blocks_;
+        Fy = -bh2 * b.f_y;
+        Gw = -(b.g_q + c.gamma_prime * b.g_v);
+        Gy = c1 * Mat::Identity(R, R) - b.g_y;
+        if (index2 && m > 0) {
+            dense_of(B_, w.Bd);
+            Ge = b.g_q * w.Bd.transpose();
+        }
+    }
+    const auto add_dense = [&](const Mat &X, int row0, int col0) {
+        for (int j = 0; j < X.cols(); ++j)
+            for (int i = 0; i < X.rows(); ++i)
+                w.entries.emplace_back(row0 + i, col0 + j, X(i, j));
+    };
     count(counters, GA_COUNT_FACTORIZATIONS);
     bool singular = false;
     if (sparse_backend_) {
@@ -282,6 +327,13 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
             add_block(w.entries, Js, 1.0, n + m, 0);
             add_block(w.entries, Sparse(Zs * BT), -s3, n + m, n + m);
         }
+        if (R > 0) {
+            add_dense(Fy, 0, N);
+            add_dense(Gw, N, 0);
+            if (index2 && m > 0)
+                add_dense(Ge, N, n + m);
+            add_dense(Gy, N, N);
+        }
 #ifdef GALPHA_HAVE_KLU
         if (!w.klu) {
             std::vector<std::pair<int, int>> pattern;
@@ -289,7 +341,7 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
             for (const auto &t : w.entries)
                 pattern.emplace_back(t.row(), t.col());
             w.klu = std::make_unique<KluSystem>();
-            w.klu->setup(N, pattern);
+            w.klu->setup(N + R, pattern);
             w.slots.resize(w.entries.size());
             for (std::size_t k = 0; k < w.entries.size(); ++k)
                 w.slots[k] = w.klu->slot(w.entries[k].row(), w.entries[k].col());
@@ -306,7 +358,7 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
 #endif
     } else {
         Mat &D = w.D;
-        D.setZero(N, N);
+        D.setZero(N + R, N + R);
         dense_of(M_, w.Md);
         dense_of(J_, w.Jd);
         D.topLeftCorner(n, n) = (bh2 * c.beta_prime) * w.Md;
@@ -329,6 +381,13 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
             D.block(n + m, 0, m, n) = s3 * w.Zd + w.Jd;
             D.block(n + m, n + m, m, m) = -s3 * (w.Zd * w.Bd.transpose());
         }
+        if (R > 0) {
+            D.block(0, N, n, R) = Fy;
+            D.block(N, 0, R, n) = Gw;
+            if (index2 && m > 0)
+                D.block(N, n + m, R, m) = Ge;
+            D.block(N, N, R, R) = Gy;
+        }
         w.dense_lu.compute(D);
         singular = !(w.dense_lu.rcond() > std::numeric_limits<double>::epsilon());
     }
@@ -343,16 +402,20 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     const double am = p.alpha_m, af = p.alpha_f;
     const Vec mqdd_total = w.mqdd + ((1.0 - af) / (1.0 - am)) * w.ma;
     w.tmp = c.gamma_prime * w.mv + c.beta_prime * mqdd_total;  // adjoint of w (or of d)
-    Eigen::VectorXd y(N);
+    Eigen::VectorXd y(N + R);
+    // s_y' = y_p + dy, s_y'' = c1 dy, s_w' = w_p + (1 - alpha_f1) / (1 - alpha_m1) s_y''
+    const double am1 = p1.alpha_m, af1 = p1.alpha_f;
+    if (R > 0)
+        y.tail(R) = w.my + c1 * (w.mydot + ((1.0 - af1) / (1.0 - am1)) * w.mw);
     if (index2 && m > 0) {
         y.head(n) = w.tmp + w.mq;  // d = w - B^T e
         y.segment(n, m) = w.ml / bh2;
         w.ye.setZero();
         B_.multiply_add(-1.0, w.mq, w.ye);
-        y.tail(m) = w.ye;
+        y.segment(n + m, m) = w.ye;
     } else {
         y.head(n) = w.tmp + w.mq;
-        y.tail(m) = w.ml / bh2;
+        y.segment(n, m) = w.ml / bh2;
     }
     // S^{-T}; the right-hand side was -(rows' scales) (r, r_lambda, r_v)
     Eigen::VectorXd z;
@@ -368,7 +431,9 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     w.rr = -bh2 * z.head(n);
     w.rl = -z.segment(n, m);
     if (index2 && m > 0)
-        w.rv = -(p.beta * h / p.gamma) * z.tail(m);
+        w.rv = -(p.beta * h / p.gamma) * z.segment(n + m, m);
+    if (R > 0)
+        w.ry = -z.tail(R);
     // the linearized residual r = K q_p + C v_p + R_p, r_lambda = J q_p, r_v = Z q_p + J v_p
     w.qp = w.mq;
     w.vp = w.mv;
@@ -381,6 +446,14 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
         Z_.multiply_transpose_add(1.0, w.rv, w.qp);
         J_.multiply_transpose_add(1.0, w.rv, w.vp);
     }
+    if (R > 0) {  // r^q sees y_p through -f_y; r^y = y'_p - g_q q_p - g_v v_p - g_y y_p
+        const CouplingBlocks &b = blocks_;
+        w.qp.noalias() -= b.g_q.transpose() * w.ry;
+        w.vp.noalias() -= b.g_v.transpose() * w.ry;
+        w.yp = w.my;
+        w.yp.noalias() -= b.f_y.transpose() * w.rr;
+        w.yp.noalias() -= b.g_y.transpose() * w.ry;
+    }
     for (int j = 0; j < w.np; ++j) {
         Sensitivities &z = sens;
         if ((st = constraint_parameter_terms(j, t1, x, index2, index2, e0[0], q_n, w.eta)))
@@ -391,6 +464,21 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
         w.dJ[j] += w.rr.dot(z.rq) + w.rl.dot(z.cl) + w.qp.dot(z.cbt);
         if (index2 && m > 0)
             w.dJ[j] += w.rv.dot(z.cv);
+        if (R > 0) {
+            z.ry.setZero();
+            if ((st = rate_parameter_residual(j, t1, x)))
+                return st;
+            w.dJ[j] += w.ry.dot(z.ry);
+        }
+    }
+    // P^T of the first-order states: w_p = (af1 y'_n - am1 w_n) / (1 - am1),
+    // y_p = y_n + h ((1 - gamma1) w_n + gamma1 w_p)
+    Vec msy, msydot, msw;
+    if (R > 0) {
+        const Vec mwp = w.mw + (h * p1.gamma) * w.yp;
+        msy = w.yp;
+        msw = (h * (1.0 - p1.gamma)) * w.yp - (am1 / (1.0 - am1)) * mwp;
+        msydot = (af1 / (1.0 - am1)) * mwp;
     }
     // P^T: a_p = (af sqdd - am sa) / (1 - am), q_p = s_q + h sv + h^2 ((1/2 - beta) sa + beta a_p)
     // (- in index 2 the derivative of B^T eta_bar along s_q), v_p = sv + h ((1 - gamma) sa +
@@ -407,9 +495,13 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
         msq += w.tmp;
     }
     if (kind == AdjointRecord::First) {  // the start, differenced in p (sensitivity.cpp)
-        for (int j = 0; j < w.np; ++j)
+        for (int j = 0; j < w.np; ++j) {
             w.dJ[j] += msq.dot(r.sigma0[j].q) + msv.dot(r.start0[j].v) +
                        msa.dot(r.start0[j].a) + msqdd.dot(r.start0[j].qdd);
+            if (R > 0)
+                w.dJ[j] += msy.dot(r.sigma0[j].y) + msydot.dot(r.sigma0[j].ydot) +
+                           msw.dot(r.start0[j].w);
+        }
         return GA_OK;
     }
     // the start as the accepted state (a_n rescaled by rho): the adjoint of sigma_k
@@ -418,6 +510,11 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     w.mqdd = msqdd + (1.0 - rho) * msa;
     w.ma = rho * msa;
     w.ml.setZero();
+    if (R > 0) {  // w_n rescaled as a_n (first_order_start)
+        w.my = msy;
+        w.mydot = msydot + (1.0 - rho) * msw;
+        w.mw = rho * msw;
+    }
     return GA_OK;
 }
 
@@ -437,6 +534,9 @@ ga_status Solver::replay_segment(long s)
     e += 4;
     for (const Vec *v : {&accepted_.q, &accepted_.v, &accepted_.qdd, &accepted_.lambda})
         put(*v, e);
+    e += m_;
+    put(accepted_.y, e);
+    put(accepted_.ydot, e);
     for (long k = first + 1; k <= last; ++k) {
         const double *l = r.log_entry(k);
         const double h = l[1];
@@ -466,6 +566,9 @@ ga_status Solver::replay_segment(long s)
             Eigen::Map<Vec>(x, m_) = eta_total_;
         else
             Eigen::Map<Vec>(x, m_).setZero();
+        x += m_;
+        put(accepted_.y, x);
+        put(accepted_.ydot, x);
     }
     return GA_OK;
 }
@@ -473,8 +576,11 @@ ga_status Solver::replay_segment(long s)
 ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, double *J,
                                    double *dJ)
 {
-    if (adjoint_.interval == 0)
-        return adjoint_sweep(running, terminal, J, dJ);
+    if (adjoint_.interval == 0) {
+        const ga_status st = adjoint_sweep(running, terminal, J, dJ);
+        model.y_now = &accepted_.y;  // (the sweep pointed the forces at recorded states)
+        return st;
+    }
     // The sweep recomputes segments in place: the run is restored afterwards as it was --
     // its state and kept matrix from a checkpoint of it, the rest as saved here.
     AdjointRecord &r = adjoint_;
@@ -495,6 +601,7 @@ ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, doub
     previous_valid_ = previous_valid;
     start_pending_ = start_pending;
     events_ = events;
+    model.y_now = &accepted_.y;
     state_id_ = state_id;
     output_for_ = output_for;
     r.data = segment;
@@ -521,7 +628,7 @@ ga_status Solver::adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double 
         return diag.fail(GA_ERR_STATE, "the adjoint sweep with dropped redundant constraints is "
                          "not built");
     AdjointWork w;
-    w.allocate(n_, m_, sens.np);
+    w.allocate(n_, m_, this->r(), sens.np);
     const long N = r.steps;
     // Cost terms at a recorded state k: its value into `value`, weight times its gradient
     // into the adjoint variables (and into dJ/dp).
@@ -564,7 +671,8 @@ ga_status Solver::adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double 
             for (int j = 0; j < w.np; ++j) {
                 const StateDerivative &s0 = r.sigma0[j];
                 w.dJ[j] += w.mq.dot(s0.q) + w.mv.dot(s0.v) + w.mqdd.dot(s0.qdd) +
-                           w.ml.dot(s0.lambda) + w.ma.dot(s0.a);
+                           w.ml.dot(s0.lambda) + w.ma.dot(s0.a) + w.my.dot(s0.y) +
+                           w.mydot.dot(s0.ydot) + w.mw.dot(s0.w);
             }
             break;
         }
@@ -578,6 +686,9 @@ ga_status Solver::adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double 
             w.mqdd.setZero();
             w.ml.setZero();
             w.ma.setZero();
+            w.my.setZero();
+            w.mydot.setZero();
+            w.mw.setZero();
         }
     }
     *J = total;

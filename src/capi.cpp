@@ -855,9 +855,6 @@ GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_s
         if (!c.sens.active())
             return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity_method before "
                                "ga_set_sensitivity with np > 0");
-        if ((methods & GA_SENSITIVITY_ADJOINT) && c.r() > 0)
-            return c.diag.fail(GA_ERR_STATE, "the adjoint with first-order states is not built "
-                               "yet");
         if (c.initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity_method after ga_init");
         return c.set_sensitivity_method(methods, max_steps);

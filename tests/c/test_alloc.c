@@ -434,6 +434,10 @@ static void no_allocation_with_first_order_states(void **state)
             assert_int_equal(ga_set_sensitivity(s, 1, unread, NULL,
                                                 GA_DEPENDS_FORCE | GA_DEPENDS_RATE),
                              GA_OK);
+        if (sensitivities) /* and the adjoint's record (its y and y' too) */
+            assert_int_equal(ga_set_sensitivity_method(
+                                 s, GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT, 2000),
+                             GA_OK);
         if (mode & 1)
             assert_int_equal(ga_set_coupling(s, em_coupling), GA_OK);
         if (mode >= 2)
