@@ -557,6 +557,30 @@ static int motor_running(double t, const double *q, const double *v, const doubl
     return 0;
 }
 
+/* The motor scene recorded for the adjoint with forward sensitivities, started (interval > 0:
+ * with checkpoints every interval steps). */
+static ga_solver *motor_adjoint_solver(int index2, int coupling, int adaptive, long interval)
+{
+    double q[SC_N], v[SC_N];
+    const double y0[SCM_R] = {0.0, 0.0};
+    g_motor_p = sc_motor_default();
+    ga_solver *s = motor_solver(1);
+    if (coupling)
+        assert_int_equal(ga_set_coupling(s, scm_coupling), GA_OK);
+    assert_int_equal(ga_set_formulation(s, index2 ? GA_INDEX2_STABILIZED : GA_INDEX3), GA_OK);
+    assert_int_equal(ga_set_output(s, GA_OUTPUT_STEP), GA_OK);
+    assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT,
+                                               5000),
+                     GA_OK);
+    if (interval > 0)
+        assert_int_equal(ga_set_adjoint_checkpoints(s, interval, 5000 / interval + 1), GA_OK);
+    sc_initial(&g_motor_p.crank, M_PI / 2, q, v);
+    assert_int_equal(ga_init_y(s, 0.0, q, v, y0), GA_OK);
+    if (adaptive)
+        assert_int_equal(ga_set_tolerances(s, 1e-5, 1e-5), GA_OK);
+    return s;
+}
+
 static void first_order_adjoint(void **state)
 {
     (void)state;
@@ -569,22 +593,8 @@ static void first_order_adjoint(void **state)
         for (int k = 0; k < 3; ++k)
             for (int i = 0; i < SC_N; ++i)
                 g_cw[k][i] = k == 2 && !index2 ? 0.0 : (double)rand() / RAND_MAX - 0.5;
-        g_motor_p = sc_motor_default();
         double q[SC_N], v[SC_N], qdd[SC_N], lam[SC_M], d[4][SC_N];
-        const double y0[SCM_R] = {0.0, 0.0};
-        ga_solver *s = motor_solver(1);
-        if (coupling)
-            assert_int_equal(ga_set_coupling(s, scm_coupling), GA_OK);
-        assert_int_equal(ga_set_formulation(s, index2 ? GA_INDEX2_STABILIZED : GA_INDEX3),
-                         GA_OK);
-        assert_int_equal(ga_set_output(s, GA_OUTPUT_STEP), GA_OK);
-        assert_int_equal(ga_set_sensitivity_method(
-                             s, GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT, 5000),
-                         GA_OK);
-        sc_initial(&g_motor_p.crank, M_PI / 2, q, v);
-        assert_int_equal(ga_init_y(s, 0.0, q, v, y0), GA_OK);
-        if (adaptive)
-            assert_int_equal(ga_set_tolerances(s, 1e-5, 1e-5), GA_OK);
+        ga_solver *s = motor_adjoint_solver(index2, coupling, adaptive, 0);
         double J_fwd = 0.0, dJ_fwd[6] = {0}, prev[7] = {0}, t = 0.0, t_prev = 0.0;
         const double t_end = 0.1;
         for (int step = 0;; ++step) {
@@ -640,21 +650,7 @@ static void first_order_adjoint(void **state)
         worst = fmax(worst, rel);
         ga_free(s);
         /* with checkpoints every 7 steps: the same numbers, bit for bit */
-        g_motor_p = sc_motor_default();
-        ga_solver *c = motor_solver(1);
-        if (coupling)
-            assert_int_equal(ga_set_coupling(c, scm_coupling), GA_OK);
-        assert_int_equal(ga_set_formulation(c, index2 ? GA_INDEX2_STABILIZED : GA_INDEX3),
-                         GA_OK);
-        assert_int_equal(ga_set_output(c, GA_OUTPUT_STEP), GA_OK);
-        assert_int_equal(ga_set_sensitivity_method(
-                             c, GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT, 5000),
-                         GA_OK);
-        assert_int_equal(ga_set_adjoint_checkpoints(c, 7, 800), GA_OK);
-        sc_initial(&g_motor_p.crank, M_PI / 2, q, v);
-        assert_int_equal(ga_init_y(c, 0.0, q, v, y0), GA_OK);
-        if (adaptive)
-            assert_int_equal(ga_set_tolerances(c, 1e-5, 1e-5), GA_OK);
+        ga_solver *c = motor_adjoint_solver(index2, coupling, adaptive, 7);
         for (t = 0.0; t < t_end * (1 - 1e-12);) {
             assert_int_equal(adaptive ? ga_step_adaptive(c, t_end) : ga_step(c, t_end / 100),
                              GA_OK);
