@@ -408,16 +408,17 @@ ga_status Solver::rate_parameter_residual(int j, double t, const State &x)
 // The constraints' share of R_p (GA_DEPENDS_CONSTRAINT) at the converged step x: into sens.cq
 // d/dp_j (Phi_q^T lambda), into sens.cl dPhi/dp_j and, with `velocity`, into sens.cv
 // d/dp_j (Phi_q v + Phi_t); with `correction` (index 2) into sens.cbt the derivative of the
-// position correction -B^T eta_bar, B = Phi_q(q_n) at t_n. Zero without that flag.
+// position correction -B^T eta_bar, B = Phi_q(q_n) at t_n. Without that flag they stay the
+// zeros they were allocated as.
 ga_status Solver::constraint_parameter_terms(int j, double t, const State &x, bool velocity,
                                              bool correction, double t_n, const Vec &q_n,
                                              const Vec &eta)
 {
     Sensitivities &z = sens;
-    for (Vec *c : {&z.cq, &z.cl, &z.cv, &z.cbt})
-        c->setZero();
     if (!(z.depends & GA_DEPENDS_CONSTRAINT) || m_ == 0)
         return GA_OK;
+    for (Vec *c : {&z.cq, &z.cl, &z.cv, &z.cbt})
+        c->setZero();
     ModelMatrix &Jp = z.J_pert;
     if (model.cb.constraint_p) {
         if (auto st = model.constraint_p(t, x.q, j, z.cl, Jp, velocity ? &z.cv : nullptr))
