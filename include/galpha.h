@@ -793,7 +793,9 @@ typedef enum ga_sensitivity_method {
 /** methods is an or of ::ga_sensitivity_method; with GA_SENSITIVITY_ADJOINT each accepted step
  *  from ga_init on is recorded (its size, q, v, qdd, lambda: 3 n + 2 m + 4 doubles), for up to
  *  max_steps steps, allocated here; a step beyond them fails with GA_ERR_NOMEM and changes
- *  nothing. After ga_set_sensitivity, before ga_init. Errors: GA_ERR_ARG (no method, unknown
+ *  nothing. A rejected adaptive step then drops the kept iteration matrix (one factorization
+ *  more per rejection), so that the run can be repeated from a checkpoint bit for bit
+ *  (ga_set_adjoint_checkpoints). After ga_set_sensitivity, before ga_init. Errors: GA_ERR_ARG (no method, unknown
  *  flags, max_steps < 1 with the adjoint), GA_ERR_STATE (no parameters, after ga_init),
  *  GA_ERR_NOMEM. */
 GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_steps);
