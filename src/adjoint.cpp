@@ -184,7 +184,6 @@ struct Solver::AdjointWork {
     {
         for (Vec *v : {&my, &mydot, &mw, &ry, &yp})
             v->setZero(r);
-        x.allocate_first_order(r);
         for (Vec *v : {&mq, &mv, &mqdd, &ma, &cq, &cv, &cqdd, &yq, &zq, &rr, &qp, &vp, &tmp})
             v->setZero(n);
         for (Vec *v : {&ml, &cl, &yl, &ye, &zl, &ze, &rl, &rv, &eta})

@@ -58,3 +58,15 @@ int scm_coupling(double t, const double *q, const double *v, const double *y, do
     f_y[SC_TH1 + SC_N * SCM_I] = p->Kt;
     return 0;
 }
+
+ga_status scm_declare(ga_solver *s, sc_motor *p)
+{
+    ga_status st = ga_set_callbacks(s, sc_mass, NULL, sc_constraint, sc_jacobian, p);
+    if (!st)
+        st = ga_set_constraint_accel(s, sc_constraint_accel);
+    if (!st)
+        st = ga_set_constraint_dt(s, sc_constraint_dt);
+    if (!st)
+        st = ga_set_first_order(s, SCM_R, scm_force, scm_rate);
+    return st;
+}

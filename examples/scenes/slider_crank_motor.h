@@ -11,6 +11,8 @@
 #ifndef GALPHA_SCENE_SLIDER_CRANK_MOTOR_H
 #define GALPHA_SCENE_SLIDER_CRANK_MOTOR_H
 
+#include <galpha.h>
+
 #include "slider_crank.h"
 
 #ifdef __cplusplus
@@ -35,6 +37,9 @@ int scm_rate(double t, const double *q, const double *v, const double *y, double
 /* the exact coupling blocks g_q (0), g_v, g_y, f_y */
 int scm_coupling(double t, const double *q, const double *v, const double *y, double *g_q,
                  double *g_v, double *g_y, double *f_y, void *user);
+/* The scene on a new solver: the callbacks (user p), the constraint acceleration and Phi_t,
+ * the two first-order states; the first failing status, or GA_OK. */
+ga_status scm_declare(ga_solver *s, sc_motor *p);
 
 #ifdef __cplusplus
 }

@@ -21,11 +21,7 @@ static ga_solver *motor_solver(int formulation)
 {
     ga_solver *s = NULL;
     assert_int_equal(ga_create(SC_N, SC_M, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, sc_mass, NULL, sc_constraint, sc_jacobian, &g_motor),
-                     GA_OK);
-    assert_int_equal(ga_set_constraint_accel(s, sc_constraint_accel), GA_OK);
-    assert_int_equal(ga_set_constraint_dt(s, sc_constraint_dt), GA_OK);
-    assert_int_equal(ga_set_first_order(s, SCM_R, scm_force, scm_rate), GA_OK);
+    assert_int_equal(scm_declare(s, &g_motor), GA_OK);
     assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
     return s;
 }

@@ -415,11 +415,7 @@ static ga_solver *motor_solver(int sens)
 {
     ga_solver *s = NULL;
     assert_int_equal(ga_create(SC_N, SC_M, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, sc_mass, NULL, sc_constraint, sc_jacobian, &g_motor_p),
-                     GA_OK);
-    assert_int_equal(ga_set_constraint_accel(s, sc_constraint_accel), GA_OK);
-    assert_int_equal(ga_set_constraint_dt(s, sc_constraint_dt), GA_OK);
-    assert_int_equal(ga_set_first_order(s, SCM_R, scm_force, scm_rate), GA_OK);
+    assert_int_equal(scm_declare(s, &g_motor_p), GA_OK);
     if (sens)
         assert_int_equal(ga_set_sensitivity(s, 6, &g_motor_p.Kt, NULL,
                                             GA_DEPENDS_FORCE | GA_DEPENDS_RATE),
