@@ -119,9 +119,11 @@ typedef enum ga_status {
     GA_ERR_INTERNAL = -10,      /**< unexpected internal error, including a C++ exception thrown
                                      by a user callback written in C++ */
     GA_ERR_STEP_SIZE = -11,     /**< adaptive mode: the step size fell below its minimum */
-    GA_EVENT = 1                /**< not an error: ga_step, ga_step_adaptive or ga_advance stopped
+    GA_EVENT = 1,               /**< not an error: ga_step, ga_step_adaptive or ga_advance stopped
                                      at a terminal event (or with its event log full); see
                                      ga_set_events */
+    GA_STOPPED = 2              /**< not an error: the step hook asked to stop after an accepted
+                                     step (ga_set_step_hook) */
 } ga_status;
 
 /** Fixed English name of a status (a ::ga_status value), e.g. "invalid argument"; "unknown
@@ -209,7 +211,7 @@ GA_API ga_status ga_init(ga_solver *s, double t0, const double *q0, const double
 /** Advance by exactly one step of size h > 0 (Algorithm 1). With event functions
  *  (ga_set_events) it returns GA_EVENT, a success, when a terminal one fired in the step (or in
  *  the rest of the step a call before stopped in: then no step is taken). The step is
- *  transactional: unless GA_OK or GA_EVENT is returned, t, q, v, qdd, lambda and a are bit-identical to the last accepted step
+ *  transactional: unless GA_OK, GA_EVENT or GA_STOPPED (ga_set_step_hook) is returned, t, q, v, qdd, lambda and a are bit-identical to the last accepted step
  *  (work counters do count the failed attempt). After GA_ERR_CALLBACK_RETRY, GA_ERR_NEWTON,
  *  GA_ERR_NONFINITE or GA_ERR_SINGULAR the caller may retry, typically with a smaller h.
  *  A step more than 100 times shorter than the one before (a sliver that lands on an output
@@ -536,7 +538,8 @@ GA_API ga_status ga_set_initial_step(ga_solver *s, double h0);
 GA_API ga_status ga_step_adaptive(ga_solver *s, double t_stop);
 
 /** Adaptive steps until t_out (>= t), landing on it exactly (ga_get_t then returns t_out),
- *  or until a terminal event: GA_EVENT, with t at the end of the step that holds it.
+ *  or until a terminal event: GA_EVENT, with t at the end of the step that holds it, or until
+ *  the step hook asks to stop: GA_STOPPED, with t at the end of that step.
  *  Errors: as ga_step_adaptive; steps accepted before a failure are kept. */
 GA_API ga_status ga_advance(ga_solver *s, double t_out);
 
@@ -600,6 +603,26 @@ typedef enum ga_event_direction {
  *  (the events set before stay). */
 GA_API ga_status ga_set_events(ga_solver *s, int count, ga_event_fn fn, const int *direction,
                                const int *terminal, int with_multipliers);
+
+/** Step hook: called after every step that ga_step, ga_step_adaptive or ga_advance accepts,
+ *  with the solver (for reading only: ga_get_*, ga_interpolate*, ga_get_sensitivity, counters),
+ *  the step's t, q (n), v (n), lambda (m; NULL unless asked for, see ga_set_step_hook) and its
+ *  own user pointer. Return 0 to go on; nonzero stops the call after this step, which stays
+ *  accepted: the call returns GA_STOPPED (GA_EVENT if a terminal event stops it too). */
+typedef int (*ga_step_hook_fn)(const ga_solver *s, double t, const double *q, const double *v,
+                               const double *lambda, void *user);
+
+/** Install the step hook `fn` with its `user` pointer (fn NULL removes it), for progress
+ *  reports, on-line reductions (a peak force, an energy balance) and recording without a loop
+ *  around ga_step. with_multipliers nonzero: fn receives lambda as ga_get_lambda gives it (in
+ *  GA_OUTPUT_CONSISTENT one saddle-point solve per step, whose failure fails the step and
+ *  undoes it); zero: lambda is NULL. Not called for steps an adjoint sweep computes again from
+ *  its checkpoints, nor by ga_init. Calls that change the solver are refused from the hook
+ *  (GA_ERR_STATE); a C++ exception thrown by it fails the call (GA_ERR_INTERNAL) and undoes the
+ *  step. Kept by ga_init and ga_set_state; may be set before or after ga_init. Errors:
+ *  GA_ERR_ARG (s NULL), GA_ERR_STATE (from a callback or the hook). */
+GA_API ga_status ga_set_step_hook(ga_solver *s, ga_step_hook_fn fn, void *user,
+                                  int with_multipliers);
 
 /** Events logged by the last ga_step, ga_step_adaptive or ga_advance (each starts an empty
  *  log; ga_advance keeps those of the steps it accepted before a failure; ga_init, ga_set_state

@@ -103,7 +103,7 @@ ga_status reading(const ga_solver *s, const char *name, const char *bad_argument
 {
     if (!s)
         return GA_ERR_ARG;
-    if (s->busy)
+    if (s->busy && !s->in_hook)
         return GA_ERR_STATE;
     const ga_status st = body(s->core);
     if (st != GA_OK)
@@ -117,7 +117,23 @@ ga_status reading(const ga_solver *s, const char *name, const char *bad_argument
 template <class Body>
 ga_status computing(const ga_solver *s, Body &&body)
 {
-    return call(const_cast<ga_solver *>(s), false, std::forward<Body>(body));
+    auto *w = const_cast<ga_solver *>(s);
+    if (w && w->in_hook) {
+        // from the step hook, under the stepping call's guard; the callbacks this evaluates
+        // are refused reads as any callback is
+        w->in_hook = false;
+        ga_status st;
+        try {
+            st = body(w->core);
+        } catch (const std::bad_alloc &) {
+            st = w->core.diag.fail(GA_ERR_NOMEM, "out of memory");
+        } catch (...) {
+            st = w->core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception");
+        }
+        w->in_hook = true;
+        return st;
+    }
+    return call(w, false, std::forward<Body>(body));
 }
 
 ga_status copy_out(const ga::Solver &c, const ga::Vec &x, double *out)
@@ -211,6 +227,7 @@ GA_API const char *ga_strerror(int status)
     case GA_ERR_INTERNAL: return "internal error";
     case GA_ERR_STEP_SIZE: return "step size below its minimum";
     case GA_EVENT: return "stopped at an event";
+    case GA_STOPPED: return "stopped by the step hook";
     }
     return "unknown status";
 }
@@ -629,6 +646,23 @@ GA_API ga_status ga_set_events_y(ga_solver *s, int count, ga_event_y_fn fn, cons
 {
     return set_events(s, "ga_set_events_y", count, nullptr, fn, direction, terminal,
                       with_multipliers);
+}
+
+GA_API ga_status ga_set_step_hook(ga_solver *s, ga_step_hook_fn fn, void *user,
+                                  int with_multipliers)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        ga::Solver::StepHook hook;
+        if (fn) {
+            hook.fn = fn;
+            hook.user = user;
+            hook.handle = s;
+            hook.running = &s->in_hook;
+            hook.with_lambda = with_multipliers != 0;
+        }
+        c.set_step_hook(hook);  // may throw std::bad_alloc: the hook stays as it was
+        return GA_OK;
+    });
 }
 
 GA_API ga_status ga_get_event_count(const ga_solver *s, int *count)

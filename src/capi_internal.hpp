@@ -11,4 +11,6 @@ struct ga_solver {
     // true while a call on this solver runs (and so inside its callbacks); atomic, so that a
     // second thread calling the same solver (not allowed) is refused, not let in
     std::atomic<bool> busy{false};
+    // true while the step hook runs (inside a busy call): read-only calls are let in
+    std::atomic<bool> in_hook{false};
 };

@@ -223,7 +223,7 @@ ga_status Solver::advance(double t_out)
         return diag.fail(GA_ERR_ARG, "t_out = %.17g is before t = %.17g", t_out, accepted_.t);
     if (!events_.active()) {
         while (accepted_.t < t_out)
-            if (auto st = adaptive_step(t_out))
+            if (auto st = hooked(true, t_out, &Solver::adaptive_step))
                 return st;
         return GA_OK;
     }
@@ -237,7 +237,7 @@ ga_status Solver::advance(double t_out)
     // each step is undone alone: those accepted before a failure stay, with their events
     while (accepted_.t < t_out) {
         events_.save();
-        if (auto st = step_with_events(true, t_out))
+        if (auto st = hooked(true, t_out, &Solver::adaptive_step_with_events))
             return st;
     }
     return GA_OK;

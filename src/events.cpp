@@ -291,7 +291,7 @@ ga_status Solver::watched_step(bool adaptive, double h_or_t_stop)
 // ga_step with events. The common case -- the search stands at the end of the last step and
 // the functions need no multipliers -- goes without save points: a failure puts back what
 // it changed (the step, t_hi, the log) from what it knows.
-ga_status Solver::step(double h)
+ga_status Solver::one_step(double h)
 {
     EventSet &e = events_;
     if (!e.active())
@@ -322,7 +322,7 @@ ga_status Solver::step(double h)
     return st;
 }
 
-ga_status Solver::step_adaptive(double t_stop)
+ga_status Solver::one_adaptive_step(double t_stop)
 {
     return events_.active() ? watched_step(true, t_stop) : adaptive_step(t_stop);
 }

@@ -8,6 +8,7 @@
 
 #include <cfenv>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "diagnostics.hpp"
@@ -179,6 +180,13 @@ public:
     // r^q = M qdd - f + Phi_q^T lambda: the residual of eq. (1), not weighted.
     static void dynamics_residual(const ModelMatrix &M, const Vec &qdd, const Vec &f,
                                   const ModelMatrix &J, const Vec &lambda, Vec &rq);
+
+    // A user function outside the model (the step hook), in the caller's environment as well.
+    template <class Call>
+    int run_user(Call &&call)
+    {
+        return user(std::forward<Call>(call));
+    }
 
 private:
     void count_event() { ga::count(counters_, GA_COUNT_EVENT_EVALS); }

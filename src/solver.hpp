@@ -3,6 +3,7 @@
 // The consistent start lives in init.cpp, step-size control and dense output in control.cpp.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 
 #include "diagnostics.hpp"
@@ -139,6 +140,15 @@ public:
     ga_status set_adjoint_checkpoints(long interval, long count);
 
     // Events (events.cpp): the functions watched, where their search stands, the last log.
+    // The step hook (ga_set_step_hook), called by step, step_adaptive and advance.
+    struct StepHook {
+        ga_step_hook_fn fn = nullptr;
+        void *user = nullptr;
+        const ga_solver *handle = nullptr;
+        std::atomic<bool> *running = nullptr;  // the handle's flag: reads allowed from the hook
+        bool with_lambda = false;
+    };
+    void set_step_hook(const StepHook &hook);  // step_hook.cpp; throws std::bad_alloc
     EventSet &events() { return events_; }
     const EventSet &events() const { return events_; }
 
@@ -212,7 +222,16 @@ private:
     // after it; a failure of either leaves the solver as it was and the search as the
     // caller saved it.
     ga_status step_with_events(bool adaptive, double h_or_t_stop);
+    ga_status adaptive_step_with_events(double t_stop) { return step_with_events(true, t_stop); }
     ga_status watched_step(bool adaptive, double h_or_t_stop);
+    // ga_step's and ga_step_adaptive's step with events, before the step hook
+    ga_status one_step(double h);
+    ga_status one_adaptive_step(double t_stop);
+    // step_hook.cpp: (this->*step)(arg), then the step hook if a step was accepted; a failure
+    // of the hook's multipliers or a throwing hook undoes that step.
+    ga_status hooked(bool adaptive, double arg, ga_status (Solver::*step)(double));
+    StepHook hook_;
+    Vec hook_lambda_;  // the multipliers the hook sees, its own: reads from the hook reuse out_
     ga_status residual(double t, const State &x);
     // first_order.cpp: the parts of a step that concern first-order states.
     void first_order_start(double h);

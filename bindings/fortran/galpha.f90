@@ -21,7 +21,7 @@ module galpha
        GA_ERR_NOMEM = -3, GA_ERR_CALLBACK = -4, GA_ERR_CALLBACK_RETRY = -5, &
        GA_ERR_NONFINITE = -6, GA_ERR_SINGULAR = -7, GA_ERR_NEWTON = -8, &
        GA_ERR_INCONSISTENT = -9, GA_ERR_INTERNAL = -10, GA_ERR_STEP_SIZE = -11, &
-       GA_EVENT = 1
+       GA_EVENT = 1, GA_STOPPED = 2
   ! ---- options ----------------------------------------------------------------------------
   integer(c_int), parameter, public :: GA_TANGENT_AUTO = 0, GA_TANGENT_FD = 1, &
        GA_TANGENT_NEGLECT = 2
@@ -151,10 +151,19 @@ module galpha
        real(c_double), intent(out) :: value, d_q(*), d_v(*), d_qdd(*), d_lambda(*), d_p(*)
        type(c_ptr), value :: user
      end function ga_cost_fn
+     ! the step hook: after each accepted step; lambda is NULL unless asked for (not to be
+     ! touched then); s is the solver's handle, for reads; nonzero stops (GA_STOPPED)
+     integer(c_int) function ga_step_hook_fn(s, t, q, v, lambda, user) bind(C)
+       import :: c_int, c_double, c_ptr
+       type(c_ptr), value :: s
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*), v(*), lambda(*)
+       type(c_ptr), value :: user
+     end function ga_step_hook_fn
   end interface
   public :: ga_mass_fn, ga_force_fn, ga_constraint_fn, ga_stiffness_fn, ga_event_fn, &
        ga_force_y_fn, ga_coupling_fn, ga_event_y_fn, ga_force_p_fn, ga_mass_p_fn, ga_cost_fn, &
-       ga_constraint_p_fn
+       ga_constraint_p_fn, ga_step_hook_fn
 
   ! ---- the C API, one to one ----------------------------------------------------------------
   interface
@@ -447,6 +456,14 @@ module galpha
        integer(c_int), intent(in), optional :: direction(*), terminal(*)  ! absent: NULL
        integer(c_int), value :: with_multipliers
      end function ga_set_events
+     integer(c_int) function ga_set_step_hook(s, fn, user, with_multipliers) &
+          bind(C, name="ga_set_step_hook")
+       import :: c_int, c_ptr, c_funptr
+       type(c_ptr), value :: s
+       type(c_funptr), value :: fn
+       type(c_ptr), value :: user
+       integer(c_int), value :: with_multipliers
+     end function ga_set_step_hook
      integer(c_int) function ga_get_event_count(s, count) bind(C, name="ga_get_event_count")
        import :: c_int, c_ptr
        type(c_ptr), value :: s
@@ -597,7 +614,8 @@ module galpha
        ga_set_sensitivity, ga_set_parameter_derivatives, ga_get_sensitivity, &
        ga_set_constraint_parameter_derivative, &
        ga_set_sensitivity_start, ga_get_sensitivity_y, &
-       ga_set_sensitivity_method, ga_adjoint_gradient, ga_set_adjoint_checkpoints
+       ga_set_sensitivity_method, ga_adjoint_gradient, ga_set_adjoint_checkpoints, &
+       ga_set_step_hook
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
@@ -681,6 +699,12 @@ module galpha
      procedure :: set_events => solver_set_events
      !> event_count(): events logged by the last stepping call (-1 if the call fails);
      !> get_event(i, t, index, direction): the i-th (1-based), index 1-based as well
+     !> set_step_hook(fn, user, with_multipliers): fn after each accepted step of step,
+     !> step_adaptive and advance (nonzero return: they stop there with GA_STOPPED); user
+     !> optional (c_null_ptr), with_multipliers optional (.false.: lambda not passed).
+     !> clear_step_hook() removes it
+     procedure :: set_step_hook => solver_set_step_hook
+     procedure :: clear_step_hook => solver_clear_step_hook
      procedure :: event_count => solver_event_count
      procedure :: get_event => solver_get_event
      !> set_first_order(r, rate, force): r first-order states y' = rate(t, q, v, y), force
@@ -875,6 +899,27 @@ contains
     if (ok) status = ga_set_events_y(this%handle, size(direction, kind=c_int), c_funloc(fn), &
          direction, flags, lam)
   end function solver_set_events_y
+
+  integer(c_int) function solver_set_step_hook(this, fn, user, with_multipliers) result(status)
+    class(galpha_solver), intent(inout) :: this
+    procedure(ga_step_hook_fn) :: fn
+    type(c_ptr), intent(in), optional :: user
+    logical, intent(in), optional :: with_multipliers
+    type(c_ptr) :: u
+    integer(c_int) :: lam
+    u = c_null_ptr
+    if (present(user)) u = user
+    lam = 0
+    if (present(with_multipliers)) then
+       if (with_multipliers) lam = 1
+    end if
+    status = ga_set_step_hook(this%handle, c_funloc(fn), u, lam)
+  end function solver_set_step_hook
+
+  integer(c_int) function solver_clear_step_hook(this) result(status)
+    class(galpha_solver), intent(inout) :: this
+    status = ga_set_step_hook(this%handle, c_null_funptr, c_null_ptr, 0_c_int)
+  end function solver_clear_step_hook
 
   integer(c_int) function solver_event_count(this) result(count)
     class(galpha_solver), intent(in) :: this

@@ -405,6 +405,62 @@ static void no_allocation_with_events(void **state)
     }
 }
 
+/* The step hook with multipliers, reading the solver (dense output) and stopping now and then;
+ * with events and failing steps, fixed and adaptive, both formulations. */
+static long hook_calls;
+static int reading_hook(const ga_solver *s, double t, const double *q, const double *v,
+                        const double *lambda, void *user)
+{
+    (void)q, (void)v, (void)lambda, (void)user;
+    double h, qi[2], vi[2], li;
+    if (ga_get_h_last(s, &h) != GA_OK || ga_interpolate(s, t - 0.5 * h, qi, vi, &li) != GA_OK)
+        return -1;
+    return ++hook_calls % 7 == 0;
+}
+
+static void no_allocation_with_step_hook(void **state)
+{
+    (void)state;
+    for (int mode = 0; mode < 6; ++mode) {
+        pendulum p = {1.0, 1.0, 9.81};
+        double q[2], v[2];
+        ga_solver *s = NULL;
+        pendulum_state(&p, 1.5, 0.0, q, v);
+        assert_int_equal(ga_create(2, 1, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, pendulum_mass, force_maybe_failing,
+                                          pendulum_constraint, pendulum_jacobian, &p),
+                         GA_OK);
+        if (mode >= 3)
+            assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
+        const int terminal[3] = {0, 0, 1};
+        assert_int_equal(ga_set_events(s, 3, watch, NULL, terminal, 1), GA_OK);
+        assert_int_equal(ga_set_step_hook(s, reading_hook, NULL, 1), GA_OK);
+        assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        if (mode % 3 > 0)
+            assert_true(ga_step_adaptive(s, 1e3) >= GA_OK);
+        allocations = 0;
+        hook_calls = 0;
+        armed = 1;
+        long stops = 0, failed = 0;
+        for (int i = 0; i < 300; ++i) {
+            fail_force = i % 13 == 6 ? (i % 2 ? -1 : 1) : 0;
+            const ga_status st = mode % 3 == 0 ? ga_step(s, 3e-3)
+                                 : mode % 3 == 1 ? ga_step_adaptive(s, 1e3)
+                                                 : ga_advance(s, 0.01 * (i + 1));
+            stops += st == GA_STOPPED;
+            failed += st < GA_OK;
+        }
+        armed = 0;
+        fail_force = 0;
+        printf("  mode %d: %ld hook calls, %ld stops, %ld failed calls, %ld allocations\n",
+               mode, hook_calls, stops, failed, allocations);
+        assert_true(stops > 0 && failed > 0);
+        assert_int_equal(allocations, 0);
+        ga_free(s);
+    }
+}
+
 /* First-order states: coupling blocks by differences and by callback, both formulations, fixed
  * and adaptive steps, dense and sparse, rate callbacks that fail now and then; with forward
  * sensitivities. */
@@ -568,6 +624,7 @@ int main(void)
         cmocka_unit_test(no_allocation_with_any_dense_kernel),
         cmocka_unit_test(no_allocation_after_tangent_options_change),
         cmocka_unit_test(no_allocation_with_events),
+        cmocka_unit_test(no_allocation_with_step_hook),
         cmocka_unit_test(no_allocation_with_first_order_states),
         cmocka_unit_test(no_allocation_with_sensitivities),
     };

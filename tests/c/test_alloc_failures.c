@@ -144,7 +144,7 @@ static ga_solver *make_redundant(void)
 typedef enum call {
     INIT, INIT_INDEX2, INIT_REDUNDANT, SET_STATE, FORMULATION, TANGENT_MODE, OUTPUT, EVENTS,
     SET_FIRST_ORDER, INIT_Y, SET_SENSITIVITY, SENSITIVITY_METHOD, SENSITIVITY_START,
-    INIT_SENSITIVITY, ADJOINT_CHECKPOINTS
+    INIT_SENSITIVITY, ADJOINT_CHECKPOINTS, STEP_HOOK
 } call;
 static const char *const kNames[] = {"ga_init", "ga_init (index 2)",
                                      "ga_init (a redundant constraint)", "ga_set_state",
@@ -152,7 +152,8 @@ static const char *const kNames[] = {"ga_init", "ga_init (index 2)",
                                      "ga_set_output", "ga_set_events", "ga_set_first_order",
                                      "ga_init_y", "ga_set_sensitivity",
                                      "ga_set_sensitivity_method", "ga_set_sensitivity_start",
-                                     "ga_init (sensitivities)", "ga_set_adjoint_checkpoints"};
+                                     "ga_init (sensitivities)", "ga_set_adjoint_checkpoints",
+                                     "ga_set_step_hook"};
 
 /* event functions that never fire */
 static int far_away(double t, const double *q, const double *v, const double *lambda,
@@ -161,6 +162,14 @@ static int far_away(double t, const double *q, const double *v, const double *la
     (void)t, (void)v, (void)lambda, (void)user;
     g[0] = 100.0 + q[0];
     g[1] = 100.0 - q[1];
+    return 0;
+}
+
+/* a step hook that only watches */
+static int quiet_hook(const ga_solver *s, double t, const double *q, const double *v,
+                      const double *lambda, void *user)
+{
+    (void)s, (void)t, (void)q, (void)v, (void)lambda, (void)user;
     return 0;
 }
 
@@ -186,6 +195,7 @@ static ga_status do_call(ga_solver *s, call c, const double *checkpoint, size_t 
         return ga_set_sensitivity_method(s, GA_SENSITIVITY_FORWARD | GA_SENSITIVITY_ADJOINT, 10);
     case SENSITIVITY_START: return ga_set_sensitivity_start(s, 1, q, v);
     case ADJOINT_CHECKPOINTS: return ga_set_adjoint_checkpoints(s, 2, 3);
+    case STEP_HOOK: return ga_set_step_hook(s, quiet_hook, NULL, 1);
     default: return ga_set_output(s, GA_OUTPUT_CONSISTENT);
     }
 }
@@ -315,6 +325,7 @@ static void sensitivity_method_sweep(void **state) { (void)state; sweep(SENSITIV
 static void sensitivity_start_sweep(void **state) { (void)state; sweep(SENSITIVITY_START); }
 static void init_sensitivity_sweep(void **state) { (void)state; sweep(INIT_SENSITIVITY); }
 static void adjoint_checkpoints_sweep(void **state) { (void)state; sweep(ADJOINT_CHECKPOINTS); }
+static void step_hook_sweep(void **state) { (void)state; sweep(STEP_HOOK); }
 
 int main(void)
 {
@@ -328,6 +339,7 @@ int main(void)
         cmocka_unit_test(sensitivity_sweep),  cmocka_unit_test(sensitivity_method_sweep),
         cmocka_unit_test(sensitivity_start_sweep), cmocka_unit_test(init_sensitivity_sweep),
         cmocka_unit_test(adjoint_checkpoints_sweep),
+        cmocka_unit_test(step_hook_sweep),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

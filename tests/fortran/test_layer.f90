@@ -4,8 +4,10 @@
 
 module layer_events
   use, intrinsic :: iso_c_binding
+  use galpha, only: GA_OK, ga_get_t, ga_get_q, ga_get_v, ga_get_lambda
   implicit none
   real(c_double), target, save :: stiffness(1) = [4.0d0]
+  integer :: hook_calls = 0, hook_mismatches = 0, hook_stop_at = 0
 contains
   ! g(1) = x: the pendulum passes the vertical
   integer(c_int) function vertical(t, q, v, lambda, g, user) bind(C)
@@ -16,6 +18,26 @@ contains
     g(1) = q(1)
     vertical = 0
   end function vertical
+
+  ! the step hook: counts steps, checks what it is passed against the solver's reads, stops
+  ! at call hook_stop_at
+  integer(c_int) function watch_steps(s, t, q, v, lambda, user) bind(C)
+    type(c_ptr), value :: s
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*), lambda(*)
+    type(c_ptr), value :: user
+    real(c_double) :: tt, qq(2), vv(2), ll(1)
+    hook_calls = hook_calls + 1
+    if (ga_get_t(s, tt) /= GA_OK .or. ga_get_q(s, qq) /= GA_OK .or. &
+        ga_get_v(s, vv) /= GA_OK .or. ga_get_lambda(s, ll) /= GA_OK) then
+       hook_mismatches = hook_mismatches + 1
+    else if (tt /= t .or. any(qq /= q(1:2)) .or. any(vv /= v(1:2)) .or. &
+             ll(1) /= lambda(1)) then
+       hook_mismatches = hook_mismatches + 1
+    end if
+    watch_steps = 0
+    if (hook_calls == hook_stop_at) watch_steps = 1
+  end function watch_steps
 
   ! first-order states: x'' = -x + y with y' = -2 y (y = exp(-2 t) from y0 = 1)
   integer(c_int) function unit_mass(t, q, M, user) bind(C)
@@ -289,6 +311,17 @@ program test_layer
   call ok(s%set_events(vertical, [integer(c_int) ::]), 'set_events removes')
   call ok(s%step(1d-3), 'step without events')
   call expect(s%event_count() == 0, 'no events logged')
+
+  ! the step hook, with multipliers: called once per step with what the solver reads give
+  hook_stop_at = 10
+  call ok(s%set_step_hook(watch_steps, with_multipliers=.true.), 'set_step_hook')
+  call expect(s%advance(s%t() + 1.0d0) == GA_STOPPED, 'the hook stops advance')
+  call expect(hook_calls == 10 .and. hook_mismatches == 0, 'hook calls and what they see')
+  call ok(s%step(1d-3), 'step with the hook')
+  call expect(hook_calls == 11, 'one call per step')
+  call ok(s%clear_step_hook(), 'clear_step_hook')
+  call ok(s%step(1d-3), 'step without the hook')
+  call expect(hook_calls == 11, 'no call after clear_step_hook')
 
   ! first-order states: y = exp(-2 t); the step's error at h = 1e-3 is ~1e-7 (order 2, C suite)
   call r%free()

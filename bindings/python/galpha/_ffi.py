@@ -109,6 +109,8 @@ CONSTRAINT_P_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, ct
 COST_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
                            c_double_p, c_double_p, c_double_p, c_double_p, c_double_p,
                            c_double_p, c_double_p, ctypes.c_void_p)
+STEP_HOOK_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double, c_double_p,
+                                c_double_p, c_double_p, ctypes.c_void_p)  # (s, t, q, v, lam, user)
 COUPLING_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
                                c_double_p, c_double_p, c_double_p, c_double_p, ctypes.c_void_p)
 
@@ -126,6 +128,7 @@ GA_ERR_INCONSISTENT = -9
 GA_ERR_INTERNAL = -10
 GA_ERR_STEP_SIZE = -11
 GA_EVENT = 1  # not an error: a stepping call stopped at an event
+GA_STOPPED = 2  # not an error: the step hook asked to stop
 
 # Sensitivity dependence flags (ga_depends).
 GA_DEPENDS_FORCE = 1
@@ -216,6 +219,7 @@ _SIGNATURES = {
     "ga_interpolate_qdd": (_I, [_S, _D, c_double_p]),
     "ga_set_output": (_I, [_S, _I]),
     "ga_set_events": (_I, [_S, _I, EVENT_FN, _P(_I), _P(_I), _I]),
+    "ga_set_step_hook": (_I, [_S, STEP_HOOK_FN, ctypes.c_void_p, _I]),
     "ga_get_event_count": (_I, [_S, _P(_I)]),
     "ga_get_event": (_I, [_S, _I, _P(_D), _P(_I), _P(_I)]),
     "ga_set_first_order": (_I, [_S, _I, FORCE_Y_FN, RATE_FN]),

@@ -38,6 +38,7 @@ _FORCE_P = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _i, _vp, _vp)
 _MASS_P = ctypes.CFUNCTYPE(_i, _d, _vp, _i, _vp, _vp, _vp)
 _CONSTRAINT_P = ctypes.CFUNCTYPE(_i, _d, _vp, _i, _vp, _vp, _vp, _vp)
 _COST = ctypes.CFUNCTYPE(_i, _d, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp, _vp)
+_HOOK = ctypes.CFUNCTYPE(_i, _vp, _d, _vp, _vp, _vp, _vp)
 
 # The derivatives of the accepted step in the sensitivity parameters (Solver.sensitivity).
 Sensitivity = collections.namedtuple("Sensitivity", "dq dv dqdd dlam dy dydot")
@@ -45,6 +46,46 @@ Sensitivity = collections.namedtuple("Sensitivity", "dq dv dqdd dlam dy dydot")
 
 def _cast(fn, ctype):
     return ctypes.cast(fn, ctype) if fn is not None else ctype()
+
+
+def native_address(fn):
+    """The C address of a compiled callback -- a numba cfunc, a ctypes function pointer or an
+    int address -- or None for a Python callable (or None)."""
+    if fn is None or isinstance(fn, bool):
+        return None
+    if isinstance(fn, int):
+        if fn <= 0:
+            raise ValueError("a callback address must be a positive int, got %d" % fn)
+        return fn
+    if isinstance(fn, ctypes._CFuncPtr):
+        address = ctypes.cast(fn, ctypes.c_void_p).value
+        if not address:
+            raise ValueError("a NULL ctypes function pointer is not a callback")
+        return address
+    address = getattr(fn, "address", None)  # numba.cfunc (CFunc: address, ctypes, native_name)
+    if isinstance(address, int) and hasattr(fn, "native_name"):
+        return address
+    return None
+
+
+def user_pointer(user):
+    """(address, what keeps it alive) of the `user` argument passed to compiled callbacks: None
+    (NULL), an int address, a numpy array (its data), or a ctypes object (its address)."""
+    if user is None:
+        return None, None
+    if isinstance(user, bool):
+        raise TypeError("user must be None, an int address, a numpy array or a ctypes object")
+    if isinstance(user, int):
+        return user, None
+    if isinstance(user, np.ndarray):
+        if not user.flags.c_contiguous:
+            raise ValueError("user: a numpy array passed to C must be contiguous")
+        return user.ctypes.data, user
+    if isinstance(user, ctypes._SimpleCData) or isinstance(user, (ctypes.Structure,
+                                                                   ctypes.Array)):
+        return ctypes.addressof(user), user
+    raise TypeError("user must be None, an int address, a numpy array or a ctypes object, "
+                    "not %s" % type(user).__name__)
 
 
 _PATTERN_MATRICES = {"mass": _ffi.GA_MATRIX_MASS, "jacobian": _ffi.GA_MATRIX_JACOBIAN,
@@ -180,11 +221,19 @@ class Solver:
         Checkpointing for records that do not fit (ga_set_adjoint_checkpoints): one segment
         of `interval` steps kept, a checkpoint after every interval-th step, runs of up to
         interval * count steps; adjoint_gradient() computes earlier segments again.
+    user : None, int, numpy array or ctypes object
+        The `user` pointer compiled callbacks receive (void *user: an address, a numpy
+        array's data, a ctypes object's address); NULL by default. Python callbacks ignore it.
     zero_copy : bool
         False (default): callbacks get copies of their inputs and an array of their own to
         fill, so what they keep stays valid and unchanged after the call. True: views of the
         library's buffers instead, faster (see docs/performance.md), valid only during the
         call (inputs read-only; nothing may be kept, written or read after the call returns).
+
+    Every callback may instead be compiled: a numba cfunc (`numba.cfunc(sig)(fn)`), a ctypes
+    function pointer or an int address, with the C signature of the header's ga_*_fn; it is
+    called directly from C, without Python (examples/python/numba_pendulum.py). Arrays arrive
+    as raw pointers: column-major, dense or pattern values as with Python callbacks.
 
     Use as a context manager, or call close(); the handle is also freed by the garbage
     collector.
@@ -201,13 +250,17 @@ class Solver:
                  coupling_patterns=None, parameters=None, depends=("force",),
                  parameter_scale=None, force_p=None, mass_p=None, constraint_p=None,
                  sensitivity_method=("forward",), max_steps=None, adjoint_checkpoints=None,
-                 zero_copy=False):
+                 zero_copy=False, user=None):
         self._ptr = None
         self._lock = threading.RLock()  # see _serialized
         self._pending = None          # exception raised inside a callback
         self._interrupted = False     # SIGINT during a call into C (_InterruptsDeferred)
         self._in_callback = 0         # callbacks of this solver running now
         self._views = {}              # (address, shape, writeable) -> ndarray
+        self._compiled = []           # compiled callbacks (and the user data) kept alive
+        self._user_address, keep = user_pointer(user)
+        self._compiled.append(keep)
+        self._hook = None
         self.n, self.m = int(n), int(m)
         handle = ctypes.c_void_p()
         self._check(_ffi.ga_create(self.n, self.m, ctypes.byref(handle)))
@@ -312,28 +365,28 @@ class Solver:
         sM, sJ = shape("mass", (n, n)), shape("jacobian", (m, n))
         self._jacobian_shape = sJ
         sK, sC = shape("stiffness", (n, n)), shape("damping", (n, n))
+        slot = self._slot
         self._cbs = [
-            _MASS(lambda t, q, M, u: call(mass, M, sM, t, (q, n))),
-            _FORCE(lambda t, q, qd, f, u: call(force, f, (n,), t, (q, n), (qd, n)))
-            if force else None,
-            _CONSTRAINT(lambda t, q, p, u: call(constraint, p, (m,), t, (q, n)))
-            if m and constraint else None,
-            _CONSTRAINT(lambda t, q, J, u: call(jacobian, J, sJ, t, (q, n)))
-            if m and jacobian else None,
-            _STIFFNESS(lambda t, q, qd, a, lam, K, u: call(
-                stiffness, K, sK, t, (q, n), (qd, n), (a, n), (lam, m))) if stiffness else None,
-            _FORCE(lambda t, q, qd, C, u: call(damping, C, sC, t, (q, n), (qd, n)))
-            if damping else None,
-            _FORCE(lambda t, q, qd, o, u: call(constraint_accel, o, (m,), t, (q, n), (qd, n)))
-            if constraint_accel else None,
-            _CONSTRAINT(lambda t, q, o, u: call(constraint_dt, o, (m,), t, (q, n)))
-            if m and constraint_dt else None,
+            slot(mass, _MASS, lambda t, q, M, u: call(mass, M, sM, t, (q, n))),
+            slot(force, _FORCE, lambda t, q, qd, f, u: call(force, f, (n,), t, (q, n), (qd, n))),
+            slot(constraint if m else None, _CONSTRAINT,
+                 lambda t, q, p, u: call(constraint, p, (m,), t, (q, n))),
+            slot(jacobian if m else None, _CONSTRAINT,
+                 lambda t, q, J, u: call(jacobian, J, sJ, t, (q, n))),
+            slot(stiffness, _STIFFNESS, lambda t, q, qd, a, lam, K, u: call(
+                stiffness, K, sK, t, (q, n), (qd, n), (a, n), (lam, m))),
+            slot(damping, _FORCE,
+                 lambda t, q, qd, C, u: call(damping, C, sC, t, (q, n), (qd, n))),
+            slot(constraint_accel, _FORCE, lambda t, q, qd, o, u: call(
+                constraint_accel, o, (m,), t, (q, n), (qd, n))),
+            slot(constraint_dt if m else None, _CONSTRAINT,
+                 lambda t, q, o, u: call(constraint_dt, o, (m,), t, (q, n))),
         ]
         mc, fc, cc, jc, kc, dc, ac, tc = self._cbs
         self._check(_ffi.ga_set_callbacks(self._ptr, _cast(mc, _ffi.MASS_FN),
                                           _cast(fc, _ffi.FORCE_FN),
                                           _cast(cc, _ffi.CONSTRAINT_FN),
-                                          _cast(jc, _ffi.JACOBIAN_FN), None))
+                                          _cast(jc, _ffi.JACOBIAN_FN), self._user_address))
         if kc or dc:
             self._check(_ffi.ga_set_tangents(self._ptr, _cast(kc, _ffi.STIFFNESS_FN),
                                              _cast(dc, _ffi.DAMPING_FN)))
@@ -347,15 +400,15 @@ class Solver:
             r = self.r
             self._user.update(rate=rate, force_y=force_y, coupling=coupling)
             fo = [
-                _EVENT(lambda t, q, qd, y, f, u: call(force_y, f, (n,), t, (q, n), (qd, n),
-                                                      (y, r))) if force_y else None,
-                _EVENT(lambda t, q, qd, y, yd, u: call(rate, yd, (r,), t, (q, n), (qd, n),
-                                                       (y, r))) if rate else None,
-                _COUPLING(lambda t, q, qd, y, gq, gv, gy, fy, u: call(
+                slot(force_y, _EVENT, lambda t, q, qd, y, f, u: call(
+                    force_y, f, (n,), t, (q, n), (qd, n), (y, r))),
+                slot(rate, _EVENT, lambda t, q, qd, y, yd, u: call(
+                    rate, yd, (r,), t, (q, n), (qd, n), (y, r))),
+                slot(coupling, _COUPLING, lambda t, q, qd, y, gq, gv, gy, fy, u: call(
                     lambda t, q, qd, y, out: coupling(t, q, qd, y, out[0], out[1], out[2],
                                                       out[3]),
                     (gq, gv, gy, fy), ((r, n), (r, n), (r, r), (n, r)), t, (q, n), (qd, n),
-                    (y, r))) if coupling else None,
+                    (y, r))),
             ]
             self._cbs += fo
             self._check(_ffi.ga_set_first_order(self._ptr, r, _cast(fo[0], _ffi.FORCE_Y_FN),
@@ -448,13 +501,12 @@ class Solver:
                                             None if sc is None else self._dp(sc), flags))
         self._parameters = (p, sc)  # alive as long as the solver: the library holds p
         n, call = self.n, self._call
+        slot = self._slot
         cbs = [
-            _FORCE_P(lambda t, q, qd, j, out, u: call(
-                lambda t, q, qd, o: force_p(t, q, qd, j, o), out, (n,), t, (q, n), (qd, n)))
-            if force_p else None,
-            _MASS_P(lambda t, q, j, a, out, u: call(
-                lambda t, q, a, o: mass_p(t, q, j, a, o), out, (n,), t, (q, n), (a, n)))
-            if mass_p else None,
+            slot(force_p, _FORCE_P, lambda t, q, qd, j, out, u: call(
+                lambda t, q, qd, o: force_p(t, q, qd, j, o), out, (n,), t, (q, n), (qd, n))),
+            slot(mass_p, _MASS_P, lambda t, q, j, a, out, u: call(
+                lambda t, q, a, o: mass_p(t, q, j, a, o), out, (n,), t, (q, n), (a, n))),
         ]
         if force_p or mass_p:
             self._cbs += cbs
@@ -470,7 +522,7 @@ class Solver:
                 return call(lambda t, q, outs: constraint_p(
                     t, q, j, outs[0], outs[1], outs[2] if len(outs) > 2 else None),
                     places, shapes, t, (q, n))
-            cb = _CONSTRAINT_P(trampoline)
+            cb = slot(constraint_p, _CONSTRAINT_P, trampoline)
             self._cbs.append(cb)
             self._check(_ffi.ga_set_constraint_parameter_derivative(
                 self._ptr, _cast(cb, _ffi.CONSTRAINT_P_FN)))
@@ -528,6 +580,8 @@ class Solver:
         def trampoline(fn):
             if fn is None:
                 return None
+            if native_address(fn) is not None:
+                return self._slot(fn, _COST, None)
 
             def c(t, q, qd, qdd, lam, value, dq, dv, dqdd, dlam, dp, u):
                 if self._pending is not None or self._interrupted:
@@ -555,6 +609,21 @@ class Solver:
         return float(J[0]), dJ[:npar].copy()
 
     # ---- plumbing ---------------------------------------------------------------------------
+    def _slot(self, fn, ctype, trampoline):
+        """The C function pointer of one callback: fn's own if it is compiled (numba cfunc,
+        ctypes function pointer, int address; it gets the solver's `user`), else the Python
+        trampoline. None if fn is None."""
+        if fn is None:
+            return None
+        address = native_address(fn)
+        if address is not None:
+            self._compiled.append(fn)
+            return ctype(address)
+        if not callable(fn):
+            raise TypeError("a callback must be callable, a numba cfunc, a ctypes function "
+                            "pointer or an int address, not %s" % type(fn).__name__)
+        return ctype(trampoline)
+
     def _view(self, address, shape, writeable=False):
         key = (address, shape, writeable)
         arr = self._views.get(key)
@@ -577,7 +646,7 @@ class Solver:
         if status < _ffi.GA_OK:
             message = _ffi.ga_last_error(self._ptr).decode() if self._ptr else ""
             raise error_for(status, message)
-        return status == _ffi.GA_EVENT
+        return status in (_ffi.GA_EVENT, _ffi.GA_STOPPED)
 
     def _handle(self):
         if self._ptr is None:
@@ -704,32 +773,60 @@ class Solver:
     @_runs_callbacks
     def step(self, h):
         """One step of size h. On failure raises; the state stays at the last accepted step.
-        True if it stopped at a terminal event (see set_events), else False."""
+        True if it stopped at a terminal event (see set_events) or the step hook asked to stop
+        (set_step_hook), else False."""
         return self._check(_ffi.ga_step(self._handle(), float(h)))
 
     @_serialized
     @_runs_callbacks
     def step_adaptive(self, t_stop):
         """One error-controlled step, not beyond t_stop (see ga_step_adaptive). True if it
-        stopped at a terminal event."""
+        stopped at a terminal event or by the step hook."""
         return self._check(_ffi.ga_step_adaptive(self._handle(), float(t_stop)))
 
     @_serialized
     @_runs_callbacks
     def advance(self, t_out):
         """Error-controlled steps until t_out exactly (see ga_advance), or until a terminal
-        event: True then (the solver at the end of the step holding it), else False."""
+        event or the step hook asks to stop: True then (the solver at the end of that step),
+        else False."""
         return self._check(_ffi.ga_advance(self._handle(), float(t_out)))
 
     @_serialized
-    def set_events(self, functions, multipliers=False, states=False):
+    def set_events(self, functions, multipliers=False, states=False, direction=None,
+                   terminal=None):
         """Watch event functions g(t, q, v, lam) -> float (see ga_set_events), each with the
         optional attributes of scipy's solve_ivp: `direction` (> 0 rising, < 0 falling, 0
         either; default 0) and `terminal` (true: step, step_adaptive and advance stop there
         and return True; default False). lam is None unless `multipliers` (then the
         multipliers at the located state, consistent with q and v). With `states`, the
         functions are g(t, q, v, lam, y) with the first-order states y (ga_set_events_y). An
-        empty list removes them. The events found by the last stepping call: `events`."""
+        empty list removes them. The events found by the last stepping call: `events`.
+
+        `functions` may also be one compiled function (numba cfunc, ctypes function pointer
+        or address) with the C signature of ga_event_fn (ga_event_y_fn with `states`) that
+        fills all of g; then `direction` and `terminal` are sequences giving their number."""
+        if native_address(functions) is not None:
+            if direction is None:
+                raise ValueError("a compiled event function needs `direction` (one entry per "
+                                 "function)")
+            count = len(direction)
+            terminal = [True] * count if terminal is None else list(terminal)
+            if len(terminal) != count:
+                raise ValueError("direction and terminal differ in length")
+            dirs = (_i * max(count, 1))(*[int(np.sign(d)) for d in direction])
+            terms = (_i * max(count, 1))(*[int(bool(x)) for x in terminal])
+            if states:
+                cb = self._slot(functions, _EVENT_Y, None)
+                self._check(_ffi.ga_set_events_y(self._handle(), count,
+                                                 _cast(cb, _ffi.EVENT_Y_FN), dirs, terms,
+                                                 int(bool(multipliers))))
+            else:
+                cb = self._slot(functions, _EVENT, None)
+                self._check(_ffi.ga_set_events(self._handle(), count, _cast(cb, _ffi.EVENT_FN),
+                                               dirs, terms, int(bool(multipliers))))
+            self._event_cb, self._event_fns = cb, (functions,)
+            return
         functions = tuple(functions)
         for g in functions:
             if not callable(g):
@@ -767,6 +864,55 @@ class Solver:
             self._check(_ffi.ga_set_events(self._handle(), count, _cast(cb, _ffi.EVENT_FN),
                                            direction, terminal, int(bool(multipliers))))
         self._event_cb, self._event_fns = cb, functions
+
+    @_serialized
+    def set_step_hook(self, fn, multipliers=False, user=None):
+        """Call fn after every accepted step of step, step_adaptive and advance (see
+        ga_set_step_hook); None removes it. A Python fn is called as fn(t, q, v, lam) (lam None
+        unless `multipliers`; arrays as the other callbacks get them) and returns a true value
+        to stop the stepping call after this step, which then returns True. An exception it
+        raises stops the call too and is re-raised from it (the step stays accepted). fn may
+        also be compiled (numba cfunc, ctypes function pointer, address) with the C signature
+        int(const ga_solver *s, double t, const double *q, const double *v,
+        const double *lambda, void *user); `user` as the Solver's (default: the Solver's)."""
+        if fn is None:
+            self._check(_ffi.ga_set_step_hook(self._handle(), _ffi.STEP_HOOK_FN(), None, 0))
+            self._hook = None
+            return
+        n, m = self.n, self.m
+        address = native_address(fn)
+        if address is not None:
+            uaddr, keep = user_pointer(user) if user is not None else (self._user_address, None)
+            cb = _HOOK(address)
+            hold = (fn, keep)
+        else:
+            if user is not None:
+                raise ValueError("user is for compiled hooks; a Python hook sees what it closes "
+                                 "over")
+            if not callable(fn):
+                raise TypeError("the step hook must be callable or compiled, not %s"
+                                % type(fn).__name__)
+            zero_copy, copied, view = self._zero_copy, self._copied, self._view
+
+            def trampoline(handle, t, q, v, lam, u):
+                if self._pending is not None or self._interrupted:
+                    return 1
+                self._in_callback += 1
+                try:
+                    if zero_copy:
+                        args = (view(q, (n,)), view(v, (n,)), view(lam, (m,)) if lam else None)
+                    else:
+                        args = (copied(q, n), copied(v, n), copied(lam, m) if lam else None)
+                    return 1 if fn(t, *args) else 0
+                except BaseException as e:  # re-raised by the call that stepped
+                    self._pending = e
+                    return 1
+                finally:
+                    self._in_callback -= 1
+            cb, uaddr, hold = _HOOK(trampoline), None, fn
+        self._check(_ffi.ga_set_step_hook(self._handle(), ctypes.cast(cb, _ffi.STEP_HOOK_FN),
+                                          uaddr, int(bool(multipliers))))
+        self._hook = (cb, hold)
 
     @property
     @_serialized
