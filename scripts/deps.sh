@@ -20,6 +20,6 @@ ensure_packages() {
 }
 
 BUILD_PACKAGES=(build-essential cmake pkg-config libeigen3-dev liblapack-dev libsuitesparse-dev)
-TEST_PACKAGES=(libcmocka-dev gfortran python3 python3-numpy python3-pytest python3-venv python3-numba binutils
+TEST_PACKAGES=(libcmocka-dev gfortran python3 python3-numpy python3-pytest python3-venv python3-numba python3-tqdm binutils
                valgrind abigail-tools)
 JOBS=$(nproc 2>/dev/null || echo 2)

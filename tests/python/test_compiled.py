@@ -251,3 +251,37 @@ def test_numba_is_not_imported_by_galpha():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_integrate_records_through_the_hook_as_a_step_loop_would():
+    # adaptive integrate runs inside one advance() with the step hook recording: the same
+    # steps and values as stepping from Python
+    p = np.array([1.0, 1.0, 9.81])
+    opts = dict(tolerances=(1e-6, 1e-6), formulation=galpha.GA_INDEX2_STABILIZED)
+    r = galpha.integrate(*py_model(p), (0.0, 1.5), Q0, V0, m=1, progress=False, **opts)
+    ts, qs, lams = [0.0], [np.array(Q0)], []
+    with galpha.Solver(2, 1, *py_model(p), **opts) as s:
+        s.init(0.0, Q0, V0)
+        lams.append(s.lam.copy())
+        while s.t < 1.5:
+            s.step_adaptive(1.5)
+            ts.append(s.t)
+            qs.append(s.q.copy())
+            lams.append(s.lam.copy())
+    np.testing.assert_array_equal(r.t, ts)
+    np.testing.assert_array_equal(r.q, qs)
+    np.testing.assert_array_equal(r.lam, lams)
+    t_eval = np.linspace(0.0, 1.5, 7)
+    r2 = galpha.integrate(*py_model(p), (0.0, 1.5), Q0, V0, m=1, t_eval=t_eval, progress=False,
+                          **opts)
+    np.testing.assert_array_equal(r2.t, t_eval)
+    np.testing.assert_array_equal(r2.q[-1], r.q[-1])
+
+
+def test_integrate_progress_bar(capsys):
+    pytest.importorskip("tqdm")
+    p = np.array([1.0, 1.0, 9.81])
+    for h in (None, 1e-2):
+        galpha.integrate(*py_model(p), (0.0, 0.5), Q0, V0, h=h, m=1, progress=True)
+        err = capsys.readouterr().err
+        assert "galpha:" in err and "/0.5 s" in err and "%" in err

@@ -1,4 +1,6 @@
 """One call from initial values to time histories, in the spirit of scipy's solve_ivp."""
+import sys
+
 import numpy as np
 
 from .errors import GalphaError
@@ -66,8 +68,27 @@ class OdeSolution:
         return self._both(t)[1]
 
 
+def _progress_bar(progress, t0, t1):
+    """A tqdm bar over simulated time, or None: progress=None shows one on a terminal for runs
+    that last over a second, if tqdm is installed (Debian: python3-tqdm); True asks for it
+    (tqdm needed), False never."""
+    if progress is False:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        if progress:
+            raise
+        return None
+    if progress is None and not sys.stderr.isatty():
+        return None
+    return tqdm(total=t1 - t0, unit="s", unit_scale=True, delay=0.0 if progress else 1.0,
+                desc="galpha", leave=False, bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s "
+                "[{elapsed}<{remaining}]")
+
+
 def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=None, t_eval=None,
-              events=None, dense_output=False, y0=None, **options):
+              events=None, dense_output=False, y0=None, progress=None, **options):
     """Integrate from t_span[0] to t_span[1] and record every accepted step, or the states at
     the times t_eval (by dense output, without shortening steps).
 
@@ -87,6 +108,12 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
     recorded point being the event's state.
 
     dense_output: the result's `sol` is the whole run's interpolant (OdeSolution) of q and v.
+
+    progress: a progress bar over simulated time (tqdm, optional): None (default) shows it on a
+    terminal once a run has lasted a second, True always, False never.
+
+    Adaptive runs without events record through the step hook (Solver.set_step_hook) inside
+    one call of Solver.advance; fixed steps and runs with events step from Python.
 
     y0: the initial first-order states, with the options r, rate, force_y (and coupling) of
     Solver; the result's `states` holds their history, and event functions are then
@@ -213,7 +240,32 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
             record_eval(t0)
         if dense_output:
             knot()
-        while True:
+        bar = _progress_bar(progress, t0, t1)
+        if h is None and not events:
+            last = [t0]
+
+            def after_step(t, q, v, lam):
+                if pending is None:
+                    record()
+                else:
+                    record_eval(last[0])
+                if dense_output:
+                    knot()
+                if bar is not None:
+                    bar.update(t - last[0])
+                last[0] = t
+            s.set_step_hook(after_step)
+            try:
+                s.advance(t1)
+            except GalphaError as e:
+                status, message = e.status, str(e)
+            finally:
+                if bar is not None:
+                    bar.close()
+            stepped = True
+        else:
+            stepped = False
+        while not stepped:
             remaining = t1 - s.t
             if remaining <= 1e-12 * max(1.0, abs(t1)):
                 break
@@ -258,6 +310,10 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
                 record_eval(t_prev)
             if dense_output:
                 knot()
+            if bar is not None:
+                bar.update(s.t - t_prev)
+        if bar is not None and not stepped:
+            bar.close()
         stats = s.stats
     result = IntegrateResult(t=np.array(ts), q=np.array(qs), v=np.array(vs),
                              qdd=np.array(as_), lam=np.array(ls).reshape(len(ts), m),
