@@ -20,6 +20,7 @@ ensure_packages() {
 }
 
 BUILD_PACKAGES=(build-essential cmake pkg-config libeigen3-dev liblapack-dev libsuitesparse-dev)
-TEST_PACKAGES=(libcmocka-dev gfortran python3 python3-numpy python3-pytest python3-venv python3-numba python3-tqdm binutils
+TEST_PACKAGES=(libcmocka-dev gfortran python3 python3-numpy python3-pytest python3-venv python3-numba python3-tqdm
+               python3-distributed python3-mpi4py openmpi-bin binutils
                valgrind abigail-tools)
 JOBS=$(nproc 2>/dev/null || echo 2)

@@ -31,5 +31,13 @@ from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceErr
 from .integrate import IntegrateResult, OdeSolution, integrate  # noqa: F401
 from .solver import Sensitivity, Solver  # noqa: F401
 
+
+def __getattr__(name):
+    # galpha.ensemble on first use: `python3 -m galpha.ensemble` must find it not yet imported
+    if name == "ensemble":
+        import importlib
+        return importlib.import_module(".ensemble", __name__)
+    raise AttributeError("module 'galpha' has no attribute %r" % name)
+
 __version__ = _ffi.lib.ga_version().decode()
 library_path = _ffi.path

@@ -1,0 +1,168 @@
+"""galpha.ensemble: one model over many parameter sets on every engine, bit for bit the results
+of serial runs; a run on a reused solver (restarted by init) equals one on a fresh solver;
+failures are data."""
+import math
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+PACKAGE = os.path.join(HERE, "..", "..", "bindings", "python")
+if "GALPHA_PYTHON_INSTALLED" not in os.environ:  # else: the package comes from PYTHONPATH
+    sys.path.insert(0, PACKAGE)
+sys.path.insert(0, HERE)
+import galpha  # noqa: E402
+import galpha.ensemble  # noqa: E402
+import ensemble_models  # noqa: E402
+
+GRID = np.array([[L, g] for L in (0.5, 1.0, 1.5, 2.0) for g in (9.0, 9.81, 11.0)])
+TIMES = [0.0, 0.25, 0.5, 1.0]
+
+
+def same(a, b):
+    for key in ("times", "q", "v", "lam", "status", "steps"):
+        np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+    assert a.message == b.message
+    assert a.summary.keys() == b.summary.keys()
+    for key in a.summary:
+        np.testing.assert_array_equal(a.summary[key], b.summary[key], err_msg=key)
+
+
+@pytest.fixture(scope="module")
+def serial():
+    return galpha.ensemble.run(ensemble_models.pendulum, GRID, TIMES)
+
+
+def test_reused_solver_equals_fresh_solvers(serial):
+    assert serial.q.shape == (len(GRID), len(TIMES), 2) and not serial.failures
+    for i, p in enumerate(GRID):
+        fresh = galpha.ensemble.run(ensemble_models.pendulum, p[None, :], TIMES)
+        for key in ("q", "v", "lam", "steps"):
+            np.testing.assert_array_equal(fresh[key][0], serial[key][i])
+    # the runs are what they claim: on the circle of their length, released from 1 rad
+    L = GRID[:, 0]
+    np.testing.assert_allclose(np.hypot(serial.q[:, :, 0], serial.q[:, :, 1]),
+                               np.repeat(L[:, None], len(TIMES), 1), rtol=1e-9)
+    np.testing.assert_allclose(serial.q[:, 0, 0], L * np.sin(1.0), rtol=1e-15)
+    # energy per unit mass at the end: -g L cos(1) at release
+    np.testing.assert_allclose(serial.summary["energy"], -GRID[:, 1] * L * np.cos(1.0),
+                               rtol=1e-4)
+
+
+def subset(res, idx):
+    out = galpha.ensemble.EnsembleResult(res)
+    for key in ("q", "v", "lam", "status", "steps"):
+        out[key] = res[key][idx]
+    out["message"] = [res.message[i] for i in idx]
+    out["summary"] = {k: x[idx] for k, x in res.summary.items()}
+    return out
+
+
+@pytest.mark.parametrize("engine,workers,chunk", [("processes", 2, None), ("processes", 1, 5)])
+def test_processes(serial, engine, workers, chunk):
+    same(serial, galpha.ensemble.run(ensemble_models.pendulum, GRID, TIMES, engine=engine,
+                                     workers=workers, chunk_size=chunk))
+
+
+def test_threads_with_python_callbacks(serial):
+    # (Python callbacks in threads contend for the GIL at every callback: correct, slow)
+    idx = [0, 5, 10]
+    same(subset(serial, idx), galpha.ensemble.run(ensemble_models.pendulum, GRID[idx], TIMES,
+                                                  engine="threads", workers=2, chunk_size=1))
+
+
+@pytest.mark.parametrize("workers,chunk", [(1, None), (2, None), (3, 1)])
+def test_threads_with_compiled_callbacks(workers, chunk):
+    pytest.importorskip("numba")
+    serial = galpha.ensemble.run(ensemble_models.compiled_pendulum, GRID, TIMES)
+    same(serial, galpha.ensemble.run(ensemble_models.compiled_pendulum, GRID, TIMES,
+                                     engine="threads", workers=workers, chunk_size=chunk))
+    # the compiled model is the Python one, arithmetic for arithmetic
+    python = galpha.ensemble.run(ensemble_models.pendulum, GRID[:2], TIMES)
+    for key in ("q", "v", "lam", "steps"):
+        np.testing.assert_array_equal(python[key], serial[key][:2])
+    np.testing.assert_array_equal(python.summary["peak_lambda"],
+                                  serial.summary["peak_lambda"][:2])
+
+
+def test_dask_local_cluster(serial):
+    distributed = pytest.importorskip("distributed")
+    # the workers are new processes: they find the test models and galpha by PYTHONPATH
+    old = os.environ.get("PYTHONPATH")
+    os.environ["PYTHONPATH"] = os.pathsep.join([HERE, PACKAGE] + ([old] if old else []))
+    try:
+        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                      dashboard_address=None) as cluster, \
+                distributed.Client(cluster) as client:
+            same(serial, galpha.ensemble.run(ensemble_models.pendulum, GRID, TIMES,
+                                             client=client))
+            same(serial, galpha.ensemble.run(ensemble_models.pendulum, GRID, TIMES,
+                                             client=client, chunk_size=1))
+    finally:
+        if old is None:
+            del os.environ["PYTHONPATH"]
+        else:
+            os.environ["PYTHONPATH"] = old
+
+
+def test_mpi_two_ranks(serial, tmp_path):
+    pytest.importorskip("mpi4py")
+    mpirun = shutil.which("mpirun")
+    if mpirun is None:
+        pytest.skip("mpirun not found (Debian: openmpi-bin)")
+    np.save(tmp_path / "grid.npy", GRID)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([HERE, PACKAGE]),
+               OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
+    out = tmp_path / "res.npz"
+    subprocess.run([mpirun, "-n", "2", sys.executable, "-m", "galpha.ensemble",
+                    "ensemble_models:pendulum", str(tmp_path / "grid.npy"), "--times",
+                    *map(str, TIMES), "--engine", "mpi", "--out", str(out)],
+                   env=env, check=True, capture_output=True, timeout=300)
+    res = np.load(out)
+    for key in ("times", "q", "v", "lam", "status", "steps"):
+        np.testing.assert_array_equal(res[key], serial[key], err_msg=key)
+    np.testing.assert_array_equal(res["summary_peak_lambda"], serial.summary["peak_lambda"])
+
+
+def test_failures_are_data(serial):
+    grid = GRID.copy()
+    grid[3, 1] = -1.0          # a callback raises
+    grid[7, 0] = float("nan")  # NaN in the constraint: the library's failure
+    res = galpha.ensemble.run(ensemble_models.pendulum, grid, TIMES, engine="processes",
+                              workers=2)
+    assert [i for i, _ in res.failures] == [3, 7]
+    assert res.status[3] == -4 and "negative gravity" in res.message[3]
+    assert res.status[7] < 0 and res.message[7]
+    assert np.all(np.isnan(res.q[3])) and np.all(np.isnan(res.summary["peak_lambda"][[3, 7]]))
+    ok = [i for i in range(len(grid)) if i not in (3, 7)]
+    np.testing.assert_array_equal(res.q[ok], serial.q[ok])
+
+
+def test_fixed_steps_and_initial_values():
+    q0 = np.array([[math.sin(0.5), -math.cos(0.5)], [math.sin(1.0), -math.cos(1.0)]])
+    v0 = np.zeros((2, 2))
+    grid = np.array([[1.0, 9.81], [1.0, 9.81]])
+    a = galpha.ensemble.run(ensemble_models.pendulum, grid, [0.5, 1.0], h=1e-3,
+                            initial=(q0, v0))
+    b = galpha.ensemble.run(ensemble_models.pendulum, grid, [0.5, 1.0], h=1e-3,
+                            initial=(q0, v0), engine="threads", workers=2, chunk_size=1)
+    same(a, b)
+    assert a.steps[0] == 1000
+    np.testing.assert_array_equal(a.q[1], galpha.ensemble.run(
+        ensemble_models.pendulum, grid[:1], [0.5, 1.0], h=1e-3).q[0])
+
+
+def test_arguments():
+    with pytest.raises(ValueError):
+        galpha.ensemble.run(ensemble_models.pendulum, GRID, [1.0, 0.5])
+    with pytest.raises(ValueError):
+        galpha.ensemble.run(ensemble_models.pendulum, GRID, TIMES, engine="cloud")
+    with pytest.raises(ValueError):
+        galpha.ensemble.run(ensemble_models.pendulum, GRID, TIMES, engine="dask")
+    with pytest.raises(TypeError):
+        galpha.ensemble.run(lambda: 42, GRID, TIMES)
