@@ -166,3 +166,31 @@ def test_arguments():
         galpha.ensemble.run(ensemble_models.pendulum, GRID, TIMES, engine="dask")
     with pytest.raises(TypeError):
         galpha.ensemble.run(lambda: 42, GRID, TIMES)
+
+
+def test_the_sweep_example_model():
+    # examples/python/crank_sweep.py: its compiled crank is identify_crank.py's Python one,
+    # bit for bit, on every engine
+    pytest.importorskip("numba")
+    examples = os.path.join(HERE, "..", "..", "examples", "python")
+    sys.path.insert(0, examples)
+    try:
+        import crank_sweep
+        import identify_crank
+    finally:
+        sys.path.remove(examples)
+    grid = np.array([[2.5, 0.4], [4.0, 0.2], [1.0, 1.0]])
+    res = galpha.ensemble.run(crank_sweep.crank, grid, [0.5, 1.0], engine="threads", workers=2)
+    q0, v0 = identify_crank.initial_state()
+    for i, p in enumerate(grid):
+        with galpha.Solver(3, 2, *identify_crank.model(p), tolerances=(1e-6, 1e-6),
+                           formulation=galpha.GA_INDEX2_STABILIZED) as s:
+            s.init(0.0, q0, v0)
+            peak = [0.0]
+            s.set_step_hook(lambda t, q, v, lam: peak.__setitem__(0, max(peak[0], abs(
+                0.5 * np.sin(q[0]) * lam[0] - 0.5 * np.cos(q[0]) * lam[1]))), multipliers=True)
+            for k, t in enumerate((0.5, 1.0)):
+                s.advance(t)
+                np.testing.assert_array_equal(res.q[i, k], s.q)
+        np.testing.assert_allclose(res.summary["peak_torque"][i], peak[0], rtol=1e-14)
+        assert res.summary["angle"][i] == res.q[i, 1, 0]
