@@ -34,7 +34,7 @@ def pendulum():
     def hook(t, q, v, lam):
         peak[0] = max(peak[0], abs(lam[0]))
 
-    s = galpha.Solver(2, 1, mass, force, constraint, jacobian, tolerances=(1e-6, 1e-6),
+    s = galpha.Solver(2, 1, mass, force, constraint, jacobian, tolerances=(1e-5, 1e-5),
                       formulation=galpha.GA_INDEX2_STABILIZED)
     s.set_step_hook(hook, multipliers=True)
     return galpha.ensemble.Case(s, p, start=start,
@@ -54,7 +54,7 @@ def compiled_pendulum():
         p[2] = 0.0
         return 0.0, [p[0] * math.sin(1.0), -p[0] * math.cos(1.0)], [0.0, 0.0]
 
-    s = galpha.Solver(2, 1, mass, force, constraint, jacobian, user=p, tolerances=(1e-6, 1e-6),
+    s = galpha.Solver(2, 1, mass, force, constraint, jacobian, user=p, tolerances=(1e-5, 1e-5),
                       formulation=galpha.GA_INDEX2_STABILIZED)
     s.set_step_hook(hook, multipliers=True)
     # the parameters are p[:2], a view: the callbacks read them in p

@@ -20,7 +20,7 @@ import galpha.ensemble  # noqa: E402
 import ensemble_models  # noqa: E402
 
 GRID = np.array([[L, g] for L in (0.5, 1.0, 1.5, 2.0) for g in (9.0, 9.81, 11.0)])
-TIMES = [0.0, 0.25, 0.5, 1.0]
+TIMES = [0.0, 0.2, 0.4]
 
 
 def same(a, b):
@@ -147,14 +147,14 @@ def test_fixed_steps_and_initial_values():
     q0 = np.array([[math.sin(0.5), -math.cos(0.5)], [math.sin(1.0), -math.cos(1.0)]])
     v0 = np.zeros((2, 2))
     grid = np.array([[1.0, 9.81], [1.0, 9.81]])
-    a = galpha.ensemble.run(ensemble_models.pendulum, grid, [0.5, 1.0], h=1e-3,
+    a = galpha.ensemble.run(ensemble_models.pendulum, grid, [0.25, 0.5], h=1e-3,
                             initial=(q0, v0))
-    b = galpha.ensemble.run(ensemble_models.pendulum, grid, [0.5, 1.0], h=1e-3,
+    b = galpha.ensemble.run(ensemble_models.pendulum, grid, [0.25, 0.5], h=1e-3,
                             initial=(q0, v0), engine="threads", workers=2, chunk_size=1)
     same(a, b)
-    assert a.steps[0] == 1000
+    assert a.steps[0] == 500
     np.testing.assert_array_equal(a.q[1], galpha.ensemble.run(
-        ensemble_models.pendulum, grid[:1], [0.5, 1.0], h=1e-3).q[0])
+        ensemble_models.pendulum, grid[:1], [0.25, 0.5], h=1e-3).q[0])
 
 
 def test_arguments():
