@@ -769,28 +769,49 @@ class Solver:
         """(y, ydot) at t inside the last step (see ga_interpolate_y)."""
         return self._y_pair(_ffi.ga_interpolate_y, float(t))
 
-    @_serialized
-    @_runs_callbacks
+    def _stepping(self, fn, x):
+        """fn(handle, x) under the lock, with Ctrl-C deferred in the main thread (the work of
+        _serialized and _runs_callbacks, inlined: a step loop pays it at every step)."""
+        global _running, _sigint_handler_tried
+        with self._lock:
+            ptr = self._ptr
+            if ptr is None:
+                raise error_for(_ffi.GA_ERR_STATE, "solver is closed")
+            if threading.get_ident() != _MAIN_THREAD:
+                return self._check(fn(ptr, x))
+            if not _sigint_handler_tried:
+                _sigint_handler_tried = True
+                if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+                    signal.signal(signal.SIGINT, _on_sigint)
+            outer, _running = _running, self
+            try:
+                status = fn(ptr, x)
+            finally:
+                _running = outer
+            if self._interrupted:
+                self._interrupted = False
+                self._pending = None
+                raise KeyboardInterrupt
+            if status == 0 and self._pending is None:
+                return False
+            return self._check(status)
+
     def step(self, h):
         """One step of size h. On failure raises; the state stays at the last accepted step.
         True if it stopped at a terminal event (see set_events) or the step hook asked to stop
         (set_step_hook), else False."""
-        return self._check(_ffi.ga_step(self._handle(), float(h)))
+        return self._stepping(_ffi.ga_step, h)
 
-    @_serialized
-    @_runs_callbacks
     def step_adaptive(self, t_stop):
         """One error-controlled step, not beyond t_stop (see ga_step_adaptive). True if it
         stopped at a terminal event or by the step hook."""
-        return self._check(_ffi.ga_step_adaptive(self._handle(), float(t_stop)))
+        return self._stepping(_ffi.ga_step_adaptive, t_stop)
 
-    @_serialized
-    @_runs_callbacks
     def advance(self, t_out):
         """Error-controlled steps until t_out exactly (see ga_advance), or until a terminal
         event or the step hook asks to stop: True then (the solver at the end of that step),
         else False."""
-        return self._check(_ffi.ga_advance(self._handle(), float(t_out)))
+        return self._stepping(_ffi.ga_advance, t_out)
 
     @_serialized
     def set_events(self, functions, multipliers=False, states=False, direction=None,
