@@ -86,4 +86,11 @@ fi
 echo "python overhead"
 GALPHA_LIBRARY=build-demo/libgalpha.so.0 /usr/bin/python3 bench/python_overhead.py \
     build-demo/examples/pendulum_demo > "$out/python_overhead.csv"
+if /usr/bin/python3 -c "import numba" 2>/dev/null; then
+    echo "compiled callbacks and ensembles"
+    GALPHA_LIBRARY=build-demo/libgalpha.so.0 /usr/bin/python3 bench/compiled_callbacks.py \
+        build-demo/bench/libbench_scenes.so build-demo/bench/c_driver > "$out/compiled_callbacks.csv"
+    GALPHA_LIBRARY=build-demo/libgalpha.so.0 /usr/bin/python3 bench/ensemble_scaling.py 1000 \
+        > "$out/ensemble_scaling.csv" 2>/dev/null
+fi
 /usr/bin/python3 scripts/plot_bench.py "$out"

@@ -35,5 +35,7 @@ for k, (lang, code) in enumerate(blocks):
         cmd = [exe]
     else:
         cmd = [sys.executable, src]
-    out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env).stdout
+    # from the repository's root, as a reader would run them
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env,
+                         cwd=os.path.dirname(os.path.abspath(readme))).stdout
     print("README block %d (%s) ran:\n  %s" % (k, lang, out.strip().replace("\n", "\n  ")))
