@@ -285,3 +285,87 @@ def test_integrate_progress_bar(capsys):
         galpha.integrate(*py_model(p), (0.0, 0.5), Q0, V0, h=h, m=1, progress=True)
         err = capsys.readouterr().err
         assert "galpha:" in err and "/0.5 s" in err and "%" in err
+
+
+# ---- the other callback slots, compiled: the numbers of their Python twins, bit for bit ----
+@cfunc(types.int32(types.float64, dp, dp, dp, dp, dp, vp))
+def c_stiffness(t, q, v, qdd, lam, K, user):
+    out, mu = carray(K, 4), carray(lam, 1)
+    out[0], out[1], out[2], out[3] = mu[0], 0.0, 0.0, mu[0]
+    return 0
+
+
+@cfunc(types.int32(types.float64, dp, dp, dp, vp))
+def c_accel(t, q, v, out, user):
+    x = carray(v, 2)
+    carray(out, 1)[0] = x[0] * x[0] + x[1] * x[1]
+    return 0
+
+
+@cfunc(types.int32(types.float64, dp, dp, vp))
+def c_phi_t(t, q, out, user):
+    carray(out, 1)[0] = 0.0
+    return 0
+
+
+@cfunc(types.int32(types.float64, dp, dp, types.int32, dp, vp))
+def c_force_p(t, q, v, j, f_p, user):
+    p, out = carray(user, 3, np.float64), carray(f_p, 2)
+    out[0] = 0.0
+    out[1] = -p[2] if j == 0 else (-p[0] if j == 2 else 0.0)
+    return 0
+
+
+@cfunc(types.int32(types.float64, dp, dp, dp, dp, dp, dp, dp, dp, dp, dp, vp))
+def c_cost(t, q, v, qdd, lam, value, d_q, d_v, d_qdd, d_lam, d_p, user):
+    x = carray(q, 2)
+    carray(value, 1)[0] = x[0] * x[1]
+    g = carray(d_q, 2)
+    g[0], g[1] = x[1], x[0]
+    return 0
+
+
+def test_every_other_slot_compiled():
+    def stiffness(t, q, v, qdd, lam, K):
+        K[0, 0] = K[1, 1] = lam[0]
+
+    def accel(t, q, v, out):
+        out[0] = v[0] * v[0] + v[1] * v[1]
+
+    def phi_t(t, q, out):
+        out[0] = 0.0
+
+    def force_p(t, q, v, j, f_p):
+        f_p[1] = -p[2] if j == 0 else (-p[0] if j == 2 else 0.0)
+
+    def cost(t, q, v, qdd, lam, d_q, d_v, d_qdd, d_lam, d_p):
+        d_q[0], d_q[1] = q[1], q[0]
+        return q[0] * q[1]
+
+    results = []
+    for compiled in (False, True):
+        p = np.array([1.3, 0.8, 9.81])
+        cbs = ((c_mass, c_force, c_constraint, c_jacobian) if compiled else py_model(p))
+        extra = dict(stiffness=c_stiffness, constraint_accel=c_accel, constraint_dt=c_phi_t,
+                     force_p=c_force_p) if compiled else dict(
+            stiffness=stiffness, constraint_accel=accel, constraint_dt=phi_t, force_p=force_p)
+        with galpha.Solver(2, 1, *cbs, user=p if compiled else None, parameters=p,
+                           sensitivity_method=("forward", "adjoint"), max_steps=400,
+                           formulation=galpha.GA_INDEX2_STABILIZED, **extra) as s:
+            s.init(0.0, Q0, V0)
+            for _ in range(300):
+                s.step(1e-3)
+            sens = s.sensitivity()
+            J, dJ = s.adjoint_gradient(terminal=c_cost if compiled else cost)
+            results.append((s.q.copy(), s.lam.copy(), sens.dq, sens.dlam, J, dJ, s.stats))
+    (q1, l1, dq1, dl1, J1, g1, st1), (q2, l2, dq2, dl2, J2, g2, st2) = results
+    for a, b in ((q1, q2), (l1, l2), (dq1, dq2), (dl1, dl2), (g1, g2)):
+        np.testing.assert_array_equal(a, b)
+    assert J1 == J2
+    # the compiled slots were used: the tangent and the constraint terms by callback
+    for st in (st1, st2):
+        assert st["stiffness_evals"] > 0 and st["accel_evals"] > 0
+        assert st["constraint_dt_evals"] > 0
+    # the adjoint gradient is the forward one (d(x y)/dp from dq)
+    x, y = q1
+    np.testing.assert_allclose(g1, y * dq1[0] + x * dq1[1], rtol=1e-9)
