@@ -369,3 +369,16 @@ def test_every_other_slot_compiled():
     # the adjoint gradient is the forward one (d(x y)/dp from dq)
     x, y = q1
     np.testing.assert_allclose(g1, y * dq1[0] + x * dq1[1], rtol=1e-9)
+
+
+def test_numba_example():
+    # examples/python/numba_pendulum.py: the peak rod force its compiled hook records, against
+    # the exact m g (3 - 2 cos theta0) at the bottom
+    script = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "python",
+                          "numba_pendulum.py")
+    out = subprocess.run([sys.executable, script], check=True, capture_output=True,
+                         text=True).stdout
+    import re
+    peak, exact = map(float, re.search(r"peak rod force = ([0-9.]+) N \(exact ([0-9.]+)\)",
+                                       out).groups())
+    assert abs(peak - exact) < 1e-7 * exact

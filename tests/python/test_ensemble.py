@@ -194,3 +194,12 @@ def test_the_sweep_example_model():
                 np.testing.assert_array_equal(res.q[i, k], s.q)
         np.testing.assert_allclose(res.summary["peak_torque"][i], peak[0], rtol=1e-14)
         assert res.summary["angle"][i] == res.q[i, 1, 0]
+
+
+def test_progress_bar(capsys, serial):
+    pytest.importorskip("tqdm")
+    res = galpha.ensemble.run(ensemble_models.pendulum, GRID[:4], TIMES, engine="threads",
+                              workers=2, chunk_size=1, progress=True)
+    err = capsys.readouterr().err
+    assert "galpha:" in err and "/4" in err
+    same(subset(serial, [0, 1, 2, 3]), res)

@@ -161,7 +161,7 @@ def _chunks(runs, pieces):
 
 
 def run(model, parameters, times, *, initial=None, h=None, engine="serial", workers=None,
-        client=None, chunk_size=None, comm=None):
+        client=None, chunk_size=None, comm=None, progress=None):
     """Run `model` once per row of `parameters` (runs x np) and record q, v, lam (and y) at
     `times` (increasing; a time equal to the start records the initial state).
 
@@ -177,6 +177,8 @@ def run(model, parameters, times, *, initial=None, h=None, engine="serial", work
     chunk_size : int, optional
         Runs per task (default: about four tasks per worker, each worker reusing its case).
     comm : an mpi4py communicator (default COMM_WORLD) for engine="mpi".
+    progress : a progress bar over the runs (tqdm, optional; not under MPI): None shows it on
+        a terminal once the sweep has lasted a second, True always, False never.
     """
     P = np.ascontiguousarray(parameters, dtype=float)
     if P.ndim == 1:
@@ -214,21 +216,40 @@ def run(model, parameters, times, *, initial=None, h=None, engine="serial", work
             return None
         results = [r for part in gathered for r in part]
     else:
-        pieces = _chunks(runs, 1 if engine == "serial" else
-                         (workers * 4 if chunk_size is None else math.ceil(runs / chunk_size)))
-        if engine == "serial":
-            results = [r for c in pieces for r in _run_chunk(*task(c))]
-        elif engine == "dask":
-            if client is None:
-                raise ValueError("engine='dask' needs client= (a dask.distributed.Client)")
-            futures = [client.submit(_run_chunk, *task(c), pure=False) for c in pieces]
-            results = [r for part in client.gather(futures) for r in part]
+        if engine == "serial":  # (chunks only for the progress bar)
+            pieces = _chunks(runs, math.ceil(runs / (chunk_size or max(1, runs // 100))))
         else:
-            pool = (concurrent.futures.ThreadPoolExecutor if engine == "threads" else
-                    concurrent.futures.ProcessPoolExecutor)
-            with pool(max_workers=workers) as ex:
-                futures = [ex.submit(_run_chunk, *task(c)) for c in pieces]
-                results = [r for f in futures for r in f.result()]
+            pieces = _chunks(runs, workers * 4 if chunk_size is None
+                             else math.ceil(runs / chunk_size))
+        from .integrate import _progress_bar
+        bar = _progress_bar(progress, 0, runs, unit="run")
+        results = []
+
+        def collect(part):
+            results.extend(part)
+            if bar is not None:
+                bar.update(len(part))
+        try:
+            if engine == "serial":
+                for c in pieces:
+                    collect(_run_chunk(*task(c)))
+            elif engine == "dask":
+                if client is None:
+                    raise ValueError("engine='dask' needs client= (a dask.distributed.Client)")
+                from distributed import as_completed
+                futures = [client.submit(_run_chunk, *task(c), pure=False) for c in pieces]
+                for f in as_completed(futures):
+                    collect(f.result())
+            else:
+                pool = (concurrent.futures.ThreadPoolExecutor if engine == "threads" else
+                        concurrent.futures.ProcessPoolExecutor)
+                with pool(max_workers=workers) as ex:
+                    futures = [ex.submit(_run_chunk, *task(c)) for c in pieces]
+                    for f in concurrent.futures.as_completed(futures):
+                        collect(f.result())
+        finally:
+            if bar is not None:
+                bar.close()
     return _stack(results, runs, times)
 
 

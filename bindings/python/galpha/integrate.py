@@ -68,10 +68,10 @@ class OdeSolution:
         return self._both(t)[1]
 
 
-def _progress_bar(progress, t0, t1):
-    """A tqdm bar over simulated time, or None: progress=None shows one on a terminal for runs
-    that last over a second, if tqdm is installed (Debian: python3-tqdm); True asks for it
-    (tqdm needed), False never."""
+def _progress_bar(progress, t0, t1, unit="s"):
+    """A tqdm bar over simulated time (or runs), or None: progress=None shows one on a terminal
+    for runs that last over a second, if tqdm is installed (Debian: python3-tqdm); True asks
+    for it (tqdm needed), False never."""
     if progress is False:
         return None
     try:
@@ -82,6 +82,9 @@ def _progress_bar(progress, t0, t1):
         return None
     if progress is None and not sys.stderr.isatty():
         return None
+    if unit != "s":
+        return tqdm(total=t1 - t0, unit=unit, delay=0.0 if progress else 1.0, desc="galpha",
+                    leave=False)
     return tqdm(total=t1 - t0, unit="s", unit_scale=True, delay=0.0 if progress else 1.0,
                 desc="galpha", leave=False, bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s "
                 "[{elapsed}<{remaining}]")
