@@ -102,3 +102,45 @@ def _compiled(carray, cfunc, types, dp, vp):
 
     _cfuncs = (mass, force, constraint, jacobian, hook)
     return _cfuncs
+
+
+def stopping_pendulum():
+    """The pendulum of length p[0] (gravity 9.81), released from 1 rad; its step hook ends the
+    run after the step in which it passes the vertical (summary: that step's time)."""
+    p = np.array([1.0])
+
+    def mass(t, q, M):
+        M[0, 0] = M[1, 1] = 1.0
+
+    def force(t, q, v, f):
+        f[1] = -9.81
+
+    def constraint(t, q, phi):
+        phi[0] = 0.5 * (q[0] * q[0] + q[1] * q[1] - p[0] * p[0])
+
+    def jacobian(t, q, J):
+        J[0, 0], J[0, 1] = q[0], q[1]
+
+    s = galpha.Solver(2, 1, mass, force, constraint, jacobian, tolerances=(1e-5, 1e-5),
+                      formulation=galpha.GA_INDEX2_STABILIZED)
+    s.set_step_hook(lambda t, q, v, lam: q[0] < 0.0)
+    return galpha.ensemble.Case(
+        s, p, start=lambda p: (0.0, [p[0] * math.sin(1.0), -p[0] * math.cos(1.0)], [0.0, 0.0]),
+        summary=lambda s: {"t_stop": s.t})
+
+
+def driven_decay():
+    """First-order states: x'' = -p[0] x + y, y' = -2 y; x(0) = 0, x'(0) = 0, y(0) = 1."""
+    p = np.array([1.0])
+
+    def mass(t, q, M):
+        M[0, 0] = 1.0
+
+    def force_y(t, q, v, y, f):
+        f[0] = -p[0] * q[0] + y[0]
+
+    def rate(t, q, v, y, ydot):
+        ydot[0] = -2.0 * y[0]
+
+    s = galpha.Solver(1, 0, mass, r=1, rate=rate, force_y=force_y, tolerances=(1e-7, 1e-7))
+    return galpha.ensemble.Case(s, p, q0=[0.0], v0=[0.0], y0=[1.0])

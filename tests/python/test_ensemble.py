@@ -203,3 +203,39 @@ def test_progress_bar(capsys, serial):
     err = capsys.readouterr().err
     assert "galpha:" in err and "/4" in err
     same(subset(serial, [0, 1, 2, 3]), res)
+
+
+def test_runs_ended_by_the_hook():
+    grid = np.array([[0.5], [1.0], [2.0]])
+    res = galpha.ensemble.run(ensemble_models.stopping_pendulum, grid, [0.1, 5.0],
+                              engine="threads", workers=2)
+    assert list(res.status) == [1, 1, 1] and not res.failures
+    assert all("stopped at t" in m for m in res.message)
+    assert np.all(np.isfinite(res.q[:, 0])) and np.all(np.isnan(res.q[:, 1]))
+    # it ended just past the vertical: a quarter period, sqrt(L/g) K(sin 1/2) (K by the AGM)
+    a, b = 1.0, math.cos(0.5)
+    for _ in range(8):
+        a, b = 0.5 * (a + b), math.sqrt(a * b)
+    quarter = np.sqrt(grid[:, 0] / 9.81) * math.pi / (2 * a)
+    t_stop = res.summary["t_stop"]
+    assert np.all(t_stop >= quarter) and np.all(t_stop < quarter + 0.05 * quarter)
+
+
+def test_first_order_states():
+    grid = np.array([[1.0], [4.0]])
+    times = [0.5, 1.0]
+    res = galpha.ensemble.run(ensemble_models.driven_decay, grid, times)
+    same(res, galpha.ensemble.run(ensemble_models.driven_decay, grid, times,
+                                  engine="processes", workers=2, chunk_size=1))
+    np.testing.assert_array_equal(res.y, galpha.ensemble.run(
+        ensemble_models.driven_decay, grid, times, engine="threads", workers=2).y)
+    assert res.y.shape == (2, 2, 1)
+    np.testing.assert_allclose(res.y[:, :, 0], np.exp(-2 * np.array([times, times])),
+                               rtol=1e-5)
+    # x = (cos(w t) - e^{-2 t}) / (w^2 + 4) + 2 sin(w t) / (w (w^2 + 4)), w^2 = k
+    for i, k in enumerate(grid[:, 0]):
+        w = math.sqrt(k)
+        for j, t in enumerate(times):
+            x = ((math.exp(-2 * t) - math.cos(w * t)) * 1 / (k + 4) +
+                 2 * math.sin(w * t) / (w * (k + 4)))
+            assert abs(res.q[i, j, 0] - x) < 1e-5

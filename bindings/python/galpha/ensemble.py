@@ -67,8 +67,10 @@ class Case:
 
 class EnsembleResult(dict):
     """times (T,); q, v (runs, T, n); lam (runs, T, m); y (runs, T, r) with first-order states;
-    status (runs,) 0 or the ga_status of the failure (-4 for an exception in a callback);
-    message (list of str, "" for success); steps (runs,) accepted steps; summary: dict of
+    status (runs,) 0, 1 if a terminal event or the step hook ended the run before the last
+    output time (what it reached is recorded; Case.summary is called), or the negative
+    ga_status of a failure (-4 for an exception in a callback); message (list of str, "" for
+    success); steps (runs,) accepted steps; summary: dict of
     arrays (runs, ...) from Case.summary (NaN for failed runs); failures: [(run, message)].
     Values not reached by a failed run are NaN."""
 
@@ -80,7 +82,7 @@ class EnsembleResult(dict):
 
     def __repr__(self):
         return "EnsembleResult(runs=%d, outputs=%d, failed=%d)" % (
-            len(self["status"]), len(self["times"]), int(np.count_nonzero(self["status"])))
+            len(self["status"]), len(self["times"]), int(np.count_nonzero(self["status"] < 0)))
 
 
 # ---- one worker --------------------------------------------------------------------------
@@ -125,13 +127,18 @@ def _one(case, p, init, times, h):
             values = init
         s.init(float(t0), *values)
         for k, t in enumerate(times):
+            stopped = False
             if t > s.t:
                 if h is None:
-                    s.advance(t)
+                    stopped = s.advance(t)
                 else:
-                    while s.t < t:
+                    while s.t < t and not stopped:
                         left = t - s.t
-                        s.step(h if left > h * (1 + 1e-9) else left)
+                        stopped = s.step(h if left > h * (1 + 1e-9) else left)
+            if stopped and s.t < t:  # a terminal event or the step hook ended the run
+                status, message = 1, "stopped at t = %.17g (a terminal event or the step " \
+                    "hook)" % s.t
+                break
             out[0][k], out[1][k], out[2][k] = s.q, s.v, s.lam
             if r:
                 out[3][k] = s.y
@@ -269,7 +276,7 @@ def _stack(results, runs, times):
                                  else np.full(shape, np.nan) for r in results])
     res = EnsembleResult(times=times, q=q, v=v, lam=lam, status=status, message=message,
                          steps=steps, summary=summary,
-                         failures=[(i, message[i]) for i in np.flatnonzero(status)])
+                         failures=[(i, message[i]) for i in np.flatnonzero(status < 0)])
     if y.shape[2]:
         res["y"] = y
     return res
