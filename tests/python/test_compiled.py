@@ -382,3 +382,70 @@ def test_numba_example():
     peak, exact = map(float, re.search(r"peak rod force = ([0-9.]+) N \(exact ([0-9.]+)\)",
                                        out).groups())
     assert abs(peak - exact) < 1e-7 * exact
+
+
+# first-order states: x'' = -k x + y, y' = -2 y (k = user[0]), with the coupling blocks
+@cfunc(types.int32(types.float64, dp, dp, vp))
+def c_unit_mass(t, q, M, user):
+    carray(M, 1)[0] = 1.0
+    return 0
+
+
+@cfunc(types.int32(types.float64, dp, dp, dp, dp, vp))
+def c_force_y(t, q, v, y, f, user):
+    carray(f, 1)[0] = -carray(user, 1, np.float64)[0] * carray(q, 1)[0] + carray(y, 1)[0]
+    return 0
+
+
+@cfunc(types.int32(types.float64, dp, dp, dp, dp, vp))
+def c_rate(t, q, v, y, ydot, user):
+    carray(ydot, 1)[0] = -2.0 * carray(y, 1)[0]
+    return 0
+
+
+@cfunc(types.int32(types.float64, dp, dp, dp, dp, dp, dp, dp, vp))
+def c_coupling(t, q, v, y, g_q, g_v, g_y, f_y, user):
+    carray(g_q, 1)[0] = 0.0
+    carray(g_v, 1)[0] = 0.0
+    carray(g_y, 1)[0] = -2.0
+    carray(f_y, 1)[0] = 1.0
+    return 0
+
+
+@cfunc(types.int32(types.float64, dp, dp, dp, vp))
+def c_damping(t, q, v, C, user):
+    carray(C, 1)[0] = 0.0
+    return 0
+
+
+def test_first_order_slots_compiled():
+    k = np.array([4.0])
+
+    def force_y(t, q, v, y, f):
+        f[0] = -k[0] * q[0] + y[0]
+
+    def rate(t, q, v, y, ydot):
+        ydot[0] = -2.0 * y[0]
+
+    def coupling(t, q, v, y, g_q, g_v, g_y, f_y):
+        g_y[0, 0], f_y[0, 0] = -2.0, 1.0
+
+    def unit_mass(t, q, M):
+        M[0, 0] = 1.0
+
+    def damping(t, q, v, C):
+        C[0, 0] = 0.0
+
+    runs = []
+    for cbs in ((unit_mass, force_y, rate, coupling, damping, None),
+                (c_unit_mass, c_force_y, c_rate, c_coupling, c_damping, k)):
+        with galpha.Solver(1, 0, cbs[0], r=1, force_y=cbs[1], rate=cbs[2], coupling=cbs[3],
+                           damping=cbs[4], user=cbs[5]) as s:
+            s.init(0.0, [0.0], [0.0], [1.0])
+            for _ in range(500):
+                s.step(1e-3)
+            runs.append((s.q.copy(), s.v.copy(), s.y.copy(), s.stats["coupling_evals"],
+                         s.stats["damping_evals"]))
+    for a, b in zip(*runs):
+        np.testing.assert_array_equal(a, b)
+    assert runs[1][3] > 0 and runs[1][4] > 0
