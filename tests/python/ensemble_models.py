@@ -144,3 +144,8 @@ def driven_decay():
 
     s = galpha.Solver(1, 0, mass, r=1, rate=rate, force_y=force_y, tolerances=(1e-7, 1e-7))
     return galpha.ensemble.Case(s, p, q0=[0.0], v0=[0.0], y0=[1.0])
+
+
+def not_a_case():
+    """A broken model (for the error path): it returns no Case."""
+    return 42

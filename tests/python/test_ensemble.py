@@ -239,3 +239,21 @@ def test_first_order_states():
             x = ((math.exp(-2 * t) - math.cos(w * t)) * 1 / (k + 4) +
                  2 * math.sin(w * t) / (w * (k + 4)))
             assert abs(res.q[i, j, 0] - x) < 1e-5
+
+
+def test_mpi_rank_failure_is_reported(tmp_path):
+    # a model that cannot be built: every rank says so, none hangs
+    pytest.importorskip("mpi4py")
+    mpirun = shutil.which("mpirun")
+    if mpirun is None:
+        pytest.skip("mpirun not found (Debian: openmpi-bin)")
+    np.save(tmp_path / "grid.npy", GRID[:3])
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([HERE, PACKAGE]),
+               OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
+    out = subprocess.run([mpirun, "-n", "2", sys.executable, "-m", "galpha.ensemble",
+                          "ensemble_models:not_a_case", str(tmp_path / "grid.npy"), "--times",
+                          "1.0", "--engine", "mpi", "--out", str(tmp_path / "r.npz")],
+                         env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode != 0
+    assert "must return a galpha.ensemble.Case" in out.stderr

@@ -24,6 +24,7 @@ sweep from the command line. Nothing here imports dask or mpi4py unless asked fo
 """
 import concurrent.futures
 import math
+import os
 import pickle
 import threading
 
@@ -193,6 +194,8 @@ def run(model, parameters, times, *, initial=None, h=None, engine="serial", work
     if P.ndim != 2:
         raise ValueError("parameters: one row per run")
     runs = P.shape[0]
+    if runs == 0:
+        raise ValueError("parameters: no runs")
     times = np.asarray(times, dtype=float).ravel()
     if times.size == 0 or np.any(np.diff(times) <= 0) or not np.all(np.isfinite(times)):
         raise ValueError("times must be finite and increasing")
@@ -204,7 +207,6 @@ def run(model, parameters, times, *, initial=None, h=None, engine="serial", work
         engine = "dask"
     if engine not in ("serial", "threads", "processes", "dask", "mpi"):
         raise ValueError("unknown engine %r" % (engine,))
-    import os
     workers = int(workers or os.cpu_count() or 1)
 
     def task(idx):
@@ -217,11 +219,19 @@ def run(model, parameters, times, *, initial=None, h=None, engine="serial", work
             comm = MPI.COMM_WORLD
         size, rank = comm.Get_size(), comm.Get_rank()
         pieces = _chunks(runs, size * 4 if chunk_size is None else math.ceil(runs / chunk_size))
-        mine = [r for c in pieces[rank::size] for r in _run_chunk(*task(c))]
-        gathered = comm.gather(mine, root=0)
+        try:  # a rank that cannot run says so in the gather instead of leaving it hanging
+            mine, error = [r for c in pieces[rank::size] for r in _run_chunk(*task(c))], None
+        except Exception as e:
+            mine, error = [], "rank %d: %s: %s" % (rank, type(e).__name__, e)
+        gathered = comm.gather((mine, error), root=0)
         if rank != 0:
+            if error:
+                raise RuntimeError(error)
             return None
-        results = [r for part in gathered for r in part]
+        errors = [e for _, e in gathered if e]
+        if errors:
+            raise RuntimeError("ensemble under MPI: " + "; ".join(errors))
+        results = [r for part, _ in gathered for r in part]
     else:
         if engine == "serial":  # (chunks only for the progress bar)
             pieces = _chunks(runs, math.ceil(runs / (chunk_size or max(1, runs // 100))))
