@@ -51,6 +51,10 @@ typedef struct model {
      * ones are part of the snapshot; an adjoint record refuses checkpoints */
     double p[2];
     int sens, sens_forward, sens_adjoint;
+    /* the step hook (ga_set_step_hook): it reads the solver, tries to change it, and stops
+     * the call at some t (a function of t alone, so that a restored run stops alike) */
+    int hook_stops;
+    long hook_calls, hook_wrong; /* calls; reads that disagreed or changes let through */
 } model;
 
 static uint64_t next(model *md)
@@ -323,6 +327,23 @@ static int events(double t, const double *q, const double *v, const double *lamb
 }
 
 /* The events of `md` set on s (again: the search starts afresh from the current state). */
+static int step_hook(const ga_solver *s, double t, const double *q, const double *v,
+                     const double *lambda, void *user)
+{
+    model *md = user;
+    double x[NMAX], h = 0.0, qi[NMAX], vi[NMAX], li[MMAX];
+    (void)v, (void)lambda;
+    ++md->hook_calls;
+    if (ga_get_q(s, x) != GA_OK || memcmp(x, q, sizeof(double) * (size_t)md->n) != 0)
+        ++md->hook_wrong;
+    if (ga_get_h_last(s, &h) == GA_OK && h > 0.0)  /* may fail with the callbacks: allowed */
+        ga_interpolate(s, t - 0.5 * h, qi, vi, md->m ? li : NULL);
+    if (ga_set_rho_inf((ga_solver *)s, 0.5) != GA_ERR_STATE ||
+        ga_step((ga_solver *)s, 1e-3) != GA_ERR_STATE)
+        ++md->hook_wrong;
+    return md->hook_stops && sin(1e4 * t) > 0.5;
+}
+
 static ga_status set_events(const model *md, ga_solver *s)
 {
     return ga_set_events(s, md->ev_count, md->ev_count ? events : NULL, md->ev_dir, md->ev_term,
@@ -393,7 +414,7 @@ static int snapshot(const model *md, ga_solver *s, double *x)
 static void check(ga_solver *s, ga_status st, int changes_solver, const char *call, int seq)
 {
     const int stepping = strcmp(call, "ga_step") == 0 || strcmp(call, "ga_step_adaptive") == 0;
-    if (st > (stepping ? GA_EVENT : GA_OK) || st < GA_ERR_STEP_SIZE)
+    if (st > (stepping ? GA_STOPPED : GA_OK) || st < GA_ERR_STEP_SIZE)
         SEQ_FAIL("sequence %d: %s returned %d, not a ga_status", seq, call, st);
     if (st < GA_OK && changes_solver && ga_last_error(s)[0] == '\0')
         SEQ_FAIL("sequence %d: %s failed (%s) without a message", seq, call, ga_strerror(st));
@@ -419,7 +440,7 @@ static void check_transaction(const model *md, ga_solver *s, ga_status st,
 
 typedef struct seq_stats {
     long long calls, steps_ok, sparse_ok, twin_steps_ok, events, sensitivity_steps_ok,
-        adjoint_ok;
+        adjoint_ok, hook_calls, hook_stops;
 } seq_stats;
 
 /* The restart twin: a few steps from a checkpoint, then the checkpoint restored in the same
@@ -488,6 +509,7 @@ static void after_step(const model *md, ga_solver *s, ga_status st, const double
     check_event_log(md, s, st, seq);
     stats->steps_ok += st >= GA_OK;
     stats->events += st == GA_EVENT;
+    stats->hook_stops += st == GA_STOPPED;
     stats->sensitivity_steps_ok += st >= GA_OK && md->sens;
     stats->sparse_ok += st >= GA_OK && strstr(ga_linear_solver_name(s), "sparse") != NULL;
 }
@@ -554,7 +576,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         ga_status st = GA_OK;
         int changes = 1;
         const char *call = "";
-        switch (pick(&md, 39)) {
+        switch (pick(&md, 40)) {
         case 0: call = "ga_set_rho_inf"; st = ga_set_rho_inf(s, edge_value(&md)); break;
         case 1: {
             const double am = edge_value(&md), af = edge_value(&md), b = edge_value(&md);
@@ -750,6 +772,16 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             }
             break;
         }
+        case 39: {
+            call = "ga_set_step_hook";
+            if (pick(&md, 3) == 0) {
+                st = ga_set_step_hook(s, NULL, NULL, 0);
+            } else {
+                md.hook_stops = pick(&md, 2);
+                st = ga_set_step_hook(s, step_hook, &md, pick(&md, 2));
+            }
+            break;
+        }
         case 30: {
             double value;
             call = "ga_get_info";
@@ -810,6 +842,10 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
     }
     if (md.reentry_allowed)
         SEQ_FAIL("sequence %d: a callback's ga_step on its own solver was not refused", seq);
+    if (md.hook_wrong)
+        SEQ_FAIL("sequence %d: the step hook read other values than it was passed, or changed "
+                 "the solver (%ld of %ld calls)", seq, md.hook_wrong, md.hook_calls);
+    stats->hook_calls += md.hook_calls;
     ga_free(s);
 }
 

@@ -42,9 +42,10 @@ static void random_call_sequences_keep_the_contract(void **state)
     const long long steps_ok = stats.steps_ok, sparse_ok = stats.sparse_ok;
     printf("  %d sequences, %lld calls, %lld accepted steps (%lld on the sparse path, %lld with "
            "sensitivities), %lld steps repeated from a restored checkpoint, %lld stops at "
-           "events, %lld adjoint sweeps\n",
+           "events, %lld adjoint sweeps, %lld step hook calls, %lld stops by it\n",
            SEQUENCES, stats.calls, steps_ok, sparse_ok, stats.sensitivity_steps_ok,
-           stats.twin_steps_ok, stats.events, stats.adjoint_ok);
+           stats.twin_steps_ok, stats.events, stats.adjoint_ok, stats.hook_calls,
+           stats.hook_stops);
     /* the sequences must reach the stepping code, dense and sparse, not only the checks of
      * arguments and of the call order */
     assert_true(steps_ok > SEQUENCES / 2);
@@ -53,6 +54,7 @@ static void random_call_sequences_keep_the_contract(void **state)
     assert_true(stats.events > SEQUENCES / 400); /* few sequences step far; some must stop */
     assert_true(stats.sensitivity_steps_ok > SEQUENCES / 100);
     assert_true(stats.adjoint_ok > SEQUENCES / 400);
+    assert_true(stats.hook_calls > SEQUENCES / 10 && stats.hook_stops > SEQUENCES / 400);
 }
 
 /* The sequences' model is exact: for every chain length, with and without the redundant
