@@ -193,6 +193,23 @@ static void once_per_step(void **state)
         assert_memory_equal(seen.v[k], v, sizeof v);
         assert_true(seen.lambda[k] == lambda);
     }
+    /* kept by ga_set_state and by ga_init (a restart) */
+    size_t len;
+    assert_int_equal(ga_state_size(s, &len), GA_OK);
+    double *ckpt = malloc(len * sizeof *ckpt);
+    assert_non_null(ckpt);
+    assert_int_equal(ga_get_state(s, ckpt, len), GA_OK);
+    assert_int_equal(ga_set_state(s, ckpt, len), GA_OK);
+    free(ckpt);
+    assert_int_equal(ga_step(s, 1e-2), GA_OK);
+    assert_int_equal(seen.calls, 21);
+    double q0[2], v0[2];
+    pendulum_state(&sc.p, 0.5, 0.0, q0, v0);
+    assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+    assert_int_equal(seen.calls, 21); /* (ga_init takes no step) */
+    assert_int_equal(ga_step(s, 1e-2), GA_OK);
+    assert_int_equal(seen.calls, 22);
+    seen.calls = 20;
     /* removed: no more calls */
     assert_int_equal(ga_set_step_hook(s, NULL, &seen, 1), GA_OK);
     assert_int_equal(ga_step(s, 1e-2), GA_OK);
