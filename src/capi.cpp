@@ -46,6 +46,21 @@ private:
     std::fenv_t caller_;
 };
 
+// `body` on the core, every C++ exception turned into a status.
+template <class Body>
+ga_status caught(ga::Solver &core, Body &&body)
+{
+    try {
+        return body(core);
+    } catch (const std::bad_alloc &) {
+        return core.diag.fail(GA_ERR_NOMEM, "out of memory");
+    } catch (const std::exception &e) {
+        return core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception: %s", e.what());
+    } catch (...) {
+        return core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception of unknown type");
+    }
+}
+
 // Runs `body` as one API call on `s`: refuses calls from inside the solver's own callbacks,
 // clears the last error if asked, and converts every C++ exception into a status.
 template <class Body>
@@ -59,16 +74,7 @@ ga_status call(ga_solver *s, bool clear_message, Body &&body)
     const TrapsHeld traps(s->core.model);
     if (clear_message)
         s->core.diag.clear();
-    ga_status st;
-    try {
-        st = body(s->core);
-    } catch (const std::bad_alloc &) {
-        st = s->core.diag.fail(GA_ERR_NOMEM, "out of memory");
-    } catch (const std::exception &e) {
-        st = s->core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception: %s", e.what());
-    } catch (...) {
-        st = s->core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception of unknown type");
-    }
+    const ga_status st = caught(s->core, std::forward<Body>(body));
     s->busy = false;
     return st;
 }
@@ -122,14 +128,7 @@ ga_status computing(const ga_solver *s, Body &&body)
         // from the step hook, under the stepping call's guard; the callbacks this evaluates
         // are refused reads as any callback is
         w->in_hook = false;
-        ga_status st;
-        try {
-            st = body(w->core);
-        } catch (const std::bad_alloc &) {
-            st = w->core.diag.fail(GA_ERR_NOMEM, "out of memory");
-        } catch (...) {
-            st = w->core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception");
-        }
+        const ga_status st = caught(w->core, std::forward<Body>(body));
         w->in_hook = true;
         return st;
     }

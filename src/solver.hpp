@@ -139,7 +139,6 @@ public:
     ga_status adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ);
     ga_status set_adjoint_checkpoints(long interval, long count);
 
-    // Events (events.cpp): the functions watched, where their search stands, the last log.
     // The step hook (ga_set_step_hook), called by step, step_adaptive and advance.
     struct StepHook {
         ga_step_hook_fn fn = nullptr;
@@ -149,6 +148,8 @@ public:
         bool with_lambda = false;
     };
     void set_step_hook(const StepHook &hook);  // step_hook.cpp; throws std::bad_alloc
+
+    // Events (events.cpp): the functions watched, where their search stands, the last log.
     EventSet &events() { return events_; }
     const EventSet &events() const { return events_; }
 

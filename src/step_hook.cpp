@@ -75,23 +75,21 @@ ga_status Solver::hooked(bool adaptive, double arg, ga_status (Solver::*step)(do
         hook_lambda_ = output == GA_OUTPUT_CONSISTENT ? out_lambda_ : accepted_.lambda;
         lambda = hook_lambda_.data();
     }
+    const double t = accepted_.t;
     int rc = 0;
     try {
         HookRunning running(hook_.running);
         rc = model.run_user([&] {
-            return hook_.fn(hook_.handle, accepted_.t, accepted_.q.data(), accepted_.v.data(),
-                            lambda, hook_.user);
+            return hook_.fn(hook_.handle, t, accepted_.q.data(), accepted_.v.data(), lambda,
+                            hook_.user);
         });
     } catch (const std::bad_alloc &) {
-        const double t = accepted_.t;
         undo_this_step();
         return diag.fail(GA_ERR_NOMEM, "out of memory in the step hook at t = %.17g", t);
     } catch (const std::exception &e) {
-        const double t = accepted_.t;
         undo_this_step();
         return diag.fail(GA_ERR_INTERNAL, "the step hook threw at t = %.17g: %s", t, e.what());
     } catch (...) {
-        const double t = accepted_.t;
         undo_this_step();
         return diag.fail(GA_ERR_INTERNAL, "the step hook threw a C++ exception of unknown type "
                          "at t = %.17g", t);
