@@ -3,19 +3,12 @@
  * ga_step(h); best of 5 of each, in microseconds per step. CSV on stdout: scene,driver,us,steps */
 #include <math.h>
 #include <stdio.h>
-#include <time.h>
 
 #include <galpha.h>
 
+#include "rounds.h"
 #include "scenes/andrews.h"
 #include "scenes/pendulum.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 
 typedef struct scene {
     const char *name;

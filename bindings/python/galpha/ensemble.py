@@ -31,6 +31,7 @@ import threading
 import numpy as np
 
 from .errors import GalphaError
+from .integrate import _Fields, _progress_bar
 
 __all__ = ["Case", "EnsembleResult", "run"]
 
@@ -66,7 +67,7 @@ class Case:
         self.start, self.summary = start, summary
 
 
-class EnsembleResult(dict):
+class EnsembleResult(_Fields):
     """times (T,); q, v (runs, T, n); lam (runs, T, m); y (runs, T, r) with first-order states;
     status (runs,) 0, 1 if a terminal event or the step hook ended the run before the last
     output time (what it reached is recorded; Case.summary is called), or the negative
@@ -74,12 +75,6 @@ class EnsembleResult(dict):
     success); steps (runs,) accepted steps; summary: dict of
     arrays (runs, ...) from Case.summary (NaN for failed runs); failures: [(run, message)].
     Values not reached by a failed run are NaN."""
-
-    def __getattr__(self, name):
-        try:
-            return self[name]
-        except KeyError:
-            raise AttributeError(name) from None
 
     def __repr__(self):
         return "EnsembleResult(runs=%d, outputs=%d, failed=%d)" % (
@@ -238,7 +233,6 @@ def run(model, parameters, times, *, initial=None, h=None, engine="serial", work
         else:
             pieces = _chunks(runs, workers * 4 if chunk_size is None
                              else math.ceil(runs / chunk_size))
-        from .integrate import _progress_bar
         bar = _progress_bar(progress, 0, runs, unit="run")
         results = []
 

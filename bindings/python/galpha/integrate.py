@@ -7,18 +7,22 @@ from .errors import GalphaError
 from .solver import Solver
 
 
-class IntegrateResult(dict):
-    """Attributes: t (N,), q, v, qdd (N, n), lam (N, m), stats (dict), success (bool),
-    status (0 or the failing ga_status, 1 when a terminal event ended the run), message (str);
-    with first-order states (y0): states (N, r); with events: t_events, y_events ([q, v]
-    stacked), q_events, v_events, lam_events (and states_events) (lists, one array per event
-    function); with dense_output: sol (OdeSolution)."""
+class _Fields(dict):
+    """A dict whose keys read as attributes too (as scipy's OptimizeResult)."""
 
     def __getattr__(self, name):
         try:
             return self[name]
         except KeyError:
             raise AttributeError(name) from None
+
+
+class IntegrateResult(_Fields):
+    """Attributes: t (N,), q, v, qdd (N, n), lam (N, m), stats (dict), success (bool),
+    status (0 or the failing ga_status, 1 when a terminal event ended the run), message (str);
+    with first-order states (y0): states (N, r); with events: t_events, y_events ([q, v]
+    stacked), q_events, v_events, lam_events (and states_events) (lists, one array per event
+    function); with dense_output: sol (OdeSolution)."""
 
     def __repr__(self):
         return "IntegrateResult(success=%r, message=%r, outputs=%d, steps=%d, t_end=%g)" % (
