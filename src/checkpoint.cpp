@@ -1,9 +1,9 @@
-// Checkpoint and restart (ga_get_state, ga_set_state). Layout 3, in doubles:
-//   header   [magic, 3, n, m, t, h_last, h_next, err_prev, grew, sliver_span,
+// Checkpoint and restart (ga_get_state, ga_set_state). Layout 4, in doubles:
+//   header   [magic, 4, n, m, t, h_last, h_next, err_prev, grew, sliver_span,
 //             matrix kept (0/1), its t, its h, t of its B, tangents (K + 2 C + 4 Z + 8 if
 //             they were central differences, as for sensitivities),
-//             theta_prev, refresh_steps_left, reuse_backoff, fd_tangents]
-//   state    q, v, qdd (n each), lambda (m), a, a_prev (n each)
+//             theta_prev, refresh_steps_left, reuse_backoff, fd_tangents, c_count, c_dt]
+//   state    q, v, qdd (n each), lambda (m), a, a_prev, c, c_prev (n each)
 //   matrix   the iterate it was factorized at: q, v, qdd (n), lambda (m); q of its B (n)
 //   active   the constraints in use (m flags; all 1 unless GA_REDUNDANT_DROP dropped some)
 //   pivots   blocks of pivot_state_size(N) (backend.hpp) for S_ (N = n + m), S2_ (2n + 2m),
@@ -16,7 +16,8 @@
 // iterate and hands every sparse LU its pivots back, so the restored run repeats the run it
 // came from bit for bit (a kept matrix or pivots left out would make the next steps converge
 // to other round-off). Layout 2 (galpha 0.2: header up to grew, then the state) is read as a
-// restart: no kept matrix, pivots chosen afresh.
+// restart: no kept matrix, pivots chosen afresh. Layout 3 (no c_count, c_dt, c, c_prev) is
+// read as a state whose index-3 error estimate has no consistent accelerations yet.
 #include "solver.hpp"
 
 #include <cmath>
@@ -25,9 +26,10 @@ namespace ga {
 
 namespace {
 constexpr double kStateMagic = 26465.0;  // 0x6761, "ga"
-constexpr double kStateVersion = 3.0;
-constexpr std::size_t kHeader = 19;
-constexpr std::size_t kHeader2 = 9;  // layout 2
+constexpr double kStateVersion = 4.0;
+constexpr std::size_t kHeader = 21;
+constexpr std::size_t kHeader3 = 19;  // layout 3
+constexpr std::size_t kHeader2 = 9;   // layout 2
 
 bool is_flag(double x) { return x == 0.0 || x == 1.0; }
 bool is_count(double x, double max) { return x >= 0.0 && x <= max && x == std::floor(x); }
@@ -36,11 +38,12 @@ struct Layout {
     std::size_t matrix, active, pivots[4], end;  // offsets; pivots of S_, S2_, P_, O_
 };
 
-Layout layout(int n, int m)
+// Layout 4, or with layout3 the one before it (19 header entries, no c and c_prev).
+Layout layout(int n, int m, bool layout3 = false)
 {
     const std::size_t N = static_cast<std::size_t>(n), M = static_cast<std::size_t>(m);
     Layout l;
-    l.matrix = kHeader + 5 * N + M;
+    l.matrix = layout3 ? kHeader3 + 5 * N + M : kHeader + 7 * N + M;
     l.active = l.matrix + 4 * N + M;
     l.pivots[0] = l.active + M;
     l.pivots[1] = l.pivots[0] + pivot_state_size(n + m);
@@ -51,9 +54,11 @@ Layout layout(int n, int m)
 }
 }  // namespace
 
-std::size_t Solver::state_size() const
+std::size_t Solver::state_size() const { return state_size_in(false); }
+
+std::size_t Solver::state_size_in(bool layout3) const
 {
-    return layout(n_, m_).end + 6 * static_cast<std::size_t>(r()) +
+    return layout(n_, m_, layout3).end + 6 * static_cast<std::size_t>(r()) +
            static_cast<std::size_t>(sens.np) *
                (4 * static_cast<std::size_t>(n_) + m_ + 3 * static_cast<std::size_t>(r()));
 }
@@ -84,12 +89,18 @@ void Solver::get_state(double *buf) const
                                     jacobian_valid_ ? theta_prev_ : -1.0,
                                     static_cast<double>(refresh_steps_left_),
                                     static_cast<double>(reuse_backoff_),
-                                    fd_tangents_ ? 1.0 : 0.0};
+                                    fd_tangents_ ? 1.0 : 0.0,
+                                    static_cast<double>(s.c_count),
+                                    s.c_count == 2 ? s.c_dt : 0.0};
     std::copy(header, header + kHeader, buf);
     double *p = buf + kHeader;
-    for (const Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev, &r.q, &r.v, &r.qdd,
-                         &r.lambda, &r.q_b}) {
-        Eigen::Map<Vec>(p, x->size()) = *x;
+    // (c and c_prev as zeros where they are not known: the same state, the same checkpoint)
+    for (const Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev, &s.c, &s.c_prev, &r.q,
+                         &r.v, &r.qdd, &r.lambda, &r.q_b}) {
+        if ((x == &s.c && s.c_count < 1) || (x == &s.c_prev && s.c_count < 2))
+            Eigen::Map<Vec>(p, x->size()).setZero();
+        else
+            Eigen::Map<Vec>(p, x->size()) = *x;
         p += x->size();
     }
     for (int i = 0; i < m_; ++i)
@@ -113,17 +124,18 @@ void Solver::get_state(double *buf) const
 ga_status Solver::set_state(const double *buf, std::size_t len, bool internal)
 {
     const bool layout2 = len >= 2 && buf[0] == kStateMagic && buf[1] == 2.0;
-    const Layout l = layout(n_, m_);
+    const bool layout3 = len >= 2 && buf[0] == kStateMagic && buf[1] == 3.0;
+    const Layout l = layout(n_, m_, layout3);
     const std::size_t expected =
         layout2 ? kHeader2 + 5 * static_cast<std::size_t>(n_) + static_cast<std::size_t>(m_)
-                : state_size();
+                : state_size_in(layout3);
     if (len != expected)
         return diag.fail(GA_ERR_ARG, "checkpoint has %zu doubles, this solver needs %zu", len,
-                         state_size());
+                         expected);
     if (layout2 && r() > 0)
         return diag.fail(GA_ERR_ARG, "a layout-2 checkpoint has no first-order states; this "
                          "solver has %d", r());
-    if (buf[0] != kStateMagic || (buf[1] != kStateVersion && !layout2))
+    if (buf[0] != kStateMagic || (buf[1] != kStateVersion && !layout2 && !layout3))
         return diag.fail(GA_ERR_ARG, "not a galpha checkpoint (magic %g, layout version %g)",
                          buf[0], buf[1]);
     if (buf[2] != n_ || buf[3] != m_)
@@ -158,6 +170,12 @@ ga_status Solver::set_state(const double *buf, std::size_t len, bool internal)
                      !(buf[17] >= 1.0) || !is_flag(buf[18])))
         return diag.fail(GA_ERR_ARG, "checkpoint entries 10-18 (the kept iteration matrix and "
                          "its reuse) are not those a solver writes");
+    const bool with_c = !layout2 && !layout3;
+    const int c_count = with_c ? static_cast<int>(buf[19]) : 0;
+    if (with_c && (!is_count(buf[19], 2.0) || buf[20] < 0.0 || (c_count == 2 && !(buf[20] > 0.0))))
+        return diag.fail(GA_ERR_ARG, "checkpoint entries 19-20 (c_count = %g, c_dt = %g: the "
+                         "consistent accelerations of the error estimate) are not those a "
+                         "solver writes", buf[19], buf[20]);
     // The constraints in use: as the checkpoint says (layout 2, which does not say, selects
     // them anew at its q). Dropped ones need a solver that drops them.
     for (int i = 0; i < m_ && !layout2; ++i) {
@@ -216,10 +234,20 @@ ga_status Solver::set_state(const double *buf, std::size_t len, bool internal)
     control.h_next = buf[6];
     control.err_prev = buf[7];
     control.grew = buf[8] != 0.0;
-    const double *p = buf + (layout2 ? kHeader2 : kHeader);
+    const double *p = buf + (layout2 ? kHeader2 : layout3 ? kHeader3 : kHeader);
     for (Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev}) {
         *x = Eigen::Map<const Vec>(p, x->size());
         p += x->size();
+    }
+    s.c_count = c_count;
+    s.c_dt = with_c ? buf[20] : 0.0;
+    for (Vec *x : {&s.c, &s.c_prev}) {
+        if (with_c) {
+            *x = Eigen::Map<const Vec>(p, x->size());
+            p += x->size();
+        } else {
+            x->setZero();
+        }
     }
     const double *py = buf + l.end;
     if (!layout2) {

@@ -35,6 +35,19 @@ double Control::calibration() const
     return std::max(kCalibration * std::sqrt(std::min(rtol, 1.0)), kMinLocalTolerance / rtol);
 }
 
+// Index 3 with constraints and a multiplier transient damped at least as fast as at the default
+// rho_inf = 0.9 (its double root -alpha_f / (1 - alpha_f), sec. 1.4): the error estimate
+// differences consistent accelerations. Closer to 1 the transient, amplified up to about
+// 1 / (e (1 - rho_inf)) by the double root, moves q and v by more than the smooth estimate
+// sees, and differences of a, which carry it, keep the error at the tolerance
+// (design-notes.md, "Tolerance proportionality").
+bool Solver::consistent_estimate() const
+{
+    constexpr double kMaxRoot = 0.9;
+    const double alpha_f = params.alpha_f;
+    return formulation == GA_INDEX3 && m_ > 0 && alpha_f <= kMaxRoot * (1.0 - alpha_f) * (1.0 + 1e-12);
+}
+
 // Weighted RMS norm of the local error estimates of the step just computed (trial_ from
 // accepted_ with a_n), over positions and velocities; multipliers are not part of it, as in
 // index-aware DAE codes (sec. 1.5d).
@@ -45,16 +58,54 @@ double Control::calibration() const
 // With constraints both estimates are projected onto the tangent space of the constraints,
 // null(Phi_q), along the directions constraint forces act in, M^-1 Phi_q^T (the M-orthogonal
 // projection): exact and numerical solution both satisfy the constraints, so their difference
-// has no such component to leading order, while a carries the transients of the multipliers
-// after step-size changes (index 3), which would otherwise throttle the controller.
-double Solver::error_norm(double h)
+// has no such component to leading order.
+// In index 3 the differences are those of the accelerations consistent with each step's
+// (q, v) instead of a (sec. 1.5c): a carries, besides the multipliers' transient after every
+// change of h, a step-to-step oscillation along the constraints that the projection does not
+// remove and that made index-3 steps three times shorter than index-2 ones for the same error.
+ga_status Solver::error_norm(double h, double t_end, double &err)
 {
     const Params &p = params;
-    const State &s = accepted_, &x = trial_;
+    const State &s = accepted_;
+    State &x = trial_;
     const double da = p.alpha_m - p.alpha_f;
     const double cq = h * h * (p.beta + 0.5 * da - 1.0 / 6.0);
     const double cv = 1.0 / 12.0 - da * da + da * (p.alpha_m - 0.5);
     Vec &eq = dq_, &ev = dw_;  // scratch
+    if (consistent_estimate()) {
+        // Into the output's workspace: when the step is accepted they are its output.
+        output_for_ = -1;
+        const Vec *y_before = model.y_now;
+        model.y_now = &x.y;
+        const ga_status st = consistent_output(t_end, x.q, x.v, "the error estimate");
+        model.y_now = y_before;
+        if (st)
+            return st;
+        x.c = out_qdd_;
+        x.c_prev = s.c;
+        x.c_dt = h;
+        const bool sliver = x.sliver_span > 0.0;  // too close to difference twice
+        x.c_count = sliver ? 1 : std::min(s.c_count + 1, 2);
+        if (s.c_count >= 1)
+            eq = cq * (x.c - s.c);
+        else  // after a fixed step: no consistent accelerations at its start
+            eq = cq * (x.a - *a_start_);
+        if (s.c_count >= 2 && !sliver)
+            ev = (cv * h * h * h / (0.5 * (h + s.c_dt))) *
+                 ((x.c - s.c) / h - (s.c - s.c_prev) / s.c_dt);
+        else
+            ev.setZero();
+        // The projection with O_, factorized at the step's end for the accelerations:
+        // [sigma M Phi_q^T; Phi_q 0] [x; y] = [sigma M e; 0]
+        for (Vec *e : {&eq, &ev}) {
+            rq_.setZero();
+            out_M_.multiply_add(-out_sigma_, *e, rq_);
+            phi_.setZero();
+            O_.solve(rq_, phi_, *e, lambda_tmp_);
+        }
+        err = weighted_error_norm(s, x, eq, ev, h);
+        return GA_OK;
+    }
     const Vec &a_n = *a_start_;
     eq = cq * (x.a - a_n);
     if (s.h_last > 0.0)
@@ -73,6 +124,13 @@ double Solver::error_norm(double h)
                 P_.solve(rq_, phi_, *e, lambda_tmp_);
             }
     }
+    err = weighted_error_norm(s, x, eq, ev, h);
+    return GA_OK;
+}
+
+double Solver::weighted_error_norm(const State &s, const State &x, const Vec &eq, const Vec &ev,
+                                   double h)
+{
     const double rtol = control.rtol, atol = control.atol;
     const double scale = control.calibration();
     double sum = 0.0;
@@ -90,20 +148,22 @@ ga_status Solver::adaptive_step(double t_stop)
 {
     // In index 3 every change of h starts a transient in qdd and lambda whose recursion has
     // the double root -alpha_f/(1 - alpha_f) (docs/algorithms.md sec. 1.4, 6.2): -rho_inf, so at
-    // rho_inf = 1 (alpha_f = 1/2) it never decays. The error estimate, built from differences
-    // of a, then asks for ever shorter steps, and every shorter step starts another transient:
-    // a double pendulum at rtol 1e-6 took 11 million steps to t = 0.36 before h fell below its
-    // floor (0.999: 46 000 steps to t = 2; the index-2 form 367 at any rho_inf). Refused at
-    // once instead; a system without constraints has no such transient.
+    // rho_inf = 1 (alpha_f = 1/2) it never decays, and every change of h adds to it. Even with
+    // an error estimate blind to it, such runs lose their accuracy and their steps
+    // (design-notes.md, "No adaptive steps in index 3 at rho_inf = 1"). Refused at once
+    // instead; a system without constraints has no such transient.
     if (formulation == GA_INDEX3 && m_ > 0 && !(params.alpha_f < 0.5))
         return diag.fail(GA_ERR_ARG,
                          "adaptive steps in the index-3 formulation need rho_inf < 1 "
                          "(alpha_f = %g): each change of h starts a transient of the "
-                         "multipliers that rho_inf = 1 never damps, and the steps would shrink "
-                         "without end; use the stabilized index-2 formulation "
+                         "multipliers that rho_inf = 1 never damps, and the run would lose its "
+                         "accuracy and its step size; use the stabilized index-2 formulation "
                          "(ga_set_formulation) or rho_inf < 1",
                          params.alpha_f);
-    setup_projection();
+    if (consistent_estimate())
+        setup_output();
+    else
+        setup_projection();
     const double t = accepted_.t;
     const double remaining = t_stop - t;
     if (!(remaining > 0.0))
@@ -161,8 +221,10 @@ ga_status Solver::adaptive_step(double t_stop)
         // A sliver is a Taylor step (sliver_step) only when it lands on t_stop; retries after
         // failures stay under error control.
         ga_status st = attempt_step(h, tol, land);
+        double err = 0.0;
+        if (st == GA_OK)
+            st = error_norm(h, land ? t_stop : trial_.t, err);
         if (st == GA_OK) {
-            const double err = error_norm(h);
             control.err_last = err;
             if (err <= 1.0) {
                 if (auto st2 = sensitivity_step(h)) {  // of the accepted step only
@@ -172,6 +234,8 @@ ga_status Solver::adaptive_step(double t_stop)
                 }
                 const double h_prev = accepted_.h_last;  // the accepted step before this one
                 commit(land, t_stop);
+                if (consistent_estimate())  // the estimate's accelerations are the output
+                    output_for_ = state_id_;
                 // Predictive controller (Gustafsson, as in Radau5 and SciPy's Radau; k = 3 for
                 // a local error O(h^3)): the elementary proposal s err^(-1/k), reduced when
                 // the error grew faster than the step size explains,

@@ -124,6 +124,8 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
     }
     x.a = x.qdd;  // eq. (3): a_0 = qdd_0
     x.a_prev = x.a;
+    x.c = x.qdd;
+    x.c_count = 1;
 
     accepted_.swap(trial_);
     sens.accepted.swap(sens.trial);
@@ -188,6 +190,7 @@ ga_status Solver::acceleration_level(double t, const Vec &q, const Vec &v, Saddl
                          "saddle-point matrix [M Phi_q^T; Phi_q 0] is singular at t = %.17g "
                          "(rcond = %.3g)",
                          t, w.K.rcond());
+    w.sigma = sigma;
     w.r = -sigma * w.f;
     w.K.solve(w.r, w.c, qdd, lambda);
     if (m_ > 0)

@@ -33,7 +33,7 @@ void Solver::setup_output()
 }
 
 // qdd, lambda from the acceleration-level equations at (t, q, v) into out_qdd_, out_lambda_.
-ga_status Solver::consistent_output(double t, const Vec &q, const Vec &v)
+ga_status Solver::consistent_output(double t, const Vec &q, const Vec &v, const char *purpose)
 {
     if (!O_.ready())
         return diag.fail(GA_ERR_INTERNAL, "the workspace of consistent output was not set up");
@@ -44,10 +44,11 @@ ga_status Solver::consistent_output(double t, const Vec &q, const Vec &v)
     }
     w.mass_given = model.constant_mass && out_mass_valid_;
     const ga_status st = acceleration_level(t, q, v, w, out_qdd_, out_lambda_);
+    out_sigma_ = w.sigma;
     if (w.mass_evaluated)
         out_mass_valid_ = model.constant_mass;
     if (st)
-        diag.append(" (consistent accelerations and multipliers for output at t = %.17g)", t);
+        diag.append(" (consistent accelerations and multipliers for %s at t = %.17g)", purpose, t);
     return st;
 }
 

@@ -96,6 +96,10 @@ void State::allocate(int n, int m)
     lambda.setZero(m);
     a.setZero(n);
     a_prev.setZero(n);
+    c.setZero(n);
+    c_prev.setZero(n);
+    c_dt = 0.0;
+    c_count = 0;
 }
 
 void State::allocate_first_order(int r)
@@ -117,6 +121,10 @@ void State::swap(State &other)
     lambda.swap(other.lambda);
     a.swap(other.a);
     a_prev.swap(other.a_prev);
+    c.swap(other.c);
+    c_prev.swap(other.c_prev);
+    std::swap(c_dt, other.c_dt);
+    std::swap(c_count, other.c_count);
     y.swap(other.y);
     ydot.swap(other.ydot);
     w.swap(other.w);
@@ -523,6 +531,7 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     x.t = s.t + h;
     x.h_last = h;
     x.sliver_span = 0.0;
+    x.c_count = 0;  // an adaptive step's error estimate computes them (error_norm)
     if (convergence_.rate() >= 0.0)
         theta_prev_ = convergence_.rate();
     return GA_OK;
@@ -621,6 +630,8 @@ ga_status Solver::sliver_step(double h)
     }
     x.h_last = s.h_last;
     x.sliver_span = s.sliver_span + h;
+    x.c = x.qdd;  // consistent; the one before is a sliver away, too close to difference
+    x.c_count = 1;
     a_start_ = &x.a;  // for the error estimate of adaptive steps: none from this step
     w_start_ = &x.w;  // (likewise for the first-order states)
     last_newton_iters_ = 0;

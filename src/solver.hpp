@@ -26,6 +26,11 @@ struct State {
     double sliver_span = 0.0;
     Vec q, v, qdd, lambda, a;
     Vec a_prev;           // a of the state before (variable-step error estimate)
+    // Index-3 adaptive steps (control.cpp): qdd consistent with (q, v) here (c) and at the
+    // state before (c_prev), c_dt apart; c_count of them known (0-2; 0 after a fixed step).
+    Vec c, c_prev;
+    double c_dt = 0.0;
+    int c_count = 0;
     // First-order states (docs/algorithms.md sec. 11): y, y' = g, the auxiliary w of y' (as a
     // is of qdd) and w of the state before; empty when r = 0.
     Vec y, ydot, w, w_prev;
@@ -57,6 +62,7 @@ struct SaddleWorkspace {
     Vec &f, &c, &r;
     bool mass_given = false;      // M holds the constant mass matrix already
     bool mass_evaluated = false;  // set by the solve
+    double sigma = 1.0;           // set by the solve: the first block row's scaling
 };
 
 class Solver {
@@ -182,11 +188,13 @@ public:
     int last_newton_iters() const { return last_newton_iters_; }
     double last_newton_ratio() const { return convergence_.ratio(); }
 
-    // Checkpoint (checkpoint.cpp, layout 3): the state, the step-size control, and what
+    // Checkpoint (checkpoint.cpp, layout 4): the state, the step-size control, and what
     // rebuilds the kept iteration matrix and the pivots of every sparse LU bit for bit, so
     // that taking one changes nothing and a restored run continues as the run it came from.
-    // Layout 2 (galpha 0.2: the state and the control only) is read as a restart.
+    // Layout 2 (galpha 0.2: the state and the control only) is read as a restart, layout 3
+    // (no consistent accelerations for the index-3 error estimate) as a state without them.
     std::size_t state_size() const;
+    std::size_t state_size_in(bool layout3) const;  // 4, or layout 3's
     void get_state(double *buf) const;
     // internal: the adjoint sweep's own restores into a recorded run
     ga_status set_state(const double *buf, std::size_t len, bool internal = false);
@@ -285,7 +293,11 @@ private:
     ga_status rebuild_matrix();  // checkpoint.cpp: the kept matrix again, from recipe_
     ga_status evaluate_mass(double t, const Vec &q);
     void commit(bool land_on, double t_land);
-    double error_norm(double h);  // control.cpp
+    // control.cpp: the error norm of trial_ (a step of h ending at t_end)
+    ga_status error_norm(double h, double t_end, double &err);
+    bool consistent_estimate() const;
+    double weighted_error_norm(const State &s, const State &x, const Vec &eq, const Vec &ev,
+                               double h);
     // init.cpp
     ga_status start(double t0, const double *q0, const double *v0);
     void restore_active(const std::vector<unsigned char> &before);
@@ -359,13 +371,15 @@ private:
 
     // Consistent output (output.cpp): its own saddle-point matrix and scratch, and the
     // accepted state its values belong to (state_id_ counts accepted states).
-    ga_status consistent_output(double t, const Vec &q, const Vec &v);
+    ga_status consistent_output(double t, const Vec &q, const Vec &v,
+                                const char *purpose = "output");
     IterationMatrix O_;
     ModelMatrix out_M_, out_J_;
     Vec out_f_, out_c_, out_r_, out_q_, out_v_, out_qdd_, out_lambda_;
     long long state_id_ = 0;
     mutable long long output_for_ = -1;
     mutable bool out_mass_valid_ = false;
+    double out_sigma_ = 1.0;  // O_'s scaling of its first block row (acceleration_level)
 
     // Step workspace, sized once.
     ModelMatrix M_, J_, K_, C_, B_;  // B_: index-2, Phi_q(q_n)

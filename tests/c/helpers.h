@@ -11,10 +11,12 @@
 
 #include "scenes/pendulum.h"
 
-/* Checkpoint layout 3 (src/checkpoint.cpp), as far as tests look into it: 19 header entries
- * (entry 9: the span of slivers), then q, v, qdd, lambda, a, a_prev; then what rebuilds the
- * kept matrix (4n + m + n) and four pivot blocks. The pendulum's takes 85 doubles. */
-enum { CKPT_HEADER = 19, CKPT_PENDULUM = 86 };
+/* Checkpoint layout 4 (src/checkpoint.cpp), as far as tests look into it: 21 header entries
+ * (entry 9: the span of slivers; 19-20: how many consistent accelerations the index-3 error
+ * estimate has, and their distance in t), then q, v, qdd, lambda, a, a_prev, c, c_prev; then
+ * what rebuilds the kept matrix (4n + m + n) and four pivot blocks. The pendulum's takes 92
+ * doubles. */
+enum { CKPT_HEADER = 21, CKPT_PENDULUM = 92 };
 
 /* The layout-2 checkpoint (galpha 0.2) of the same state: header entries 0-8 with version 2,
  * then the state; its length. */
@@ -29,13 +31,29 @@ static inline size_t ckpt_as_layout2(const double *c3, double *c2)
     return 9 + state;
 }
 
+/* The layout-3 checkpoint of the same state (no entries 19-20, no c and c_prev), from one of
+ * `len` doubles; its length. */
+static inline size_t ckpt_as_layout3(const double *c4, size_t len, double *c3)
+{
+    const size_t n = (size_t)c4[2], state = 5 * n + (size_t)c4[3];
+    size_t k3 = 0;
+    for (size_t k = 0; k < 19; ++k)
+        c3[k3++] = c4[k];
+    c3[1] = 3.0;
+    for (size_t k = 0; k < state; ++k)
+        c3[k3++] = c4[CKPT_HEADER + k];
+    for (size_t k = CKPT_HEADER + state + 2 * n; k < len; ++k)
+        c3[k3++] = c4[k];
+    return k3;
+}
+
 /* What a failed step must leave as it was: header entries 0-9 (t, the step-size control) and
- * q, v, qdd, lambda, a, a_prev. (The rest rebuilds the kept matrix, which a failed step drops
- * on purpose: the next attempt starts with a fresh one.) */
+ * 19-20, and q, v, qdd, lambda, a, a_prev, c, c_prev. (The rest rebuilds the kept matrix,
+ * which a failed step drops on purpose: the next attempt starts with a fresh one.) */
 static inline int ckpt_same_state(const double *x, const double *y)
 {
-    const size_t state = 5 * (size_t)x[2] + (size_t)x[3];
-    return memcmp(x, y, 10 * sizeof(double)) == 0 &&
+    const size_t state = 7 * (size_t)x[2] + (size_t)x[3];
+    return memcmp(x, y, 10 * sizeof(double)) == 0 && memcmp(x + 19, y + 19, 2 * sizeof(double)) == 0 &&
            memcmp(x + CKPT_HEADER, y + CKPT_HEADER, state * sizeof(double)) == 0;
 }
 

@@ -124,8 +124,8 @@ static void sparse_restart(int formulation, int adaptive, int sliver_first)
     advance(s[0], 5);
     size_t len = 0;
     assert_int_equal(ga_state_size(s[0], &len), GA_OK);
-    /* 19 + 9n + 2m, and pivot blocks of 4 + 2N for N = n + m (three) and 2n + 2m */
-    assert_int_equal(len, 35 + 19 * (size_t)n + 13 * 2 * (size_t)c.links);
+    /* 21 + 11n + 2m, and pivot blocks of 4 + 2N for N = n + m (three) and 2n + 2m */
+    assert_int_equal(len, 37 + 21 * (size_t)n + 13 * 2 * (size_t)c.links);
     double *ckpt = malloc(3 * len * sizeof(double)), *a = ckpt + len, *b = a + len;
     assert_non_null(ckpt);
     assert_int_equal(ga_get_state(s[0], ckpt, len), GA_OK);
@@ -396,6 +396,45 @@ static void restart_after_a_jump_is_a_new_solver(void **state)
     }
 }
 
+/* A layout-3 checkpoint (before the index-3 error estimate kept consistent accelerations) is
+ * read as the same state with none of them: the estimate falls back to differences of a for
+ * one step, knows one after it and two after the next, and the run ends where the run it came
+ * from ends, within its tolerance. */
+static void layout3_is_read_without_consistent_accelerations(void **state)
+{
+    (void)state;
+    double q[2], v[2], ckpt[LEN], old[LEN], b[LEN], qa[2], qb[2], t;
+    pendulum_state(&P, 1.2, 0.8, q, v);
+    ga_solver *s = make(), *r = make();
+    assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+    assert_int_equal(ga_set_tolerances(r, 1e-6, 1e-6), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    adaptive_steps(s, 50);
+    assert_int_equal(ga_get_state(s, ckpt, LEN), GA_OK);
+    assert_true(ckpt[19] == 2.0 && ckpt[20] > 0.0);
+    const size_t len3 = ckpt_as_layout3(ckpt, LEN, old);
+    assert_int_equal(len3, LEN - 6);
+    assert_int_equal(ga_set_state(r, old, len3 - 1), GA_ERR_ARG);
+    assert_int_equal(ga_set_state(r, old, len3), GA_OK);
+    assert_int_equal(ga_get_state(r, b, LEN), GA_OK);
+    assert_memory_equal(b, ckpt, 19 * sizeof(double));
+    assert_true(b[19] == 0.0 && b[20] == 0.0);
+    assert_memory_equal(b + CKPT_HEADER, ckpt + CKPT_HEADER, 11 * sizeof(double));
+    for (int k = 1; k <= 2; ++k) {
+        adaptive_steps(r, 1);
+        assert_int_equal(ga_get_state(r, b, LEN), GA_OK);
+        assert_true(b[19] == (double)k);
+    }
+    assert_int_equal(ga_get_t(s, &t), GA_OK);
+    assert_int_equal(ga_advance(s, t + 1.0), GA_OK);
+    assert_int_equal(ga_advance(r, t + 1.0), GA_OK);
+    assert_int_equal(ga_get_q(s, qa), GA_OK);
+    assert_int_equal(ga_get_q(r, qb), GA_OK);
+    assert_true(max_abs_diff(qa, qb, 2) > 0.0 && max_abs_diff(qa, qb, 2) < 1e-5);
+    ga_free(s);
+    ga_free(r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -407,6 +446,7 @@ int main(void)
         cmocka_unit_test(taking_checkpoints_changes_nothing),
         cmocka_unit_test(failed_rebuild_restores_as_a_restart),
         cmocka_unit_test(restart_after_a_jump_is_a_new_solver),
+        cmocka_unit_test(layout3_is_read_without_consistent_accelerations),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -549,19 +549,29 @@ static void bad_checkpoints_are_refused(void **state)
         assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
         expect_message(x->s, "entries 10-18");
     }
-    /* the constraints in use (entry 39 for the pendulum): flags; a dropped one only for a
+    /* the consistent accelerations of the index-3 error estimate (entries 19-20): how many
+     * (0-2), and their distance in t, a step when there are two */
+    const double bad_c[][2] = {{3.0, 0.0}, {-1.0, 0.0}, {1.5, 0.0}, {1.0, -1e-3}, {2.0, 0.0}};
+    for (size_t k = 0; k < sizeof bad_c / sizeof bad_c[0]; ++k) {
+        memcpy(buf, before, len * sizeof(double));
+        buf[19] = bad_c[k][0];
+        buf[20] = bad_c[k][1];
+        assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
+        expect_message(x->s, "entries 19-20");
+    }
+    /* the constraints in use (entry 45 for the pendulum): flags; a dropped one only for a
      * solver that drops them */
     memcpy(buf, before, len * sizeof(double));
-    assert_true(before[39] == 1.0);
-    buf[39] = 0.5;
+    assert_true(before[45] == 1.0);
+    buf[45] = 0.5;
     assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
     expect_message(x->s, "neither 0 nor 1");
-    buf[39] = 0.0;
+    buf[45] = 0.0;
     assert_int_equal(ga_set_state(x->s, buf, len), GA_ERR_ARG);
     expect_message(x->s, "dropped constraint 0");
-    /* the pivot blocks (from entry 40 for the pendulum): flags and sizes as written */
-    const double bad_pivots[][2] = {{40, 0.5}, {41, -1.0}, {41, 2.5}, {42, 2.0}, {43, 0.5},
-                                    {50, 3.0}, {66, 0.5}, {76, 0.5}};
+    /* the pivot blocks (from entry 46 for the pendulum): flags and sizes as written */
+    const double bad_pivots[][2] = {{46, 0.5}, {47, -1.0}, {47, 2.5}, {48, 2.0}, {49, 0.5},
+                                    {56, 3.0}, {72, 0.5}, {82, 0.5}};
     for (size_t k = 0; k < sizeof bad_pivots / sizeof bad_pivots[0]; ++k) {
         memcpy(buf, before, len * sizeof(double));
         buf[(int)bad_pivots[k][0]] = bad_pivots[k][1];

@@ -132,6 +132,46 @@ static void reading_does_not_change_the_run(void **state)
     }
 }
 
+/* Adaptive index-3 steps solve the acceleration-level equations at their end for their error
+ * estimate: after such a step, the output is those values, read without another
+ * factorization, and bit for bit what a solver restored at that state computes afresh.
+ * Every scene of the catalog, dense and sparse. */
+static void adaptive_index3_output_comes_with_the_step(void **state)
+{
+    (void)state;
+    for (int which = 0; which < kCatalogScenes; ++which) {
+        const catalog_scene sc = catalog_make(which);
+        ga_solver *s = catalog_solver(&sc), *r = catalog_solver(&sc);
+        assert_non_null(s);
+        assert_non_null(r);
+        assert_int_equal(ga_set_tolerances(s, 1e-5, 1e-5), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, sc.q0, sc.v0), GA_OK);
+        size_t len = 0;
+        assert_int_equal(ga_state_size(s, &len), GA_OK);
+        double *ckpt = malloc(len * sizeof *ckpt);
+        assert_non_null(ckpt);
+        for (int k = 0; k < 30; ++k) {
+            assert_int_equal(ga_step_adaptive(s, 10.0), GA_OK);
+            long long f0 = -1, f1 = -1;
+            double lam[2][kCatalogMaxN], qdd[2][kCatalogMaxN];
+            assert_int_equal(ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &f0), GA_OK);
+            assert_int_equal(ga_get_lambda(s, lam[0]), GA_OK);
+            assert_int_equal(ga_get_qdd(s, qdd[0]), GA_OK);
+            assert_int_equal(ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &f1), GA_OK);
+            assert_true(f1 == f0);
+            assert_int_equal(ga_get_state(s, ckpt, len), GA_OK);
+            assert_int_equal(ga_set_state(r, ckpt, len), GA_OK);
+            assert_int_equal(ga_get_lambda(r, lam[1]), GA_OK);
+            assert_int_equal(ga_get_qdd(r, qdd[1]), GA_OK);
+            assert_memory_equal(lam[0], lam[1], sizeof(double) * (size_t)sc.m);
+            assert_memory_equal(qdd[0], qdd[1], sizeof(double) * (size_t)sc.n);
+        }
+        free(ckpt);
+        ga_free(s);
+        ga_free(r);
+    }
+}
+
 /* The consistent multiplier at the end of a step equals the one interpolated there, and
  * inside a step it is that of the interpolated (q, v): within the interpolation's O(h^3)
  * (third-order Hermite) of the exact pendulum multiplier. */
@@ -211,6 +251,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(driven_track_multiplier_in_adaptive_index3_steps),
         cmocka_unit_test(reading_does_not_change_the_run),
+        cmocka_unit_test(adaptive_index3_output_comes_with_the_step),
         cmocka_unit_test(interpolated_multiplier_is_consistent),
         cmocka_unit_test(failed_output_is_reported_and_changes_nothing),
     };
