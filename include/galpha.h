@@ -522,17 +522,22 @@ GA_API ga_status ga_set_initial_step(ga_solver *s, double h0);
  *  GA_COUNT_REJECTED_STEPS) or by a recoverable failure (Newton, callback > 0, NaN, singular
  *  matrix; GA_COUNT_FAILED_STEPS) are retried smaller until one is accepted.
  *  Error estimate (position, docs/algorithms.md sec. 1.5a): h^2 (beta + delta_alpha/2 - 1/6)
- *  (a_n+1 - a_n); velocity (sec. 1.5b) from the divided differences of a over two steps.
+ *  (a_n+1 - a_n); velocity (sec. 1.5b) from the divided differences of a over two steps. In
+ *  the index-3 formulation with constraints at rho_inf <= 0.9 (sec. 1.5c) the differences are
+ *  those of the accelerations consistent with each step's (q, v): they are solved for at the
+ *  end of every attempted step, and after an accepted one they are its consistent output
+ *  (ga_get_qdd, ga_get_lambda read them without another solve). Both follow the tolerance
+ *  (tests/c/test_tolerance.c).
  *  Controller: predictive (Gustafsson, as in Radau5), safety 0.9, growth at most 2 and not on
  *  consecutive steps nor right after a rejection, shrink at least 0.2. First step (unless
  *  ga_set_initial_step): half the step over which qdd moves q by the tolerance, in the
  *  weighted norm of the error test.
  *  Use with ga_interpolate for output at user times without shortening steps. The first
- *  adaptive call allocates the workspace of the error estimate's projection (fixed-step runs
- *  do without it); ga_step_adaptive never allocates after that.
+ *  adaptive call allocates the workspace of the error estimate's projection or of consistent
+ *  output (fixed-step runs do without it); ga_step_adaptive never allocates after that.
  *  Errors: GA_ERR_ARG (t_stop not after t; or the index-3 formulation with constraints at
  *  rho_inf = 1, where each change of h starts a multiplier transient that is never damped and
- *  the steps would shrink without end: take GA_INDEX2_STABILIZED or rho_inf < 1),
+ *  the run loses its accuracy or its step size: take GA_INDEX2_STABILIZED or rho_inf < 1),
  *  GA_ERR_STATE, GA_ERR_STEP_SIZE, fatal callback failures, and the statuses of ga_step. On
  *  failure the state is that of the last accepted step. */
 GA_API ga_status ga_step_adaptive(ga_solver *s, double t_stop);
@@ -951,20 +956,24 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h);
  *  adaptive mode, dense and sparse, in both formulations (from a checkpoint taken before the
  *  first step too: that step still applies the corrected start). Taking a checkpoint only
  *  reads: a run that takes them is the run that does not, bit for bit and with the same work.
- *  Layout 3 (treat it as opaque): a header [magic, layout version, n, m, t, h_last, h_next,
- *  err_prev, grew, sliver_span, then 9 entries on the kept iteration matrix and its reuse],
- *  the state q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n), the iterate the kept matrix was
- *  factorized at, the constraints in use (m flags), and the pivots of the sparse
- *  factorizations (zeros on the dense path).
+ *  Layout 4 (treat it as opaque): a header [magic, layout version, n, m, t, h_last, h_next,
+ *  err_prev, grew, sliver_span, then 9 entries on the kept iteration matrix and its reuse,
+ *  c_count, c_dt], the state q(n), v(n), qdd(n), lambda(m), a(n), a_prev(n), c(n),
+ *  c_prev(n), the iterate the kept matrix was factorized at, the constraints in use (m flags),
+ *  and the pivots of the sparse factorizations (zeros on the dense path).
  *  h_next, err_prev, grew: the step-size controller; sliver_span: the time covered by slivers
  *  since the last step of Algorithm 1 (see ga_step); a_prev: the a of the step before, for
- *  the error estimate. ga_set_state rebuilds the kept matrix from the callbacks at that
+ *  the error estimate; c, c_prev: the accelerations consistent with this state and the one
+ *  before, c_dt apart in t, for the index-3 error estimate (c_count of them known, zeros
+ *  where not). ga_set_state rebuilds the kept matrix from the callbacks at that
  *  iterate (one evaluation and one factorization, counted like any other; should a callback
  *  fail there, the next step factorizes afresh instead, and the run continues as after a
  *  restart) and gives each sparse factorization its pivots back. A failed step drops the
- *  kept matrix, so the checkpoint taken after it has none. ga_set_state also reads layout 2
- *  (galpha 0.2), as a restart: a fresh iteration matrix, sparse pivots chosen afresh, and
- *  with GA_REDUNDANT_DROP the constraints in use selected anew at its q. ga_set_state needs
+ *  kept matrix, so the checkpoint taken after it has none. ga_set_state also reads layout 3,
+ *  as the same state without consistent accelerations (the next adaptive index-3 step
+ *  estimates its error from a, as after a fixed step), and layout 2 (galpha 0.2), as a
+ *  restart: a fresh iteration matrix, sparse pivots chosen afresh, and with
+ *  GA_REDUNDANT_DROP the constraints in use selected anew at its q. ga_set_state needs
  *  callbacks set, allocates like ga_init (when the solver
  *  was not initialized) and makes the solver initialized; dense output (ga_interpolate) is
  *  available again after the next step. */
