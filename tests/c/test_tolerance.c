@@ -1,6 +1,7 @@
 /* Tolerance proportionality: with rtol = atol = tol from 1e-3 down to 1e-8, the global error of
  * adaptive runs (ga_advance to 10 output times) follows tol, in positions and in velocities,
- * on every shipped scene in both formulations: the least-squares slope of log(error) against
+ * and in the accelerations and multipliers of the default output, on every shipped scene in
+ * both formulations: the least-squares slope of log(error) against
  * log(tol) lies in [0.85, 1.15], and error / tol varies by at most 30 times over the range.
  * The error is the largest over the output times and coordinates of |y_i - y_ref,i| /
  * (1 + |y_ref,i|) (the weights of the error test at rtol = atol), against an independent
@@ -25,7 +26,7 @@ enum { kOutputs = 10, kTolerances = 6 };
 static const double kSpan[kCatalogScenes] = {2.0, 1.0, 0.03, 0.03, 1.0};
 
 typedef struct study {
-    double tol[kTolerances], q[kTolerances], v[kTolerances];
+    double tol[kTolerances], q[kTolerances], v[kTolerances], qdd[kTolerances], lam[kTolerances];
     long long steps[kTolerances];
 } study;
 
@@ -39,14 +40,15 @@ static double mixed_error(const double *y, const double *y_ref, int n)
 
 static study run_study(const catalog_scene *sc, double span, int formulation)
 {
-    static double q_ref[kOutputs + 1][kCatalogMaxN], v_ref[kOutputs + 1][kCatalogMaxN];
-    double q[kCatalogMaxN], v[kCatalogMaxN];
+    static double q_ref[kOutputs + 1][kCatalogMaxN], v_ref[kOutputs + 1][kCatalogMaxN],
+        qdd_ref[kOutputs + 1][kCatalogMaxN], lam_ref[kOutputs + 1][kCatalogMaxN];
+    double q[kCatalogMaxN], v[kCatalogMaxN], qdd[kCatalogMaxN], lam[kCatalogMaxN];
     memcpy(q, sc->q0, sizeof q);
     memcpy(v, sc->v0, sizeof v);
     for (int k = 1; k <= kOutputs; ++k) {
         const double t0 = span * (k - 1) / kOutputs, t1 = span * k / kOutputs;
         assert_int_equal(index1_rk4(&sc->reference, t0, t1, lround((t1 - t0) / sc->h_reference),
-                                    q, v, NULL, NULL),
+                                    q, v, qdd_ref[k], lam_ref[k]),
                          0);
         memcpy(q_ref[k], q, sizeof q);
         memcpy(v_ref[k], v, sizeof v);
@@ -66,8 +68,12 @@ static study run_study(const catalog_scene *sc, double span, int formulation)
                 fail_msg("%s, tol %g: %s", sc->name, r.tol[j], ga_last_error(s));
             ga_get_q(s, q);
             ga_get_v(s, v);
+            assert_int_equal(ga_get_qdd(s, qdd), GA_OK);
+            assert_int_equal(ga_get_lambda(s, lam), GA_OK);
             r.q[j] = fmax(r.q[j], mixed_error(q, q_ref[k], sc->n));
             r.v[j] = fmax(r.v[j], mixed_error(v, v_ref[k], sc->n));
+            r.qdd[j] = fmax(r.qdd[j], mixed_error(qdd, qdd_ref[k], sc->n));
+            r.lam[j] = fmax(r.lam[j], mixed_error(lam, lam_ref[k], sc->m));
         }
         ga_get_counter(s, GA_COUNT_STEPS, &r.steps[j]);
         ga_free(s);
@@ -101,6 +107,17 @@ static void follows_the_tolerance(int which)
         const double band_q = band(r.tol, r.q), band_v = band(r.tol, r.v);
         printf("\n    slopes q %.2f, v %.2f; bands of error/tol q %.1f, v %.1f\n", slope_q,
                slope_v, band_q, band_v);
+        printf("    qdd, lambda:");
+        for (int j = 0; j < kTolerances; ++j)
+            printf(" %.0e: %.2g/%.2g", r.tol[j], r.qdd[j] / r.tol[j], r.lam[j] / r.tol[j]);
+        const double slope_a = fit_order(r.tol, r.qdd, kTolerances);
+        const double slope_l = fit_order(r.tol, r.lam, kTolerances);
+        printf("\n    slopes qdd %.2f, lambda %.2f; bands qdd %.1f, lambda %.1f\n", slope_a, slope_l,
+               band(r.tol, r.qdd), band(r.tol, r.lam));
+        /* the default output (consistent with q and v) follows in the same band */
+        assert_true(slope_a >= 0.85 && slope_a <= 1.15);
+        assert_true(slope_l >= 0.85 && slope_l <= 1.15);
+        assert_true(band(r.tol, r.qdd) <= 30.0 && band(r.tol, r.lam) <= 30.0);
         assert_true(slope_q >= 0.85 && slope_q <= 1.15);
         assert_true(slope_v >= 0.85 && slope_v <= 1.15);
         assert_true(band_q <= 30.0);
