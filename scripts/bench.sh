@@ -16,13 +16,13 @@ b=build-demo/bench
 echo "per-step cost"
 { "$b/step_cost" scenes 1e-10; "$b/step_cost" scenes 1e-6 | tail -n +2; } > "$out/step_cost.csv"
 echo "chain scaling"
-echo "links,n,m,backend,steps,newton_per_step,factorizations_per_step,us_per_step,first_step_us,later_us_per_step,limit_us,ratio,peak_rss_kib" > "$out/chain.csv"
+echo "links,n,m,backend,steps,newton_per_step,factorizations_per_step,us_per_step,first_step_us,later_us_per_step,limit_us,ratio,peak_rss_kib,setup_us,setup_in_steps" > "$out/chain.csv"
 # 50 steps from rest: the first step (pivots chosen for the step's matrix) costs about three
 # later ones, so that 10 steps would weigh it five times as much as a run of 50 does
 for N in 10 30 100 300 1000 3000 10000 30000 100000; do
     "$b/step_cost" chain "$N" 50 >> "$out/chain.csv"
 done
-echo "links,n,m,backend,steps,newton_per_step,factorizations_per_step,us_per_step,first_step_us,later_us_per_step,limit_us,ratio,peak_rss_kib" > "$out/chain_index2.csv"
+echo "links,n,m,backend,steps,newton_per_step,factorizations_per_step,us_per_step,first_step_us,later_us_per_step,limit_us,ratio,peak_rss_kib,setup_us,setup_in_steps" > "$out/chain_index2.csv"
 for N in 1000 10000 100000; do
     "$b/step_cost" chain "$N" 50 1e-10 1 >> "$out/chain_index2.csv"
 done
@@ -82,6 +82,25 @@ echo "work-precision against IDA"
 if [ -x "$b/ida_workprecision" ]; then
     "$b/ida_workprecision" andrews > "$out/wp_andrews.csv" 2>/dev/null
     "$b/ida_workprecision" slider_crank > "$out/wp_slider_crank.csv" 2>/dev/null
+fi
+if [ -x "$b/ida_chain" ]; then
+    # One run per process (its peak memory is that run's); 0.2 s of the fall from rest; the
+    # reference at h = 6.25e-5 (it prints its difference to the run at twice that step).
+    echo "chain against IDA with KLU (links: ${CHAIN_IDA_LINKS:=100 1000 10000 100000})"
+    echo "links,method,setting,error,cpu_seconds,steps,factorizations,peak_rss_kib" \
+        > "$out/chain_ida.csv"
+    ref=$(mktemp)
+    for N in $CHAIN_IDA_LINKS; do
+        "$b/ida_chain" reference "$N" 0.2 6.25e-5 "$ref"
+        for h in 4e-2 2e-2 1e-2 5e-3 2.5e-3 1.25e-3 6.25e-4 3.125e-4; do
+            "$b/ida_chain" run "$N" 0.2 galpha "$h" "$ref" >> "$out/chain_ida.csv"
+        done
+        for tol in 1e-2 1e-3 1e-4 1e-5 1e-6 1e-7; do
+            "$b/ida_chain" run "$N" 0.2 ida "$tol" "$ref" >> "$out/chain_ida.csv"
+            "$b/ida_chain" run "$N" 0.2 galpha_adaptive "$tol" "$ref" >> "$out/chain_ida.csv"
+        done
+    done
+    rm -f "$ref"
 fi
 echo "python overhead"
 GALPHA_LIBRARY=build-demo/libgalpha.so.0 /usr/bin/python3 bench/python_overhead.py \

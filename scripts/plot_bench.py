@@ -103,6 +103,68 @@ if ch:
         print("  chain: instructions per step %.3g at N = 1000, %.3g at N = 100000: %.0f-fold" % (
             ins[1000], ins[100000], ins[100000] / ins[1000]))
 
+# ---- the chain against IDA with KLU -------------------------------------------------------------
+ci = rows("chain_ida.csv")
+
+
+def interpolated_cpu(pts, target):
+    """CPU at `target` error, log-log between the two settings around it (None if not spanned)"""
+    pts = sorted(pts)
+    for (e1, c1), (e2, c2) in zip(pts, pts[1:]):
+        if e1 <= target <= e2 and e1 > 0:
+            w = (math.log(target) - math.log(e1)) / (math.log(e2) - math.log(e1))
+            return math.exp(math.log(c1) + w * (math.log(c2) - math.log(c1)))
+    return None
+
+
+if ci:
+    links = sorted({int(num(r["links"])) for r in ci})
+    methods = (("galpha", "galpha, fixed h", "C0"), ("galpha_adaptive", "galpha, adaptive",
+                                                        "C2"),
+               ("ida", "SUNDIALS IDA + KLU (index 1, BDF)", "k"))
+    fig, ax = plt.subplots(1, len(links) + 1, figsize=(4.2 * (len(links) + 1), 4.2))
+    per_time = {m: ([], [], []) for m, _, _ in methods}
+    for k, N in enumerate(links):
+        for method, label, color in methods:
+            pts = [(num(r["error"]), num(r["cpu_seconds"])) for r in ci
+                   if int(num(r["links"])) == N and r["method"] == method]
+            if not pts:
+                continue
+            e, c = zip(*sorted(pts, key=lambda p: p[1]))
+            ax[k].loglog(c, e, "o-", color=color, ms=4, label=label)
+            for j, target in enumerate((1e-3, 1e-5)):
+                t = interpolated_cpu(pts, target)
+                per_time[method][j].append((N, t / 0.2 if t else math.nan))
+            mem = max(num(r["peak_rss_kib"]) for r in ci
+                      if int(num(r["links"])) == N and r["method"] == method)
+            per_time[method][2].append((N, mem))
+        ax[k].set(title="%d links" % N, xlabel="CPU time [s]",
+                  ylabel="max error at t = 0.2 s [m, rad]")
+        ax[k].grid(True, which="both", lw=0.3)
+        ax[k].legend(fontsize=7)
+    for method, label, color in methods:
+        for j, style in ((0, "o-"), (1, "s--")):
+            pts = [p for p in per_time[method][j] if not math.isnan(p[1])]
+            if pts:
+                ax[-1].loglog(*zip(*pts), style, color=color, ms=4,
+                              label="%s, error %s" % (label, ("1e-3", "1e-5")[j]))
+    ax[-1].set(title="CPU per simulated second", xlabel="links N", ylabel="seconds")
+    ax[-1].grid(True, which="both", lw=0.3)
+    ax[-1].legend(fontsize=6)
+    fig.suptitle("N-link chain falling from rest, sparse path: galpha against IDA with KLU")
+    save(fig, "chain_ida.png")
+    for N in links:
+        for j, target in enumerate((1e-3, 1e-5)):
+            t = {m: dict(per_time[m][j]).get(N) for m, _, _ in methods}
+            if t["ida"] and t["galpha"]:
+                print("  chain %d links, error %g: IDA %.3g s per simulated s, galpha fixed %.3g "
+                      "(%.2fx less), adaptive %s" % (
+                          N, target, t["ida"], t["galpha"], t["ida"] / t["galpha"],
+                          "%.3g" % t["galpha_adaptive"] if t["galpha_adaptive"] else "-"))
+        mem = {m: dict(per_time[m][2]).get(N) for m, _, _ in methods}
+        print("  chain %d links: peak memory IDA %.0f MiB, galpha %.0f MiB" % (
+            N, mem["ida"] / 1024, mem["galpha"] / 1024))
+
 # ---- linear algebra -------------------------------------------------------------------------
 la = rows("linear_algebra.csv")
 if la:
