@@ -18,8 +18,9 @@ void Solver::setup_output()
 {
     if (O_.ready() || !workspace_ready_)
         return;
-    O_.setup(sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Auto), n_,
-             m_, M_, J_, K_, C_, active_ptr());
+    auto backend = sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Auto);
+    backend->analysis_from(S_.backend());  // the same pattern: its ordering, not a second one
+    O_.setup(std::move(backend), n_, m_, M_, J_, K_, C_, active_ptr());
     out_M_.copy_layout(M_);
     out_J_.copy_layout(J_);
     out_f_.setZero(n_);

@@ -297,8 +297,10 @@ void Solver::prefactor_index2()
 void Solver::setup_projection()
 {
     if (m_ > 0 && !P_.ready()) {
-        P_.setup(sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Auto),
-                 n_, m_, M_, J_, K_, C_, active_ptr());
+        auto backend =
+            sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Auto);
+        backend->analysis_from(S_.backend());  // the same pattern: its ordering
+        P_.setup(std::move(backend), n_, m_, M_, J_, K_, C_, active_ptr());
         P_.reserve_factors();
     }
 }

@@ -50,6 +50,9 @@ public:
     // of the lower-right block then).
     virtual void setup(int n, int m, const ModelMatrix &M, const ModelMatrix &J,
                        const ModelMatrix &K, const ModelMatrix &C, bool with_inactive) = 0;
+    // A backend set up already whose analysis (fill-reducing ordering) the next setup may
+    // take over if its pattern turns out the same; it must outlive that setup.
+    virtual void analysis_from(const LinearBackend *like) { (void)like; }
     // Assemble and factorize; false if singular or numerically singular.
     virtual bool factorize(const SaddleBlocks &b) = 0;
     virtual void solve(Vec &rhs) = 0;  // in place, length n + m

@@ -19,6 +19,7 @@ public:
                const unsigned char *active = nullptr);
     bool ready() const { return backend_ != nullptr; }
     const char *backend_name() const { return backend_ ? backend_->name() : "none"; }
+    const LinearBackend *backend() const { return backend_.get(); }
 
     // S_t at step size h, scaled by (10) when `scaled`. C and K may be null (neglected).
     bool factorize_step(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,

@@ -107,26 +107,56 @@ KluSystem::~KluSystem()
         klu_free_symbolic(&symbolic_, &common_);
 }
 
-void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries, Ordering start)
+void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries, Ordering start,
+                      const KluSystem *like)
 {
     N_ = N;
-    for (auto &e : entries)
-        std::swap(e.first, e.second);  // (col, row): sorted by column, then row
-    std::sort(entries.begin(), entries.end());
-    entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
+    // Compressed columns by counting (a sort of all entries was half of ga_init on a long
+    // chain); then each column's rows sorted and without duplicates.
     colptr_.assign(N + 1, 0);
-    rowind_.resize(entries.size());
-    for (std::size_t k = 0; k < entries.size(); ++k) {
-        ++colptr_[entries[k].first + 1];
-        rowind_[k] = entries[k].second;
-    }
+    for (const auto &e : entries)
+        ++colptr_[e.second + 1];
     for (int j = 0; j < N; ++j)
         colptr_[j + 1] += colptr_[j];
-    values_.assign(entries.size(), 0.0);
+    rowind_.resize(entries.size());
+    {
+        std::vector<int> next(colptr_.begin(), colptr_.end() - 1);
+        for (const auto &e : entries)
+            rowind_[next[e.second]++] = e.first;
+    }
+    std::vector<std::pair<int, int>>().swap(entries);  // freed before the factors' storage
+    int kept = 0;
+    for (int j = 0; j < N; ++j) {
+        const auto first = rowind_.begin() + colptr_[j], last = rowind_.begin() + colptr_[j + 1];
+        std::sort(first, last);
+        const auto end = std::unique(first, last);
+        colptr_[j] = kept;
+        kept = static_cast<int>(std::copy(first, end, rowind_.begin() + kept) - rowind_.begin());
+    }
+    colptr_[N] = kept;
+    rowind_.resize(kept);
+    rowind_.shrink_to_fit();
+    values_.assign(rowind_.size(), 0.0);
     loaded_rows_.assign(N, 0);
     loaded_ = false;
-    std::vector<std::pair<int, int>>().swap(entries);  // freed before the factors' storage
     row_scale_.assign(N, 1.0);
+    switched_ = false;
+    if (like && like->N_ == N && start == Ordering::Auto && like->colptr_ == colptr_ &&
+        like->rowind_ == rowind_) {
+        // the same pattern: the same orderings, counts and choice, as computed for `like`
+        orders_[0] = like->orders_[0];
+        orders_[1] = like->orders_[1];
+        amd_fill_ = like->amd_fill_;
+        rcm_fill_ = like->rcm_fill_;
+        expected_[0] = like->expected_[0];
+        expected_[1] = like->expected_[1];
+        in_use_ = chosen_ = like->chosen_;
+        symbolic_ = klu_analyze_given(N, colptr_.data(), rowind_.data(), orders_[in_use_].data(),
+                                      orders_[in_use_].data(), &common_);
+        if (!symbolic_)
+            throw std::bad_alloc();
+        return;
+    }
     // Two orderings: KLU's AMD (least fill) and reverse Cuthill-McKee (a band). For
     // mechanism-like sparsity both fill about the same, and the band keeps KLU's pivoting in
     // saddle-point systems local (with AMD's ordering the stabilized index-2 system of a
@@ -151,8 +181,7 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries, Ordering 
     expected_[1] = rcm_fill_.entries;  // a lower bound where the count stopped
     const bool band = rcm_fill_.entries <= kBandFillAllowance * amd_fill_.entries &&
                       rcm_fill_.flops <= kBandFillAllowance * amd_fill_.flops;
-    in_use_ = start == Ordering::Band || (start == Ordering::Auto && band) ? 1 : 0;
-    switched_ = false;
+    in_use_ = chosen_ = start == Ordering::Band || (start == Ordering::Auto && band) ? 1 : 0;
     if (in_use_ == 1) {
         klu_free_symbolic(&symbolic_, &common_);
         symbolic_ = klu_analyze_given(N, colptr_.data(), rowind_.data(), orders_[1].data(),
@@ -343,6 +372,17 @@ void KluSystem::solve_blocks(const double *b1, double c1, const double *b2, doub
 std::vector<std::vector<int>> KluSystem::symmetric_adjacency() const
 {
     std::vector<std::vector<int>> adj(N_);
+    {
+        std::vector<int> degree(N_, 0);  // with duplicates: each list allocated once
+        for (int j = 0; j < N_; ++j)
+            for (int p = colptr_[j]; p < colptr_[j + 1]; ++p)
+                if (rowind_[p] != j) {
+                    ++degree[j];
+                    ++degree[rowind_[p]];
+                }
+        for (int j = 0; j < N_; ++j)
+            adj[j].reserve(degree[j]);
+    }
     for (int j = 0; j < N_; ++j)
         for (int p = colptr_[j]; p < colptr_[j + 1]; ++p)
             if (rowind_[p] != j) {

@@ -41,8 +41,10 @@ public:
     // Which ordering the LU starts from: the one chosen by fill (Auto), or one forced (tests).
     enum class Ordering { Auto, Amd, Band };
     // The pattern: (row, column) of every structural entry of the N x N matrix, duplicates
-    // allowed. Throws std::bad_alloc.
-    void setup(int N, std::vector<std::pair<int, int>> entries, Ordering start = Ordering::Auto);
+    // allowed. A system `like` set up with the same pattern gives its orderings and choice,
+    // which are then not computed again. Throws std::bad_alloc.
+    void setup(int N, std::vector<std::pair<int, int>> entries, Ordering start = Ordering::Auto,
+               const KluSystem *like = nullptr);
     // Position of entry (row, col) of the pattern in values() (setup time only).
     int slot(int row, int col) const;
     // The entries, in the order of the pattern: the caller assembles them before factorize().
@@ -106,6 +108,7 @@ private:
     const char *names_[2] = {"AMD", "RCM"};
     double expected_[2] = {0.0, 0.0};
     int in_use_ = 0;
+    int chosen_ = 0;  // in_use_ as setup chose it (what a system `like` this one takes)
     bool switched_ = false;
     int full_factorizations_ = 0;
     // Pivots loaded from a checkpoint: the next factorize() builds their structure first.

@@ -39,7 +39,9 @@ public:
         if (with_inactive)
             for (int i = 0; i < m; ++i)
                 entries.emplace_back(n + i, n + i);
-        S_.setup(n + m, std::move(entries));
+        const auto *like = dynamic_cast<const SparseBackend *>(like_);
+        S_.setup(n + m, std::move(entries), KluSystem::Ordering::Auto, like ? &like->S_ : nullptr);
+        like_ = nullptr;
         J_rows_ = J.row_index();
         auto map = [&](const ModelMatrix &A, bool phi_q_transposed, int row0) {
             std::vector<int> out(A.nnz());
@@ -134,9 +136,11 @@ public:
     void save_pivots(double *out) const override { S_.save_pivots(out); }
     bool pivots_loadable(const double *in) const override { return S_.pivots_loadable(in); }
     void load_pivots(const double *in) override { S_.load_pivots(in); }
+    void analysis_from(const LinearBackend *like) override { like_ = like; }
 
 private:
     int n_ = 0, m_ = 0;
+    const LinearBackend *like_ = nullptr;  // analysis_from, until setup
     KluSystem S_;
     std::vector<int> map_M_, map_K_, map_C_, map_J_, map_JT_, diag_, lower_diag_, top_left_;
     bool j_written_ = false;  // no slot of Phi_q twice in its pattern

@@ -406,6 +406,71 @@ void ordering_follows_the_fill(void **)
     assert_true(e1 < 1e-13 && e2 < 1e-13);
 }
 
+// A system set up like another of the same pattern (the solver's output and projection
+// matrices, like its step matrix) takes that one's orderings and choice instead of computing
+// them: the same fill counts and ordering, and bit for bit the same solution; with another
+// pattern (entries in another order and duplicated count as the same) it computes its own.
+void setup_like_takes_the_analysis_of_the_same_pattern(void **)
+{
+    const int N = 900;
+    for (const auto &edges : {grid_edges(30, 30), std::vector<std::pair<int, int>>{}}) {  // AMD, RCM
+        std::vector<std::pair<int, int>> links = edges;
+        if (links.empty()) {
+            for (int k = 0; k + 2 < N; ++k)
+                links.emplace_back(k, k + 2);
+            for (int k = 0; k + 1 < N; k += 2)
+                links.emplace_back(k, k + 1);
+        }
+        std::vector<std::pair<int, int>> entries, shuffled;
+        for (int i = 0; i < N; ++i)
+            entries.emplace_back(i, i);
+        for (auto [i, j] : links) {
+            entries.emplace_back(i, j);
+            entries.emplace_back(j, i);
+        }
+        shuffled = entries;
+        shuffled.insert(shuffled.end(), entries.begin(), entries.begin() + 50);
+        std::reverse(shuffled.begin(), shuffled.end());
+        ga::KluSystem first, second;
+        first.setup(N, entries);
+        second.setup(N, shuffled, ga::KluSystem::Ordering::Auto, &first);
+        assert_string_equal(first.ordering(), second.ordering());
+        assert_true(first.amd_fill().entries == second.amd_fill().entries);
+        assert_true(first.rcm_fill().entries == second.rcm_fill().entries);
+        for (ga::KluSystem *S : {&first, &second}) {
+            for (auto [i, j] : links) {
+                S->values()[S->slot(i, j)] = -1.0 - 0.001 * i;
+                S->values()[S->slot(j, i)] = -1.0 + 0.001 * j;
+            }
+            for (int i = 0; i < N; ++i)
+                S->values()[S->slot(i, i)] = 5.0;
+            assert_true(S->factorize());
+        }
+        std::vector<double> x1(N), x2(N);
+        for (int i = 0; i < N; ++i)
+            x1[i] = x2[i] = 1.0 + 0.001 * i;
+        first.solve(x1.data());
+        second.solve(x2.data());
+        assert_memory_equal(x1.data(), x2.data(), sizeof(double) * N);
+    }
+    // another pattern: its own analysis (a 30 x 30 grid like a ladder chooses AMD, not RCM)
+    std::vector<std::pair<int, int>> ladder;
+    for (int k = 0; k + 2 < N; ++k)
+        ladder.emplace_back(k, k + 2);
+    ga::KluSystem band, grid;
+    setup_and_solve(band, N, ladder);
+    std::vector<std::pair<int, int>> entries;
+    for (int i = 0; i < N; ++i)
+        entries.emplace_back(i, i);
+    for (auto [i, j] : grid_edges(30, 30)) {
+        entries.emplace_back(i, j);
+        entries.emplace_back(j, i);
+    }
+    grid.setup(N, entries, ga::KluSystem::Ordering::Auto, &band);
+    assert_string_equal(band.ordering(), "RCM");
+    assert_string_equal(grid.ordering(), "AMD");
+}
+
 }  // namespace
 
 int main()
@@ -417,6 +482,7 @@ int main()
         cmocka_unit_test(random_patterns_against_dense_lu),
         cmocka_unit_test(cholesky_fill_against_analysis),
         cmocka_unit_test(ordering_follows_the_fill),
+        cmocka_unit_test(setup_like_takes_the_analysis_of_the_same_pattern),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
