@@ -171,11 +171,11 @@ ga_status Solver::set_state(const double *buf, std::size_t len, bool internal)
         return diag.fail(GA_ERR_ARG, "checkpoint entries 10-18 (the kept iteration matrix and "
                          "its reuse) are not those a solver writes");
     const bool with_c = !layout2 && !layout3;
-    const int c_count = with_c ? static_cast<int>(buf[19]) : 0;
-    if (with_c && (!is_count(buf[19], 2.0) || buf[20] < 0.0 || (c_count == 2 && !(buf[20] > 0.0))))
+    if (with_c && (!is_count(buf[19], 2.0) || buf[20] < 0.0 || (buf[19] == 2.0 && !(buf[20] > 0.0))))
         return diag.fail(GA_ERR_ARG, "checkpoint entries 19-20 (c_count = %g, c_dt = %g: the "
                          "consistent accelerations of the error estimate) are not those a "
                          "solver writes", buf[19], buf[20]);
+    const int c_count = with_c ? static_cast<int>(buf[19]) : 0;  // a count of 0-2 now
     // The constraints in use: as the checkpoint says (layout 2, which does not say, selects
     // them anew at its q). Dropped ones need a solver that drops them.
     for (int i = 0; i < m_ && !layout2; ++i) {

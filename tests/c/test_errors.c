@@ -551,7 +551,8 @@ static void bad_checkpoints_are_refused(void **state)
     }
     /* the consistent accelerations of the index-3 error estimate (entries 19-20): how many
      * (0-2), and their distance in t, a step when there are two */
-    const double bad_c[][2] = {{3.0, 0.0}, {-1.0, 0.0}, {1.5, 0.0}, {1.0, -1e-3}, {2.0, 0.0}};
+    const double bad_c[][2] = {{3.0, 0.0}, {-1.0, 0.0}, {1.5, 0.0}, {1e300, 0.0}, {1.0, -1e-3},
+                               {2.0, 0.0}};
     for (size_t k = 0; k < sizeof bad_c / sizeof bad_c[0]; ++k) {
         memcpy(buf, before, len * sizeof(double));
         buf[19] = bad_c[k][0];
