@@ -3,7 +3,8 @@
  *
  * IDA gets the index-1 formulation with y = (q, v, lambda), 8N unknowns:
  *     q' - v = 0,   M v' - f + Phi_q^T lambda = 0,   Phi_q v' + Phi_qq(v, v) = 0,
- * lambda algebraic and out of the error test (IDASetSuppressAlg), its Jacobian
+ * lambda algebraic and out of the error test (IDASetSuppressAlg), KLU in the natural ordering
+ * (its fastest here), its Jacobian
  * dF/dy + c_j dF/dy' assembled here in compressed rows (the chain's derivatives, written out
  * below), consistent initial values from galpha's ga_init. galpha takes fixed steps (index 3,
  * exact K_t, declared patterns, the Newton tolerance min(1e-6, 1e-4 (h / 1e-2)^2) as in
@@ -283,6 +284,9 @@ static outcome run_ida(chain *c, double T, double tol, double *q_out)
         ids[i] = i < 2 * n ? 1.0 : 0.0;
     SUNMatrix A = SUNSparseMatrix(NY, NY, jacobian_entries(Nl), CSR_MAT, ctx);
     SUNLinearSolver LS = SUNLinSol_KLU(yy, A, ctx);
+    /* KLU's fastest ordering here: the natural one of y = (q, v, lambda), 3 to 6 times faster
+     * than its default AMD (or COLAMD) at 1 000 and 10 000 links, for the same steps */
+    SUNLinSol_KLUSetOrdering(LS, 2);
     void *mem = IDACreate(ctx);
     int flag = IDAInit(mem, ida_residual, 0.0, yy, yp);
     flag |= IDASStolerances(mem, tol, tol);
