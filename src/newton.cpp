@@ -81,8 +81,10 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &s
                                       : -1.0;
         if (measured[k] && !at_floor[k])
             rate = std::max(rate, theta[k]);
+        if (measured[k] && !at_floor[k] && fresh_matrix_ && theta[k] >= 1.0)
+            diverged_ = true;
         const bool within = e[k] <= 1.0;
-        const bool predicted = theta[k] >= 0.0 && theta[k] < 1.0 &&
+        const bool predicted = !diverged_ && theta[k] >= 0.0 && theta[k] < 1.0 &&
                                e[k] * theta[k] / (1.0 - theta[k]) <= 1.0;
         const bool noise = at_floor[k] && measured[k] && theta[k] >= kStagnation;
         done[k] = within || predicted || noise;

@@ -150,6 +150,47 @@ void each_quantity_converges_at_its_own_rate(void **state)
     assert_true(c.check(kTol, u, beta_prime, gamma_prime) == Verdict::Slow);
 }
 
+// A chain of 30 000 links, adaptive at rtol 1e-3 (Newton tolerance 1.58e-6, h = 2e-4): full
+// Newton diverged for 19 iterations, a matrix at every other one, with the iterate running
+// away to |q| ~ 2e6 (an angle turned by a million radians). The 20th update then fell by
+// 3e-5 after a fresh factorization; that one ratio predicted convergence and the runaway
+// iterate was accepted. After a divergence with a matrix of this step, rates are not trusted.
+UpdateSizes runaway(double dq, double q, double qdd, double dl, double l)
+{
+    UpdateSizes u;
+    u.dq = u.dw = dq;
+    u.q = q;
+    u.qdd = qdd;
+    u.dlambda = dl;
+    u.lambda = l;
+    return u;
+}
+
+void a_diverged_iteration_does_not_converge_by_one_rate(void **state)
+{
+    (void)state;
+    constexpr double tol = 1.58e-6, beta_prime = 9.0e7, gamma_prime = 1.0e4;
+    const UpdateSizes grown = runaway(3.98e5, 1.88e6, 1.87e14, 3.39e17, 3.36e17),
+                      grew_again = runaway(2.99e6, 2.81e6, 2.77e14, 5.08e18, 4.75e18),
+                      after_refresh = runaway(2.81e6, 1.88e6, 1.87e14, 4.79e18, 4.45e16),
+                      one_drop = runaway(165.0, 1.88e6, 1.87e14, 1.47e14, 4.47e16);
+    ConvergenceTest c;
+    c.reset(-1.0);
+    c.matrix_changed();
+    assert_true(c.check(tol, grown, beta_prime, gamma_prime) == Verdict::Continue);
+    assert_true(c.check(tol, grew_again, beta_prime, gamma_prime) == Verdict::Slow);  // x5
+    c.matrix_changed();
+    assert_true(c.check(tol, after_refresh, beta_prime, gamma_prime) == Verdict::Continue);
+    // e = 55 (positions), 2 081 (multipliers): above the tolerance, whatever the ratio says
+    assert_true(c.check(tol, one_drop, beta_prime, gamma_prime) != Verdict::Converged);
+
+    // The same drop in a step that never diverged is a rate (3e-5) to be trusted.
+    c.reset(-1.0);
+    c.matrix_changed();
+    assert_true(c.check(tol, after_refresh, beta_prime, gamma_prime) == Verdict::Continue);
+    assert_true(c.check(tol, one_drop, beta_prime, gamma_prime) == Verdict::Converged);
+}
+
 }  // namespace
 
 int main()
@@ -162,6 +203,7 @@ int main()
         cmocka_unit_test(tolerance_below_roundoff_moves_within_roundoff),
         cmocka_unit_test(index2_waits_for_its_newmark_increment),
         cmocka_unit_test(a_new_step_forgets_the_fresh_matrix),
+        cmocka_unit_test(a_diverged_iteration_does_not_converge_by_one_rate),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
