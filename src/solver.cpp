@@ -237,6 +237,8 @@ ga_status Solver::setup_workspace()
     deta_.setZero(m_);
     c_.setZero(m_);
     qdd_tmp_.setZero(n_);
+    guard_q_.setZero(n_);
+    guard_v_.setZero(n_);
     lambda_tmp_.setZero(m_);
     eta_total_.setZero(m_);
     if (sens.active())

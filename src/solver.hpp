@@ -385,6 +385,7 @@ private:
     ModelMatrix M_, J_, K_, C_, B_;  // B_: index-2, Phi_q(q_n)
     ModelMatrix Z_;                  // index-2: d(Phi_q v + Phi_t)/dq, layout of J_
     Vec f_, phi_, phi_v_, rq_, dq_, dw_, dlambda_, deta_, c_, qdd_tmp_, lambda_tmp_;
+    Vec guard_q_, guard_v_;  // index-3 error estimate: the estimate from a (control.cpp)
     IterationMatrix S_;
     IterationMatrix P_;  // [I Phi_q^T; Phi_q 0]: tangent projection of error estimates
     Index2Matrix S2_;

@@ -2,7 +2,7 @@
  * adaptive runs (ga_advance to 10 output times) follows tol, in positions and in velocities,
  * and in the accelerations and multipliers of the default output, on every shipped scene in
  * both formulations: the least-squares slope of log(error) against
- * log(tol) lies in [0.85, 1.15], and error / tol varies by at most 30 times over the range.
+ * log(tol) lies in [0.85, 1.15], and error / tol varies by at most 10 times over the range.
  * The error is the largest over the output times and coordinates of |y_i - y_ref,i| /
  * (1 + |y_ref,i|) (the weights of the error test at rtol = atol), against an independent
  * reference (index1_rk4.c). */
@@ -12,6 +12,7 @@
 #include <setjmp.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -117,13 +118,14 @@ static void follows_the_tolerance(int which)
         /* the default output (consistent with q and v) follows in the same band */
         assert_true(slope_a >= 0.85 && slope_a <= 1.15);
         assert_true(slope_l >= 0.85 && slope_l <= 1.15);
-        assert_true(band(r.tol, r.qdd) <= 30.0 && band(r.tol, r.lam) <= 30.0);
+        assert_true(band(r.tol, r.qdd) <= 10.0 && band(r.tol, r.lam) <= 10.0);
         assert_true(slope_q >= 0.85 && slope_q <= 1.15);
         assert_true(slope_v >= 0.85 && slope_v <= 1.15);
-        assert_true(band_q <= 30.0);
-        assert_true(band_v <= 30.0);
+        assert_true(band_q <= 10.0);
+        assert_true(band_v <= 10.0);
         /* Index 3 pays for no transient of its own: its error estimate differences consistent
-         * accelerations, not a (it took three times the steps of index 2 when it did). */
+         * accelerations, a only as a check (it took three times the steps of index 2 when its
+         * estimate differenced a alone). */
         for (int j = 0; j < kTolerances; ++j) {
             if (f == GA_INDEX3)
                 steps3[j] = r.steps[j];
@@ -170,6 +172,67 @@ static void little_damping_keeps_the_tolerance(void **state)
     }
 }
 
+/* A long chain falling from the horizontal: near the pin a corner sharpens, and there the
+ * index-3 multiplier transient, grown by each change of h, moved the links unseen by the
+ * estimate from consistent accelerations; on 5 000 links at rtol 5e-3 it ran away (angular
+ * velocities of 1e10 rad/s) and the step size collapsed. With the estimate from a as a
+ * check, every run ends, and keeps the energy of the fall (conserved by the exact solution)
+ * to within the tolerance of its kinetic energy. */
+static double chain_energy(const chain *c, const double *q, const double *v, double *kinetic)
+{
+    double e = 0.0, k = 0.0;
+    for (int i = 0; i < c->links; ++i) {
+        const double *vi = v + 3 * i;
+        const double ki = 0.5 * c->mass * (vi[0] * vi[0] + vi[1] * vi[1]) +
+                          0.5 * c->inertia * vi[2] * vi[2];
+        k += ki;
+        e += ki + c->mass * c->gravity * q[3 * i + 1];
+    }
+    *kinetic = k;
+    return e;
+}
+
+static void long_chain_runs_through_its_corner(void **state)
+{
+    (void)state;
+    chain c = chain_make(5000);
+    const int n = 3 * c.links;
+    double *q = malloc(sizeof(double) * n), *v = malloc(sizeof(double) * n);
+    assert_non_null(q);
+    assert_non_null(v);
+    const double tols[3] = {1e-2, 5e-3, 2e-3};
+    for (int k = 0; k < 3; ++k) {
+        ga_solver *s = NULL;
+        assert_int_equal(ga_create(n, 2 * c.links, &s), GA_OK);
+        assert_int_equal(chain_declare_patterns(&c, s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, chain_mass, chain_force, chain_constraint,
+                                          chain_jacobian, &c),
+                         GA_OK);
+        assert_int_equal(ga_set_tangents(s, chain_stiffness, NULL), GA_OK);
+        assert_int_equal(ga_set_constraint_accel(s, chain_constraint_accel), GA_OK);
+        assert_int_equal(ga_set_constant_mass(s, 1), GA_OK);
+        assert_int_equal(ga_set_tolerances(s, tols[k], tols[k]), GA_OK);
+        chain_initial(&c, q, v);
+        double kinetic;
+        const double e0 = chain_energy(&c, q, v, &kinetic);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        const ga_status st = ga_advance(s, 0.2);
+        if (st != GA_OK)
+            fail_msg("rtol %g: %s", tols[k], ga_last_error(s));
+        ga_get_q(s, q);
+        ga_get_v(s, v);
+        const double drift = fabs(chain_energy(&c, q, v, &kinetic) - e0);
+        long long steps;
+        ga_get_counter(s, GA_COUNT_STEPS, &steps);
+        printf("  5 000 links, rtol %.0e: %lld steps, energy drift / kinetic energy %.2g\n",
+               tols[k], steps, drift / kinetic);
+        assert_true(drift <= tols[k] * kinetic);
+        ga_free(s);
+    }
+    free(q);
+    free(v);
+}
+
 /* Tolerances beyond round-off still run: the calibrated local tolerance stops at 1e-14 (at
  * rtol 1e-10 it asked 5e-16, and index-3 steps of the pendulum shrank below their minimum). */
 static void tolerances_beyond_roundoff_still_run(void **state)
@@ -198,6 +261,7 @@ int main(void)
         cmocka_unit_test(andrews7_follows),  cmocka_unit_test(andrews31_follows),
         cmocka_unit_test(chain_follows),
         cmocka_unit_test(little_damping_keeps_the_tolerance),
+        cmocka_unit_test(long_chain_runs_through_its_corner),
         cmocka_unit_test(tolerances_beyond_roundoff_still_run),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
