@@ -107,6 +107,28 @@ if [ -x "$b/ida_chain" ]; then
     done
     rm -f "$ref"
 fi
+if [ -x "$b/petsc_alpha2" ]; then
+    # The same method in PETSc (issue 22): a two-material lattice with n = 2 (4 NY - 1) NY
+    # unknowns, 0.2 s of its sag from rest; one run per process; reference at h = 1.25e-4.
+    echo "lattice against PETSc TSALPHA2 (NY: ${LATTICE_NY:=11 35 112})"
+    echo "unknowns,method,setting,error,cpu_seconds,steps,newton_iterations,factorizations,peak_rss_kib" \
+        > "$out/lattice_petsc.csv"
+    ref=$(mktemp)
+    for NY in $LATTICE_NY; do
+        "$b/petsc_alpha2" reference "$NY" 0.2 1.25e-4 "$ref"
+        for h in 1e-2 5e-3 2.5e-3 1.25e-3 6.25e-4; do
+            for m in galpha petsc petsc_lagged; do
+                "$b/petsc_alpha2" run "$NY" 0.2 $m "$h" "$ref" >> "$out/lattice_petsc.csv" || true
+            done
+        done
+        for tol in 1e-3 1e-4 1e-5; do
+            for m in galpha_adaptive petsc_adaptive petsc_adaptive_lagged; do
+                "$b/petsc_alpha2" run "$NY" 0.2 $m "$tol" "$ref" >> "$out/lattice_petsc.csv" || true
+            done
+        done
+    done
+    rm -f "$ref"
+fi
 echo "python overhead"
 GALPHA_LIBRARY=build-demo/libgalpha.so.0 /usr/bin/python3 bench/python_overhead.py \
     build-demo/examples/pendulum_demo > "$out/python_overhead.csv"
