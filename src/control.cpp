@@ -119,21 +119,19 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
             O_.solve(rq_, phi_, *e, lambda_tmp_);
         }
         // Index-3 a is known only to eps |q| / (beta h^2) (paper sec. 3.3; 64 ulps, as the
-        // Newton test's floors): what the estimate from a makes of that is not counted.
+        // Newton test's floors): what the estimate from a makes of that round-off widens its
+        // weights (as atol does; subtracted instead, the error jumped between 0 and O(1) and
+        // the predictive controller shrank the steps without end).
         const double q_max = std::max(s.q.cwiseAbs().maxCoeff(), x.q.cwiseAbs().maxCoeff());
         const auto a_noise = [&](double step) {
             return kRoundoffUlps * kEps * q_max / (p.beta * step * step);
         };
-        const double floor_q = std::fabs(cq) * 2.0 * a_noise(h);
-        const double floor_v = s.h_last > 0.0 ? std::fabs(cv) * h * h * h / (0.5 * (h + s.h_last)) *
+        const double noise_q = std::fabs(cq) * 2.0 * a_noise(h);
+        const double noise_v = s.h_last > 0.0 ? std::fabs(cv) * h * h * h / (0.5 * (h + s.h_last)) *
                                                     2.0 * (a_noise(h) / h + a_noise(s.h_last) / s.h_last)
                                               : 0.0;
-        for (int i = 0; i < n_; ++i) {
-            gq[i] = std::copysign(std::max(0.0, std::fabs(gq[i]) - floor_q), gq[i]);
-            gv[i] = std::copysign(std::max(0.0, std::fabs(gv[i]) - floor_v), gv[i]);
-        }
         err = std::max(weighted_error_norm(s, x, eq, ev, h),
-                       weighted_error_norm(s, x, gq, gv, h) / kTransientAllowance);
+                       weighted_error_norm(s, x, gq, gv, h, noise_q, noise_v) / kTransientAllowance);
         return GA_OK;
     }
     const Vec &a_n = *a_start_;
@@ -159,14 +157,16 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
 }
 
 double Solver::weighted_error_norm(const State &s, const State &x, const Vec &eq, const Vec &ev,
-                                   double h)
+                                   double h, double noise_q, double noise_v)
 {
     const double rtol = control.rtol, atol = control.atol;
     const double scale = control.calibration();
     double sum = 0.0;
     for (int i = 0; i < n_; ++i) {
-        const double wq = scale * (atol + rtol * std::max(std::fabs(s.q[i]), std::fabs(x.q[i])));
-        const double wv = scale * (atol + rtol * std::max(std::fabs(s.v[i]), std::fabs(x.v[i])));
+        const double wq =
+            scale * (atol + rtol * std::max(std::fabs(s.q[i]), std::fabs(x.q[i]))) + noise_q;
+        const double wv =
+            scale * (atol + rtol * std::max(std::fabs(s.v[i]), std::fabs(x.v[i]))) + noise_v;
         sum += (eq[i] / wq) * (eq[i] / wq) + (ev[i] / wv) * (ev[i] / wv);
     }
     if (r() > 0)

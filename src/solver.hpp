@@ -296,8 +296,9 @@ private:
     // control.cpp: the error norm of trial_ (a step of h ending at t_end)
     ga_status error_norm(double h, double t_end, double &err);
     bool consistent_estimate() const;
+    // noise_q, noise_v: absolute amounts of the estimates that are noise, added to the weights
     double weighted_error_norm(const State &s, const State &x, const Vec &eq, const Vec &ev,
-                               double h);
+                               double h, double noise_q = 0.0, double noise_v = 0.0);
     // init.cpp
     ga_status start(double t0, const double *q0, const double *v0);
     void restore_active(const std::vector<unsigned char> &before);

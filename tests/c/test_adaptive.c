@@ -1140,6 +1140,33 @@ static void rho_one_adaptive_needs_index2_or_no_constraints(void **state)
     assert_true(osc_rho1 <= 2 * osc_rho09);
 }
 
+/* Adaptive steps after fixed ones, index 3: the pendulum after 50 steps of 1e-2, then rtol 1e-6
+ * to t = 1. A version of the index-3 estimate's check from a that subtracted a's round-off made
+ * the error jump between 0 and O(1) after each growth of h; the predictive controller read
+ * that as an error growing fast and shrank h fivefold each time: 2.5 million steps for this
+ * half second. Error control at rtol 1e-6 over half a swing of an order-2 method needs about a
+ * thousand. */
+static void adaptive_after_fixed_steps_keeps_its_steps(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    double q[2], v[2];
+    pendulum_state(&p, 1.0, 0.5, q, v);
+    ga_solver *s = pendulum_new_solver(&p, 0);
+    assert_non_null(s);
+    assert_int_equal(ga_set_constant_mass(s, 1), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    for (int k = 0; k < 50; ++k)
+        assert_int_equal(ga_step(s, 1e-2), GA_OK);
+    assert_int_equal(ga_set_tolerances(s, 1e-6, 1e-6), GA_OK);
+    assert_int_equal(ga_advance(s, 1.0), GA_OK);
+    long long steps = 0;
+    ga_get_counter(s, GA_COUNT_STEPS, &steps);
+    printf("  pendulum, 50 fixed steps then rtol 1e-6 to t = 1: %lld steps\n", steps);
+    assert_true(steps < 5000);
+    ga_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1167,6 +1194,7 @@ int main(void)
         cmocka_unit_test(adaptive_fatal_failure_keeps_the_last_accepted_step),
         cmocka_unit_test(adaptive_steps_retry_after_newton_failures),
         cmocka_unit_test(step_size_ceiling_and_proposals),
+        cmocka_unit_test(adaptive_after_fixed_steps_keeps_its_steps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
