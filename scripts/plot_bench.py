@@ -165,6 +165,43 @@ if ci:
         print("  chain %d links: peak memory IDA %.0f MiB, galpha %.0f MiB" % (
             N, mem["ida"] / 1024, mem["galpha"] / 1024))
 
+# ---- the lattice against PETSc's TSALPHA2 -------------------------------------------------------
+lp = rows("lattice_petsc.csv")
+if lp:
+    sizes = sorted({int(num(r["unknowns"])) for r in lp})
+    methods = (("galpha", "galpha, fixed h", "C0", "o-"),
+               ("galpha_adaptive", "galpha, adaptive", "C2", "o-"),
+               ("petsc", "PETSc TSALPHA2, fixed h", "k", "s-"),
+               ("petsc_lagged", "TSALPHA2, Jacobian lagged", "C7", "s--"),
+               ("petsc_adaptive", "TSALPHA2, adaptive", "C3", "^-"),
+               ("petsc_adaptive_lagged", "TSALPHA2, adaptive, lagged", "C1", "^--"))
+    fig, ax = plt.subplots(1, len(sizes), figsize=(4.4 * len(sizes), 4.2), squeeze=False)
+    for k, n in enumerate(sizes):
+        for method, label, color, style in methods:
+            pts = [(num(r["error"]), num(r["cpu_seconds"])) for r in lp
+                   if int(num(r["unknowns"])) == n and r["method"] == method]
+            if not pts:
+                continue
+            e, c = zip(*sorted(pts, key=lambda p: -p[0]))  # by accuracy: setup dominates CPU
+            ax[0][k].loglog(c, e, style, color=color, ms=4, label=label)
+        ax[0][k].set(title="%d unknowns" % n, xlabel="CPU time [s]",
+                     ylabel="max displacement error at t = 0.2 s [m]")
+        ax[0][k].grid(True, which="both", lw=0.3)
+        ax[0][k].legend(fontsize=6)
+    fig.suptitle("Two-material lattice, no constraints: galpha against PETSc TSALPHA2 (both KLU, "
+                 "rho_inf 0.9)")
+    save(fig, "lattice_petsc.png")
+    for n in sizes:
+        for target in (1e-4, 1e-5):
+            t = {}
+            for method, _, _, _ in methods:
+                pts = [(num(r["error"]), num(r["cpu_seconds"])) for r in lp
+                       if int(num(r["unknowns"])) == n and r["method"] == method]
+                t[method] = interpolated_cpu(pts, target)
+            print("  lattice %d unknowns, error %g: CPU per simulated s: %s" % (
+                n, target, ", ".join("%s %.3g" % (m, v / 0.2) for m, v in t.items() if v)))
+
+
 # ---- linear algebra -------------------------------------------------------------------------
 la = rows("linear_algebra.csv")
 if la:
