@@ -109,6 +109,18 @@ static void position(const lattice *l, const double *q, int node, double x[2])
     }
 }
 
+/* a spring's vector from its node a to its node b, and its length */
+static double spring_vector(const lattice *l, const double *q, const lattice_spring *s,
+                            double d[2])
+{
+    double xa[2], xb[2];
+    position(l, q, s->a, xa);
+    position(l, q, s->b, xb);
+    d[0] = xb[0] - xa[0];
+    d[1] = xb[1] - xa[1];
+    return sqrt(d[0] * d[0] + d[1] * d[1]);
+}
+
 int lattice_mass(double t, const double *q, double *M, void *user)
 {
     (void)t;
@@ -130,10 +142,8 @@ int lattice_force(double t, const double *q, const double *v, double *f, void *u
     }
     for (int e = 0; e < l->springs; ++e) {
         const lattice_spring *s = &l->spring[e];
-        double xa[2], xb[2];
-        position(l, q, s->a, xa);
-        position(l, q, s->b, xb);
-        const double d0 = xb[0] - xa[0], d1 = xb[1] - xa[1], len = sqrt(d0 * d0 + d1 * d1);
+        double d[2];
+        const double len = spring_vector(l, q, s, d), d0 = d[0], d1 = d[1];
         const double pull = s->k * (len - s->rest) / len;
         const int fa = free_node(l, s->a), fb = free_node(l, s->b);
         if (fa >= 0) {
@@ -165,11 +175,9 @@ void lattice_stiffness_values(const lattice *l, const double *q, double *K)
         K[p] = 0.0;
     for (int e = 0; e < l->springs; ++e) {
         const lattice_spring *s = &l->spring[e];
-        double xa[2], xb[2];
-        position(l, q, s->a, xa);
-        position(l, q, s->b, xb);
-        const double d0 = xb[0] - xa[0], d1 = xb[1] - xa[1], len = sqrt(d0 * d0 + d1 * d1);
-        const double n0 = d0 / len, n1 = d1 / len, slack = 1.0 - s->rest / len;
+        double d[2];
+        const double len = spring_vector(l, q, s, d);
+        const double n0 = d[0] / len, n1 = d[1] / len, slack = 1.0 - s->rest / len;
         /* k (n n^T + (1 - l0 / l)(I - n n^T)): symmetric, (xx, xy, yy) */
         const double B[3] = {s->k * (n0 * n0 + slack * (1.0 - n0 * n0)),
                              s->k * (n0 * n1 - slack * n0 * n1),

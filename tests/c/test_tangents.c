@@ -19,6 +19,7 @@
 #include "helpers.h"
 #include "scenes/andrews.h"
 #include "scenes/chain.h"
+#include "scenes/lattice.h"
 #include "scenes/pendulum.h"
 
 enum { kLinks = 10 };
@@ -173,12 +174,56 @@ static void differences_count_their_residuals(void **state)
     ga_free(s);
 }
 
+/* The lattice of the PETSc bench (examples/scenes/lattice.h): its K_t, written by hand for
+ * the compressed rows it declares, is minus the derivative of its forces, checked column by
+ * column against central differences at a displaced state (every spring stretched or bent). */
+static void lattice_stiffness_is_the_force_derivative(void **state)
+{
+    (void)state;
+    lattice l;
+    assert_int_equal(lattice_make(&l, 6, 4, 1e4, 1e3), 0);
+    const int n = l.n;
+    double *q = calloc((size_t)n, sizeof(double)), *fp = calloc((size_t)n, sizeof(double)),
+           *fm = calloc((size_t)n, sizeof(double)), *K = calloc((size_t)l.nnz, sizeof(double));
+    assert_true(q && fp && fm && K);
+    for (int i = 0; i < n; ++i)
+        q[i] = 0.1 * sin(1.3 * i);
+    lattice_stiffness_values(&l, q, K);
+    double worst = 0.0, largest = 0.0;
+    const double e = 1e-6;
+    for (int c = 0; c < n; ++c) {
+        q[c] += e;
+        lattice_force(0.0, q, NULL, fp, &l);
+        q[c] -= 2.0 * e;
+        lattice_force(0.0, q, NULL, fm, &l);
+        q[c] += e;
+        for (int r = 0; r < n; ++r) {
+            double k = 0.0; /* K[r][c], zero outside the pattern */
+            for (int p = l.rowptr[r]; p < l.rowptr[r + 1]; ++p)
+                if (l.colind[p] == c)
+                    k = K[p];
+            worst = fmax(worst, fabs(k + (fp[r] - fm[r]) / (2.0 * e)));
+            largest = fmax(largest, fabs(k));
+        }
+    }
+    printf("  lattice, %d unknowns: max |K_t + df/dq| %.2g of max |K_t| %.2g\n", n, worst,
+           largest);
+    /* central differences of forces of size k ~ 1e7: truncation e^2 and round-off eps f / e */
+    assert_true(worst <= 1e-8 * largest);
+    free(q);
+    free(fp);
+    free(fm);
+    free(K);
+    lattice_free(&l);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(auto_takes_the_tangents_where_they_matter),
         cmocka_unit_test(auto_spares_the_tangents_where_they_do_not),
         cmocka_unit_test(differences_count_their_residuals),
+        cmocka_unit_test(lattice_stiffness_is_the_force_derivative),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
