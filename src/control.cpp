@@ -27,6 +27,17 @@ constexpr double kSafety = 0.9;
 constexpr double kMaxGrowth = 2.0, kMinShrink = 0.2;
 constexpr double kFailureShrink = 0.25;
 
+// The constants of (a) and (b): e_q = c_q (a_{n+1} - a_n), e_v = c_v h^3 qddd'
+struct EstimateCoefficients {
+    double cq, cv;
+};
+EstimateCoefficients estimate_coefficients(const Params &p, double h)
+{
+    const double da = p.alpha_m - p.alpha_f;
+    return {h * h * (p.beta + 0.5 * da - 1.0 / 6.0),
+            1.0 / 12.0 - da * da + da * (p.alpha_m - 0.5)};
+}
+
 bool recoverable(ga_status st)
 {
     return st == GA_ERR_NEWTON || st == GA_ERR_CALLBACK_RETRY || st == GA_ERR_NONFINITE ||
@@ -74,9 +85,7 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
     const Params &p = params;
     const State &s = accepted_;
     State &x = trial_;
-    const double da = p.alpha_m - p.alpha_f;
-    const double cq = h * h * (p.beta + 0.5 * da - 1.0 / 6.0);
-    const double cv = 1.0 / 12.0 - da * da + da * (p.alpha_m - 0.5);
+    const auto [cq, cv] = estimate_coefficients(p, h);
     Vec &eq = dq_, &ev = dw_;  // scratch
     if (consistent_estimate()) {
         // Into the output's workspace: when the step is accepted they are its output.
@@ -104,12 +113,7 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
         // The same from a (below): a transient of the multipliers that grows with each
         // change of h moves q and v unseen by c; it shows in a (sec. 1.5c).
         Vec &gq = guard_q_, &gv = guard_v_;
-        gq = cq * (x.a - *a_start_);
-        if (s.h_last > 0.0)
-            gv = (cv * h * h * h / (0.5 * (h + s.h_last))) *
-                 ((x.a - *a_start_) / h - (s.a - s.a_prev) / s.h_last);
-        else
-            gv.setZero();
+        estimate_from_a(h, gq, gv);
         // The projection with O_, factorized at the step's end for the accelerations:
         // [sigma M Phi_q^T; Phi_q 0] [x; y] = [sigma M e; 0]
         for (Vec *e : {&eq, &ev, &gq, &gv}) {
@@ -134,13 +138,7 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
                        weighted_error_norm(s, x, gq, gv, h, noise_q, noise_v) / kTransientAllowance);
         return GA_OK;
     }
-    const Vec &a_n = *a_start_;
-    eq = cq * (x.a - a_n);
-    if (s.h_last > 0.0)
-        ev = (cv * h * h * h / (0.5 * (h + s.h_last))) *
-             ((x.a - a_n) / h - (s.a - s.a_prev) / s.h_last);
-    else
-        ev.setZero();
+    estimate_from_a(h, eq, ev);
     if (m_ > 0 && P_.ready()) {
         count(counters, GA_COUNT_FACTORIZATIONS);  // counted like every other
         if (P_.factorize_kkt(M_, 1.0, J_))
@@ -154,6 +152,19 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
     }
     err = weighted_error_norm(s, x, eq, ev, h);
     return GA_OK;
+}
+
+void Solver::estimate_from_a(double h, Vec &e_q, Vec &e_v) const
+{
+    const State &s = accepted_, &x = trial_;
+    const auto [cq, cv] = estimate_coefficients(params, h);
+    const Vec &a_n = *a_start_;
+    e_q = cq * (x.a - a_n);
+    if (s.h_last > 0.0)
+        e_v = (cv * h * h * h / (0.5 * (h + s.h_last))) *
+              ((x.a - a_n) / h - (s.a - s.a_prev) / s.h_last);
+    else
+        e_v.setZero();
 }
 
 double Solver::weighted_error_norm(const State &s, const State &x, const Vec &eq, const Vec &ev,

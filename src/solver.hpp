@@ -296,6 +296,8 @@ private:
     // control.cpp: the error norm of trial_ (a step of h ending at t_end)
     ga_status error_norm(double h, double t_end, double &err);
     bool consistent_estimate() const;
+    // the estimate from a (docs/algorithms.md sec. 1.5, (a) and (b)) of trial_, into e_q, e_v
+    void estimate_from_a(double h, Vec &e_q, Vec &e_v) const;
     // noise_q, noise_v: absolute amounts of the estimates that are noise, added to the weights
     double weighted_error_norm(const State &s, const State &x, const Vec &eq, const Vec &ev,
                                double h, double noise_q = 0.0, double noise_v = 0.0);

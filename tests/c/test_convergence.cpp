@@ -157,11 +157,9 @@ void each_quantity_converges_at_its_own_rate(void **state)
 // iterate was accepted. After a divergence with a matrix of this step, rates are not trusted.
 UpdateSizes runaway(double dq, double q, double qdd, double dl, double l)
 {
-    UpdateSizes u;
-    u.dq = u.dw = dq;
+    UpdateSizes u = update(dq, dl);
     u.q = q;
     u.qdd = qdd;
-    u.dlambda = dl;
     u.lambda = l;
     return u;
 }
