@@ -59,8 +59,17 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &s
     // solved the equations, linear in lambda and qdd once q stays.
     moved_since_matrix_ += e[Q];
     const double moved_limit = std::max(1.0, ulps / tol);
-    const bool matrix_current = fresh_matrix_ && moved_since_matrix_ <= moved_limit &&
-                                at_floor[Q] && at_floor[A] && at_floor[Y];
+    const bool near_matrix = fresh_matrix_ && moved_since_matrix_ <= moved_limit;
+    const bool matrix_current = near_matrix && at_floor[Q] && at_floor[A] && at_floor[Y];
+    // Index 2 on an ill-conditioned system (a 100 000-link chain): w and lambda are known
+    // only to what the solve makes of the residual's round-off, above their floors from v.
+    // With q at its floor and a matrix of this q, an increment that stagnates there is noise
+    // if w moves q no more than q's own round-off (the index-3 floor of the accelerations).
+    const bool w_within_q_floor = size.dw <= q_floor;
+    const std::array<bool, K> stalled_floor = {
+        false, near_matrix && at_floor[Q] && w_within_q_floor,
+        near_matrix && at_floor[Q] && (at_floor[A] || w_within_q_floor) && at_floor[Y], false,
+        false};
 
     previous_dq_at_roundoff_ = at_floor[Q];
     if (matrix_current) {
@@ -79,14 +88,16 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &s
         theta[k] = measured[k]        ? e[k] / previous_[k]
                    : theta_prev_ >= 0 ? std::max(theta_prev_, kMinTrustedRate)
                                       : -1.0;
-        if (measured[k] && !at_floor[k])
+        const bool noise =
+            (at_floor[k] || stalled_floor[k]) && measured[k] && theta[k] >= kStagnation;
+        if (measured[k] && !at_floor[k] && !noise) {
             rate = std::max(rate, theta[k]);
-        if (measured[k] && !at_floor[k] && fresh_matrix_ && theta[k] >= 1.0)
-            diverged_ = true;
+            if (fresh_matrix_ && theta[k] >= 1.0)
+                diverged_ = true;
+        }
         const bool within = e[k] <= 1.0;
         const bool predicted = !diverged_ && theta[k] >= 0.0 && theta[k] < 1.0 &&
                                e[k] * theta[k] / (1.0 - theta[k]) <= 1.0;
-        const bool noise = at_floor[k] && measured[k] && theta[k] >= kStagnation;
         done[k] = within || predicted || noise;
         converged = converged && done[k];
     }

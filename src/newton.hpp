@@ -21,7 +21,12 @@
 //   - at its round-off floor and no longer improving: its increment is within the floor and
 //     either stagnates (theta_k >= 1/2: what is left is noise) or was computed with a matrix
 //     factorized in this step near the current q (one Newton update with the current matrix
-//     at fixed q solves the equations, linear in lambda and qdd once q stays).
+//     at fixed q solves the equations, linear in lambda and qdd once q stays), or
+//   - in the stabilized index-2 form, stagnating (theta_k >= 1/2) with a matrix factorized in
+//     this step near the current q, q at its floor and the Newmark increment within q's floor
+//     (accelerations), or q and the accelerations so (multipliers): on an ill-conditioned
+//     system (a 100 000-link chain) the solve resolves lambda and w only to what it makes of
+//     the residual's round-off, above the floors from v, and the iteration would never end.
 // First-order states (docs/algorithms.md sec. 11) are two more quantities of the same kind:
 // e_y = |dy| / (tol |y|) and e_y' = |c1 dy| / (tol |y'|), floor 64 ulps of |y| (times c1), where
 // |y| and |y'| include what q's own size makes of them through the coupling (first_order.cpp); with

@@ -189,6 +189,50 @@ void a_diverged_iteration_does_not_converge_by_one_rate(void **state)
     assert_true(c.check(tol, one_drop, beta_prime, gamma_prime) == Verdict::Converged);
 }
 
+// The stabilized index-2 chain of 100 000 links (h = 1e-3, tolerance 1e-10, the step from
+// t = 0.003): after two updates the increments repeat, with the same matrix and with a fresh
+// one at every iterate, the multipliers at 6e-8 of their size and the Newmark increment at
+// 3e-15 -- what the solve of this ill-conditioned system resolves, far above the floors that
+// v's round-off gives. The step failed after 20 iterations; it is converged by the stagnation.
+UpdateSizes chain_update(double dq, double dw, double dl)
+{
+    UpdateSizes u = update(dq, dl);
+    u.dw = dw;
+    u.dw_is_dq = false;
+    u.q = 1.0e5;
+    u.v = 4.968e-2;
+    u.qdd = 12.35;
+    u.lambda = 397.3;
+    return u;
+}
+
+void index2_stops_where_its_solve_stagnates(void **state)
+{
+    (void)state;
+    constexpr double tol = 1e-10, beta_prime = 3.971e6, gamma_prime = 1.995e3;
+    const UpdateSizes fresh = chain_update(2.010e-12, 3.865e-15, 2.472e-5),
+                      again = chain_update(2.010e-12, 3.312e-15, 2.475e-5);
+    ConvergenceTest c;
+    c.reset(-1.0);
+    c.matrix_changed();
+    assert_true(c.check(tol, fresh, beta_prime, gamma_prime) == Verdict::Continue);
+    assert_true(c.check(tol, again, beta_prime, gamma_prime) == Verdict::Converged);
+
+    // The same ratios with a Newmark increment that moves q by more than its round-off
+    // (the q floor is 1.4e-9 here): not noise, the iteration must go on.
+    c.reset(-1.0);
+    c.matrix_changed();
+    assert_true(c.check(tol, chain_update(2.010e-12, 3.865e-8, 2.472e-5), beta_prime,
+                        gamma_prime) == Verdict::Continue);
+    assert_true(c.check(tol, chain_update(2.010e-12, 3.312e-8, 2.475e-5), beta_prime,
+                        gamma_prime) != Verdict::Converged);
+
+    // ... or with the matrix of an earlier step, whose slow rate may be its age: a fresh one.
+    c.reset(-1.0);
+    assert_true(c.check(tol, fresh, beta_prime, gamma_prime) != Verdict::Converged);
+    assert_true(c.check(tol, again, beta_prime, gamma_prime) == Verdict::Slow);
+}
+
 }  // namespace
 
 int main()
@@ -202,6 +246,7 @@ int main()
         cmocka_unit_test(index2_waits_for_its_newmark_increment),
         cmocka_unit_test(a_new_step_forgets_the_fresh_matrix),
         cmocka_unit_test(a_diverged_iteration_does_not_converge_by_one_rate),
+        cmocka_unit_test(index2_stops_where_its_solve_stagnates),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
