@@ -94,6 +94,8 @@ public:
     // floors (< 0: none yet)
     double rate() const { return rate_; }
     int iterations_with_matrix() const { return with_matrix_; }
+    // a matrix factorized in this step saw an increment grow (see check)
+    bool diverged() const { return diverged_; }
     // the last position increment was within its round-off floor
     bool at_roundoff() const { return previous_dq_at_roundoff_; }
 
