@@ -61,14 +61,22 @@ public:
             diag_[i] = S_.slot(i, i);
         // The slots of the top-left block, where M, C_t, K_t (or I) add up; the constraint
         // blocks are written, not added, unless Phi_q's pattern repeats an entry.
-        top_left_ = diag_;
-        for (const std::vector<int> *m : {&map_M_, &map_K_, &map_C_})
-            top_left_.insert(top_left_.end(), m->begin(), m->end());
-        std::sort(top_left_.begin(), top_left_.end());
-        top_left_.erase(std::unique(top_left_.begin(), top_left_.end()), top_left_.end());
-        std::vector<int> j_slots = map_J_;
-        std::sort(j_slots.begin(), j_slots.end());
-        j_written_ = std::adjacent_find(j_slots.begin(), j_slots.end()) == j_slots.end();
+        // (marked in a pass over S's slots, not sorted: a sort of every block entry was a
+        // tenth of ga_init on a long chain)
+        std::vector<unsigned char> marked(S_.values().size(), 0);
+        for (const std::vector<int> *m : {&diag_, &map_M_, &map_K_, &map_C_})
+            for (const int slot : *m)
+                marked[slot] = 1;
+        top_left_.clear();
+        for (int slot = 0; slot < static_cast<int>(marked.size()); ++slot)
+            if (marked[slot])
+                top_left_.push_back(slot);
+        std::fill(marked.begin(), marked.end(), 0);
+        j_written_ = true;
+        for (const int slot : map_J_) {
+            j_written_ = j_written_ && !marked[slot];
+            marked[slot] = 1;
+        }
         lower_diag_.clear();
         if (with_inactive)
             for (int i = 0; i < m; ++i)
