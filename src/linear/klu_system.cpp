@@ -49,7 +49,8 @@ private:
 
 // Row k of L is the subtree of the elimination tree that the entries of row k reach (Davis,
 // Direct Methods for Sparse Linear Systems, ch. 4): O(|L|) time, no factor stored.
-CholeskyFill cholesky_fill(const Adjacency &adj, const std::vector<int> &order, double limit)
+CholeskyFill cholesky_fill(const std::vector<std::vector<int>> &adj, const std::vector<int> &order,
+                           double limit)
 {
     const int N = static_cast<int>(order.size());
     std::vector<int> position(N), parent(N, -1), ancestor(N, -1), mark(N, -1);
@@ -59,8 +60,8 @@ CholeskyFill cholesky_fill(const Adjacency &adj, const std::vector<int> &order, 
     CholeskyFill fill;
     for (int k = 0; k < N && fill.entries <= limit; ++k) {
         // the elimination tree, built row by row (Liu's algorithm, path compression)
-        for (const int *p = adj.begin(order[k]); p != adj.end(order[k]); ++p) {
-            for (int r = position[*p]; r < k;) {
+        for (int neighbour : adj[order[k]]) {
+            for (int r = position[neighbour]; r < k;) {
                 const int next = ancestor[r];
                 ancestor[r] = k;
                 if (next < 0) {
@@ -74,8 +75,8 @@ CholeskyFill cholesky_fill(const Adjacency &adj, const std::vector<int> &order, 
         mark[k] = k;
         column[k] += 1.0;
         fill.entries += 1.0;
-        for (const int *p = adj.begin(order[k]); p != adj.end(order[k]); ++p)
-            for (int r = position[*p]; r < k && mark[r] != k; r = parent[r]) {
+        for (int neighbour : adj[order[k]])
+            for (int r = position[neighbour]; r < k && mark[r] != k; r = parent[r]) {
                 mark[r] = k;
                 column[r] += 1.0;
                 fill.entries += 1.0;
@@ -171,7 +172,7 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries, Ordering 
         throw std::bad_alloc();
     orders_[0].assign(symbolic_->Q, symbolic_->Q + N);  // AMD's, rows and columns alike
     {
-        const Adjacency adj = symmetric_adjacency();  // freed before
+        const std::vector<std::vector<int>> adj = symmetric_adjacency();  // freed before
         amd_fill_ = cholesky_fill(adj, orders_[0], std::numeric_limits<double>::infinity());
         orders_[1] = reverse_cuthill_mckee(adj);
         rcm_fill_ = cholesky_fill(adj, orders_[1], kBandFillAllowance * amd_fill_.entries);
@@ -368,47 +369,36 @@ void KluSystem::solve_blocks(const double *b1, double c1, const double *b2, doub
 }
 
 // The pattern of S + S^T without the diagonal, as sorted neighbour lists.
-Adjacency KluSystem::symmetric_adjacency() const
+std::vector<std::vector<int>> KluSystem::symmetric_adjacency() const
 {
-    Adjacency adj;
-    adj.start.assign(N_ + 1, 0);
-    for (int j = 0; j < N_; ++j)  // counts with repeats: S's and S^T's entries
-        for (int p = colptr_[j]; p < colptr_[j + 1]; ++p)
-            if (rowind_[p] != j) {
-                ++adj.start[j + 1];
-                ++adj.start[rowind_[p] + 1];
-            }
-    for (int j = 0; j < N_; ++j)
-        adj.start[j + 1] += adj.start[j];
-    adj.index.resize(adj.start[N_]);
+    std::vector<std::vector<int>> adj(N_);
     {
-        std::vector<int> next(adj.start.begin(), adj.start.end() - 1);
+        std::vector<int> degree(N_, 0);  // with duplicates: each list allocated once
         for (int j = 0; j < N_; ++j)
             for (int p = colptr_[j]; p < colptr_[j + 1]; ++p)
                 if (rowind_[p] != j) {
-                    adj.index[next[j]++] = rowind_[p];
-                    adj.index[next[rowind_[p]]++] = j;
+                    ++degree[j];
+                    ++degree[rowind_[p]];
                 }
+        for (int j = 0; j < N_; ++j)
+            adj[j].reserve(degree[j]);
     }
-    // each list sorted, without repeats, moved down over the gaps the repeats leave
-    int kept = 0;
-    for (int i = 0; i < N_; ++i) {
-        const auto first = adj.index.begin() + adj.start[i];
-        const auto last = adj.index.begin() + adj.start[i + 1];
-        std::sort(first, last);
-        const auto end = std::unique(first, last);
-        adj.start[i] = kept;
-        kept = static_cast<int>(std::copy(first, end, adj.index.begin() + kept) -
-                                adj.index.begin());
+    for (int j = 0; j < N_; ++j)
+        for (int p = colptr_[j]; p < colptr_[j + 1]; ++p)
+            if (rowind_[p] != j) {
+                adj[j].push_back(rowind_[p]);
+                adj[rowind_[p]].push_back(j);
+            }
+    for (auto &a : adj) {
+        std::sort(a.begin(), a.end());
+        a.erase(std::unique(a.begin(), a.end()), a.end());
     }
-    adj.start[N_] = kept;
-    adj.index.resize(kept);
     return adj;
 }
 
 // Reverse Cuthill-McKee on the pattern of S + S^T, from a pseudo-peripheral start in every
 // connected component.
-std::vector<int> KluSystem::reverse_cuthill_mckee(const Adjacency &adj) const
+std::vector<int> KluSystem::reverse_cuthill_mckee(const std::vector<std::vector<int>> &adj) const
 {
     const int N = N_;
     std::vector<int> order, level(N, -1), next;
@@ -424,13 +414,13 @@ std::vector<int> KluSystem::reverse_cuthill_mckee(const Adjacency &adj) const
         level[root] = 0;
         for (std::size_t k = 0; k < out.size(); ++k) {
             next.clear();
-            for (const int *p = adj.begin(out[k]); p != adj.end(out[k]); ++p)
-                if (level[*p] < 0) {
-                    level[*p] = level[out[k]] + 1;
-                    next.push_back(*p);
+            for (int v : adj[out[k]])
+                if (level[v] < 0) {
+                    level[v] = level[out[k]] + 1;
+                    next.push_back(v);
                 }
             std::sort(next.begin(), next.end(),
-                      [&](int a, int b) { return adj.degree(a) < adj.degree(b); });
+                      [&](int a, int b) { return adj[a].size() < adj[b].size(); });
             out.insert(out.end(), next.begin(), next.end());
         }
     };

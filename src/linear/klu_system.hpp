@@ -28,16 +28,8 @@ namespace ga {
 struct CholeskyFill {
     double entries = 0.0, flops = 0.0;
 };
-// A symmetric pattern as neighbour lists in two arrays (one list per vertex was a heap block
-// each): the neighbours of i are index[start[i]] ... index[start[i + 1] - 1].
-struct Adjacency {
-    std::vector<int> start, index;
-    int size() const { return static_cast<int>(start.size()) - 1; }
-    int degree(int i) const { return start[i + 1] - start[i]; }
-    const int *begin(int i) const { return index.data() + start[i]; }
-    const int *end(int i) const { return index.data() + start[i + 1]; }
-};
-CholeskyFill cholesky_fill(const Adjacency &adj, const std::vector<int> &order, double limit);
+CholeskyFill cholesky_fill(const std::vector<std::vector<int>> &adj, const std::vector<int> &order,
+                           double limit);
 
 class KluSystem {
 public:
@@ -93,8 +85,8 @@ public:
     void load_pivots(const double *in);            // never allocates
 
 private:
-    Adjacency symmetric_adjacency() const;
-    std::vector<int> reverse_cuthill_mckee(const Adjacency &adj) const;
+    std::vector<std::vector<int>> symmetric_adjacency() const;
+    std::vector<int> reverse_cuthill_mckee(const std::vector<std::vector<int>> &adj) const;
 
     int N_ = 0;
     std::vector<int> colptr_, rowind_;

@@ -269,18 +269,6 @@ Adjacency from_edges(int N, const std::vector<std::pair<int, int>> &edges)
     return adj;
 }
 
-// The same in the library's compressed form.
-ga::Adjacency compressed(const Adjacency &lists)
-{
-    ga::Adjacency adj;
-    adj.start.push_back(0);
-    for (const std::vector<int> &l : lists) {
-        adj.index.insert(adj.index.end(), l.begin(), l.end());
-        adj.start.push_back(static_cast<int>(adj.index.size()));
-    }
-    return adj;
-}
-
 // The 5-point stencil of an nx x ny grid, nodes numbered row by row.
 std::vector<std::pair<int, int>> grid_edges(int nx, int ny)
 {
@@ -336,7 +324,7 @@ void cholesky_fill_against_analysis(void **)
     for (int k = 0; k + 1 < N; ++k)
         path.emplace_back(k, k + 1);
     for (const auto &order : {natural, reversed}) {
-        const ga::CholeskyFill f = ga::cholesky_fill(compressed(from_edges(N, path)), order, inf);
+        const ga::CholeskyFill f = ga::cholesky_fill(from_edges(N, path), order, inf);
         assert_true(f.entries == 2 * N - 1 && f.flops == 4 * (N - 1) + 1);
     }
     // an arrow, node 0 joined to all: eliminated first it fills L solid, N (N + 1) / 2
@@ -344,9 +332,9 @@ void cholesky_fill_against_analysis(void **)
     std::vector<std::pair<int, int>> arrow;
     for (int k = 1; k < N; ++k)
         arrow.emplace_back(0, k);
-    const ga::CholeskyFill first = ga::cholesky_fill(compressed(from_edges(N, arrow)), natural, inf);
+    const ga::CholeskyFill first = ga::cholesky_fill(from_edges(N, arrow), natural, inf);
     assert_true(first.entries == N * (N + 1) / 2 && first.flops == N * (N + 1) * (2 * N + 1) / 6);
-    const ga::CholeskyFill last = ga::cholesky_fill(compressed(from_edges(N, arrow)), reversed, inf);
+    const ga::CholeskyFill last = ga::cholesky_fill(from_edges(N, arrow), reversed, inf);
     assert_true(last.entries == 2 * N - 1 && last.flops == 4 * (N - 1) + 1);
     // a 9 x 7 grid in random orders, against the dense symbolic elimination
     const Adjacency grid = from_edges(63, grid_edges(9, 7));
@@ -356,12 +344,12 @@ void cholesky_fill_against_analysis(void **)
     std::mt19937 random(7);
     for (int trial = 0; trial < 20; ++trial) {
         std::shuffle(order.begin(), order.end(), random);
-        const ga::CholeskyFill f = ga::cholesky_fill(compressed(grid), order, inf);
+        const ga::CholeskyFill f = ga::cholesky_fill(grid, order, inf);
         const ga::CholeskyFill ref = dense_symbolic_fill(grid, order);
         assert_true(f.entries == ref.entries && f.flops == ref.flops);
     }
     // the count stops past the limit, and says so
-    const double stopped = ga::cholesky_fill(compressed(from_edges(N, arrow)), natural, 100.0).entries;
+    const double stopped = ga::cholesky_fill(from_edges(N, arrow), natural, 100.0).entries;
     assert_true(stopped > 100.0 && stopped < first.entries);
 }
 
