@@ -26,6 +26,13 @@ echo "links,n,m,runs,setup_us,later_us_per_step,setup_in_steps" > "$out/chain_se
 for N in 1000 10000 100000; do  # ga_create to ga_init against a step (steps 2-10), best of runs
     "$b/step_cost" chain_setup "$N" 10 >> "$out/chain_setup.csv"
 done
+# the same with glibc's malloc on transparent huge pages (docs/performance.md: setup is mostly
+# the first touch of its memory)
+echo "links,n,m,runs,setup_us,later_us_per_step,setup_in_steps" > "$out/chain_setup_hugepages.csv"
+for N in 1000 10000 100000; do
+    GLIBC_TUNABLES=glibc.malloc.hugetlb=1 "$b/step_cost" chain_setup "$N" 10 \
+        >> "$out/chain_setup_hugepages.csv"
+done
 echo "links,n,m,backend,steps,newton_per_step,factorizations_per_step,us_per_step,first_step_us,later_us_per_step,limit_us,ratio,peak_rss_kib" > "$out/chain_index2.csv"
 for N in 1000 10000 100000; do
     # (at 100 000 links Newton stalls above 1e-10 at the third step: docs/performance.md)
