@@ -180,6 +180,27 @@ ga_status Solver::acceleration_level(double t, const Vec &q, const Vec &v, Saddl
         st = model.constraint_accel(t, q, v, w.c);
     if (st)
         return st;
+    if (m_ == 0 && w.M.diagonal()) {
+        // M qdd = f with M diagonal: no factorization (the sparse path's saddle-point matrix
+        // has the pattern of the step's, a lattice's K_t and its fill: most of its ga_init)
+        qdd.setZero();
+        const std::vector<int> &rows = w.M.row_index();
+        for (int k = 0; k < w.M.nnz(); ++k)  // (repeated entries add up)
+            qdd[rows[k]] += w.M.data()[k];
+        for (int i = 0; i < n_; ++i) {
+            if (!(qdd[i] != 0.0))
+                return diag.fail(GA_ERR_SINGULAR,
+                                 "the mass matrix M (diagonal) is singular at t = %.17g: "
+                                 "M[%d][%d] = %g",
+                                 t, i, i, qdd[i]);
+            qdd[i] = w.f[i] / qdd[i];
+        }
+        w.sigma = 1.0;
+        if (!all_finite(qdd))
+            return diag.fail(GA_ERR_NONFINITE,
+                             "consistent accelerations are not finite at t = %.17g", t);
+        return GA_OK;
+    }
     double sigma = 1.0;
     const double mmax = max_abs(w.M), jmax = max_abs(w.J, active_ptr());
     if (mmax > 0.0 && jmax > 0.0)

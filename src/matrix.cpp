@@ -7,6 +7,7 @@ void ModelMatrix::set_dense(int rows, int cols)
     rows_ = rows;
     cols_ = cols;
     dense_ = true;
+    diagonal_ = false;
     row_.clear();
     col_.clear();
 }
@@ -18,6 +19,7 @@ void ModelMatrix::set_pattern(int rows, int cols, const int *row, const int *col
     dense_ = false;
     row_.assign(row, row + nnz);
     col_.assign(col, col + nnz);
+    diagonal_ = rows == cols && row_ == col_;
 }
 
 void ModelMatrix::allocate()
@@ -31,6 +33,7 @@ void ModelMatrix::copy_layout(const ModelMatrix &other)
     rows_ = other.rows_;
     cols_ = other.cols_;
     dense_ = other.dense_;
+    diagonal_ = other.diagonal_;
     row_ = other.row_;
     col_ = other.col_;
     allocate();

@@ -21,6 +21,7 @@ public:
     int cols() const { return cols_; }
     bool dense() const { return dense_; }
     bool zero() const { return !dense_ && row_.empty(); }
+    bool diagonal() const { return diagonal_; }  // a declared pattern on the diagonal only
     int nnz() const { return static_cast<int>(row_.size()); }  // pattern entries
     const std::vector<int> &row_index() const { return row_; }
     const std::vector<int> &col_index() const { return col_; }
@@ -40,7 +41,7 @@ public:
 
 private:
     int rows_ = 0, cols_ = 0;
-    bool dense_ = true;
+    bool dense_ = true, diagonal_ = false;
     std::vector<int> row_, col_;
     Vec values_;
 };

@@ -89,6 +89,113 @@ static void consistent_values_are_kept(void **state)
 }
 
 /* A failed re-initialization keeps the previous state. */
+/* Unconstrained, with M declared diagonal: M qdd = f is solved by division, without the
+ * saddle-point factorization (on the sparse path it had the pattern of the step's matrix, a
+ * lattice's K_t and its fill). Oracle: qdd = f / M by hand, and the dense twin. */
+typedef struct springs3 {
+    double mass[4]; /* the values written, in the declared order: (0,0) (1,1) (2,2) (1,1) */
+} springs3;
+static const int kDiagRows[4] = {0, 1, 2, 1}, kKRows[7] = {0, 0, 1, 1, 1, 2, 2},
+                 kKCols[7] = {0, 1, 0, 1, 2, 1, 2};
+static int s3_mass_sparse(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q;
+    memcpy(M, ((const springs3 *)u)->mass, sizeof(double) * 4);
+    return 0;
+}
+static int s3_mass_dense(double t, const double *q, double *M, void *u)
+{
+    const double *m = ((const springs3 *)u)->mass;
+    (void)t, (void)q;
+    memset(M, 0, sizeof(double) * 9);
+    M[0] = m[0], M[4] = m[1] + m[3], M[8] = m[2];
+    return 0;
+}
+/* a chain of three unit springs fixed at both ends, plus constant loads */
+static int s3_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)v, (void)u;
+    f[0] = -2.0 * q[0] + q[1] + 1.0;
+    f[1] = q[0] - 2.0 * q[1] + q[2] - 2.0;
+    f[2] = q[1] - 2.0 * q[2] + 8.0;
+    return 0;
+}
+static int s3_stiffness_sparse(double t, const double *q, const double *v, const double *qdd,
+                               const double *l, double *K, void *u)
+{
+    (void)t, (void)q, (void)v, (void)qdd, (void)l, (void)u;
+    const double k[7] = {2, -1, -1, 2, -1, -1, 2}; /* K_t = -df/dq */
+    memcpy(K, k, sizeof k);
+    return 0;
+}
+static ga_solver *s3_solver(springs3 *m, int sparse)
+{
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(3, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, sparse ? s3_mass_sparse : s3_mass_dense, s3_force, NULL,
+                                      NULL, m),
+                     GA_OK);
+    if (sparse) {
+        assert_int_equal(ga_set_pattern(s, GA_MATRIX_MASS, 4, kDiagRows, kDiagRows), GA_OK);
+        assert_int_equal(ga_set_pattern(s, GA_MATRIX_STIFFNESS, 7, kKRows, kKCols), GA_OK);
+        assert_int_equal(ga_set_pattern(s, GA_MATRIX_DAMPING, 0, NULL, NULL), GA_OK);
+        assert_int_equal(ga_set_tangents(s, s3_stiffness_sparse, NULL), GA_OK);
+        assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    }
+    return s;
+}
+
+static void unconstrained_diagonal_mass_needs_no_factorization(void **state)
+{
+    (void)state;
+    springs3 m = {{2.0, 3.0, 4.0, 1.0}}; /* M = diag(2, 4, 4) */
+    const double q0[3] = {0.5, -0.25, 1.0}, v0[3] = {0.0, 1.0, 0.0};
+    /* f(q0) by hand: (-1 - 0.25 + 1, 0.5 + 0.5 + 1 - 2, -0.25 - 2 + 8) = (-0.25, 0, 5.75);
+     * qdd0 = f / M */
+    const double expected[3] = {-0.125, 0.0, 1.4375};
+    ga_solver *s = s3_solver(&m, 1), *dense = s3_solver(&m, 0);
+    if (ga_init(s, 0.0, q0, v0) != GA_OK)
+        fail_msg("%s", ga_last_error(s));
+    assert_int_equal(ga_init(dense, 0.0, q0, v0), GA_OK);
+    double qdd[3], qdd_dense[3], q[3], q_dense[3];
+    long long factorizations = -1;
+    assert_int_equal(ga_get_qdd(s, qdd), GA_OK);
+    assert_int_equal(ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &factorizations), GA_OK);
+    assert_true(factorizations == 0);
+    for (int i = 0; i < 3; ++i)
+        assert_true(fabs(qdd[i] - expected[i]) <= 1e-15 * fabs(expected[i]));
+    assert_int_equal(ga_get_qdd(dense, qdd_dense), GA_OK);
+    for (int k = 0; k < 20; ++k) {
+        assert_int_equal(ga_step(s, 0.05), GA_OK);
+        assert_int_equal(ga_step(dense, 0.05), GA_OK);
+    }
+    ga_get_q(s, q);
+    ga_get_q(dense, q_dense);
+    for (int i = 0; i < 3; ++i) {
+        assert_true(fabs(qdd_dense[i] - expected[i]) <= 1e-15 * fabs(expected[i]));
+        assert_true(fabs(q[i] - q_dense[i]) <= 1e-12 * (1.0 + fabs(q_dense[i])));
+    }
+
+    /* a zero on the diagonal: refused by name, and the solver keeps the run it had */
+    double t_before, q_before[3], qdd_before[3];
+    ga_get_t(s, &t_before);
+    ga_get_q(s, q_before);
+    ga_get_qdd(s, qdd_before);
+    m.mass[1] = 0.0, m.mass[3] = 0.0;
+    assert_int_equal(ga_init(s, 0.0, q0, v0), GA_ERR_SINGULAR);
+    assert_non_null(strstr(ga_last_error(s), "M[1][1]"));
+    double t_after;
+    ga_get_t(s, &t_after);
+    ga_get_q(s, q);
+    assert_true(t_after == t_before);
+    assert_memory_equal(q, q_before, sizeof q);
+    m.mass[1] = 3.0, m.mass[3] = 1.0; /* (consistent output is computed from the model) */
+    assert_int_equal(ga_get_qdd(s, qdd), GA_OK);
+    assert_memory_equal(qdd, qdd_before, sizeof qdd);
+    ga_free(s);
+    ga_free(dense);
+}
+
 static void failed_init_keeps_previous_state(void **state)
 {
     (void)state;
@@ -250,6 +357,7 @@ int main(void)
         cmocka_unit_test(inconsistent_positions_and_velocities_are_projected),
         cmocka_unit_test(consistent_values_are_kept),
         cmocka_unit_test(failed_init_keeps_previous_state),
+        cmocka_unit_test(unconstrained_diagonal_mass_needs_no_factorization),
         cmocka_unit_test(time_dependent_constraint_start),
         cmocka_unit_test(index2_velocity_constraint_with_exact_phi_t),
     };
