@@ -25,6 +25,9 @@ constexpr double kMinTrustedRate = 0.05;
 constexpr int kIterationBudget = 4;
 // An increment within its floor that shrank by less than this factor is noise.
 constexpr double kStagnation = 0.5;
+// A rate is kept below this: a quantity that became exactly zero after a nonzero increment
+// has an infinite ratio, and the rate is carried to the next step and into checkpoints.
+constexpr double kMaxRate = 1e6;
 // The round-off floor of the positions, in ulps of |q|.
 constexpr double kFloorUlps = 64.0;
 }  // namespace
@@ -91,7 +94,7 @@ ConvergenceTest::Verdict ConvergenceTest::check(double tol, const UpdateSizes &s
         const bool noise =
             (at_floor[k] || stalled_floor[k]) && measured[k] && theta[k] >= kStagnation;
         if (measured[k] && !at_floor[k] && !noise) {
-            rate = std::max(rate, theta[k]);
+            rate = std::max(rate, std::min(theta[k], kMaxRate));
             if (fresh_matrix_ && theta[k] >= 1.0)
                 diverged_ = true;
         }

@@ -3,6 +3,7 @@
 // the first update the positions are converged, but the multipliers keep moving by ~4e5 tol
 // |lambda|, the round-off of accelerations known to eps |q| / (beta h^2). Whether one update
 // at round-off ends the step depends on where the matrix comes from (newton.hpp's comment).
+#include <cmath>
 #include <limits>
 
 #include "newton.hpp"
@@ -233,6 +234,22 @@ void index2_stops_where_its_solve_stagnates(void **state)
     assert_true(c.check(tol, again, beta_prime, gamma_prime) == Verdict::Slow);
 }
 
+// A quantity that became exactly zero after a nonzero increment has an infinite ratio to its
+// tolerance; the rate the step hands on (to the next step, and into checkpoints, which refuse
+// what is not finite: found by libFuzzer) stays finite, and still says "too slow".
+void a_rate_stays_finite(void **state)
+{
+    (void)state;
+    ConvergenceTest c;
+    c.reset(-1.0);
+    c.matrix_changed();
+    assert_true(c.check(kTol, kFirst, kBetaPrime, kGammaPrime) == Verdict::Continue);
+    UpdateSizes zero = update(1e-3 * kTol * kQ, 1e3 * kTol * kLambda);
+    zero.lambda = 0.0;
+    assert_true(c.check(kTol, zero, kBetaPrime, kGammaPrime) != Verdict::Converged);
+    assert_true(std::isfinite(c.rate()) && c.rate() >= 1.0);
+}
+
 }  // namespace
 
 int main()
@@ -247,6 +264,7 @@ int main()
         cmocka_unit_test(a_new_step_forgets_the_fresh_matrix),
         cmocka_unit_test(a_diverged_iteration_does_not_converge_by_one_rate),
         cmocka_unit_test(index2_stops_where_its_solve_stagnates),
+        cmocka_unit_test(a_rate_stays_finite),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
