@@ -639,6 +639,9 @@ ga_status Solver::sliver_step(double h)
     a_start_ = &x.a;  // for the error estimate of adaptive steps: none from this step
     w_start_ = &x.w;  // (likewise for the first-order states)
     last_newton_iters_ = 0;
+    // No iteration: the test's verdicts (diverged, which the error estimate reads) are not
+    // those of an earlier step's Newton, which a restored checkpoint does not carry.
+    convergence_.reset(-1.0);
     return GA_OK;
 }
 

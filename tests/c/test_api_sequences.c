@@ -151,12 +151,54 @@ static void fuzzer_findings_stay_fixed(void **state)
     assert_true(replayed > 0);
 }
 
+/* The first fuzzer finding of the checkpoint defect, as a plain sequence: a fixed step of h = 1
+ * whose Newton iteration diverged before it converged, then an adaptive step whose first try
+ * is a sliver (a Taylor step, no iteration). The sliver's error estimate read the diverged
+ * verdict of that earlier iteration, which a checkpoint does not carry: restored, the same
+ * adaptive step took another error and another h (9.5449e-4 instead of 9.5436e-4). */
+static void a_sliver_after_a_diverged_step_repeats_from_its_checkpoint(void **state)
+{
+    (void)state;
+    model md = {0};
+    md.p[0] = 9.81;
+    model_shape(&md, 3, 3);
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(md.n, md.m, &s), GA_OK);
+    md.s = s;
+    assert_int_equal(ga_set_output(s, GA_OUTPUT_STEP), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, mass, force, constraint, jacobian, &md), GA_OK);
+    assert_int_equal(ga_set_tangents(s, stiffness, NULL), GA_OK);
+    assert_int_equal(ga_set_initial_step(s, 0.7), GA_OK);
+    const double q0[6] = {0.37706637854462755, -0.22618623730394516, 1.3770663785446275,
+                          -0.92618623730394511, 2.3770663785446278, -0.92618623730394511};
+    const double v0[6] = {0.0};
+    assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+    assert_int_equal(ga_step(s, 1.0), GA_OK);
+    size_t len = 0;
+    assert_int_equal(ga_state_size(s, &len), GA_OK);
+    assert_true(len <= CKPT_MAX);
+    double ckpt[CKPT_MAX], end[2][CKPT_MAX], h[2];
+    assert_int_equal(ga_get_state(s, ckpt, len), GA_OK);
+    for (int run = 0; run < 2; ++run) {
+        if (run == 1)
+            assert_int_equal(ga_set_state(s, ckpt, len), GA_OK);
+        assert_int_equal(ga_step_adaptive(s, 1.005), GA_OK);
+        assert_int_equal(ga_get_h_last(s, &h[run]), GA_OK);
+        assert_int_equal(ga_get_state(s, end[run], len), GA_OK);
+    }
+    assert_true(h[0] < 1e-3);  /* shrunk from the sliver of 5e-3 that it tried first */
+    assert_memory_equal(&h[0], &h[1], sizeof h[0]);
+    assert_memory_equal(end[0], end[1], sizeof(double) * len);
+    ga_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(model_derivatives_agree_with_differences),
         cmocka_unit_test(random_call_sequences_keep_the_contract),
         cmocka_unit_test(fuzzer_findings_stay_fixed),
+        cmocka_unit_test(a_sliver_after_a_diverged_step_repeats_from_its_checkpoint),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
