@@ -825,7 +825,7 @@ typedef enum ga_sensitivity_method {
  *  more per rejection), so that the run can be repeated from a checkpoint bit for bit
  *  (ga_set_adjoint_checkpoints). After ga_set_sensitivity, before ga_init. Errors: GA_ERR_ARG (no method, unknown
  *  flags, max_steps < 1 with the adjoint), GA_ERR_STATE (no parameters, after ga_init),
- *  GA_ERR_NOMEM. */
+ *  GA_ERR_NOMEM (also a record larger than any vector: checked before it is computed). */
 GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_steps);
 
 /** Checkpointing for runs whose adjoint record does not fit: the record keeps the steps of one
@@ -841,7 +841,9 @@ GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_s
  *  same values when called again, and the options stay as they were during the run. interval = 0 returns to the full record of
  *  ga_set_sensitivity_method's max_steps. After ga_set_sensitivity_method with
  *  GA_SENSITIVITY_ADJOINT, before ga_init. Errors: GA_ERR_ARG (interval < 0, count < 1 with
- *  interval > 0), GA_ERR_STATE (no adjoint method, after ga_init), GA_ERR_NOMEM. */
+ *  interval > 0, interval * count overflows), GA_ERR_STATE (no adjoint method, after
+ *  ga_init), GA_ERR_NOMEM (also sizes larger than any vector: checked before they are
+ *  computed). */
 GA_API ga_status ga_set_adjoint_checkpoints(ga_solver *s, long interval, long count);
 
 /** A cost term: its value at (t, q, v, qdd, lambda) and every partial derivative, in q, v, qdd

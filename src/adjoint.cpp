@@ -52,6 +52,20 @@ void AdjointRecord::allocate_checkpointed(int n_, int m_, int r_, int np, long i
 
 ga_status Solver::set_adjoint_checkpoints(long interval, long count)
 {
+    // (interval * count fits in a long: the C API checked it)
+    const std::size_t stride = AdjointRecord::stride_for(n_, m_, r());
+    if (interval > 0 && !fits_doubles(static_cast<std::size_t>(interval) + 1, stride))
+        return diag.fail(GA_ERR_NOMEM, "an adjoint segment of interval = %ld steps (%zu doubles "
+                         "each) is larger than memory can hold", interval, stride);
+    if (interval > 0 && !fits_doubles(static_cast<std::size_t>(count), state_size()))
+        return diag.fail(GA_ERR_NOMEM, "count = %ld adjoint checkpoints of %zu doubles each are "
+                         "more than memory can hold", count, state_size());
+    if (interval > 0 &&
+        !fits_doubles(static_cast<std::size_t>(interval) * static_cast<std::size_t>(count),
+                      AdjointRecord::kLog))
+        return diag.fail(GA_ERR_NOMEM, "the step log of interval * count = %ld adjoint steps "
+                         "(%zu doubles each) is larger than memory can hold", interval * count,
+                         AdjointRecord::kLog);
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
     record.max_steps = adjoint_.max_steps;
     if (interval > 0)
@@ -64,6 +78,12 @@ ga_status Solver::set_adjoint_checkpoints(long interval, long count)
 
 ga_status Solver::set_sensitivity_method(int methods, long max_steps)
 {
+    const std::size_t stride = AdjointRecord::stride_for(n_, m_, r());
+    if ((methods & GA_SENSITIVITY_ADJOINT) &&
+        !fits_doubles(static_cast<std::size_t>(max_steps) + 1, stride))
+        return diag.fail(GA_ERR_NOMEM, "an adjoint record of max_steps = %ld steps (%zu doubles "
+                         "each) is larger than memory can hold; ga_set_adjoint_checkpoints "
+                         "keeps one segment", max_steps, stride);
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
     if (methods & GA_SENSITIVITY_ADJOINT)
         record.allocate(n_, m_, r(), sens.np, max_steps);

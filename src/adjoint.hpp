@@ -42,10 +42,12 @@ struct AdjointRecord {
     bool pending_sliver = true;
     double pending_reuse[5] = {0, 0, 0, 0, 0};
 
-    std::size_t stride() const
+    static std::size_t stride_for(int n, int m, int r)
     {
-        return 4 + 3 * static_cast<std::size_t>(n) + 2 * static_cast<std::size_t>(m) + 2 * r;
+        return 4 + 3 * static_cast<std::size_t>(n) + 2 * static_cast<std::size_t>(m) +
+               2 * static_cast<std::size_t>(r);
     }
+    std::size_t stride() const { return stride_for(n, m, r); }
     // entry k: [t, h of the step ending here, rho, kind, q, v, qdd (n each), lambda, eta (m),
     // y, y' (r each)]
     double *entry(long k) { return data.data() + static_cast<std::size_t>(k - base) * stride(); }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <exception>
 #include <new>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -54,6 +55,8 @@ ga_status caught(ga::Solver &core, Body &&body)
         return body(core);
     } catch (const std::bad_alloc &) {
         return core.diag.fail(GA_ERR_NOMEM, "out of memory");
+    } catch (const std::length_error &e) {  // a size beyond any vector: memory too, not a bug
+        return core.diag.fail(GA_ERR_NOMEM, "out of memory: %s", e.what());
     } catch (const std::exception &e) {
         return core.diag.fail(GA_ERR_INTERNAL, "unexpected C++ exception: %s", e.what());
     } catch (...) {

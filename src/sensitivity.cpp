@@ -523,8 +523,12 @@ ga_status Solver::sensitivity_step(double h)
     const State &s = accepted_;
     if (sens.adjoint && !replaying_) {  // how the step began, for the record (adjoint.cpp)
         AdjointRecord &r = adjoint_;
+        if (r.steps >= r.capacity && r.interval > 0)
+            return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (%ld steps: interval "
+                             "= %ld times %ld checkpoints, ga_set_adjoint_checkpoints)",
+                             r.capacity, r.interval, r.capacity / r.interval);
         if (r.steps >= r.capacity)
-            return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (%ld steps: "
+            return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (max_steps = %ld: "
                              "ga_set_sensitivity_method)", r.capacity);
         r.pending_rho = 1.0;
         if (sens.step_done || (sens.start_given && !start_pending_)) {

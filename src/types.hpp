@@ -3,6 +3,8 @@
 
 #include <Eigen/Dense>
 #include <array>
+#include <cstddef>
+#include <vector>
 
 #include "galpha.h"
 
@@ -32,5 +34,12 @@ inline bool all_finite(const double *x, Eigen::Index size)
     return (a0 + a1) + (a2 + a3) == 0.0;
 }
 inline bool all_finite(const Vec &x) { return all_finite(x.data(), x.size()); }
+
+// Whether `count` blocks of `each` doubles fit in one std::vector<double>: sizes computed from
+// a caller's counts are checked before they are multiplied, so that they never wrap.
+inline bool fits_doubles(std::size_t count, std::size_t each)
+{
+    return each == 0 || count <= std::vector<double>().max_size() / each;
+}
 
 }  // namespace ga

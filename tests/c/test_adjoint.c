@@ -4,6 +4,7 @@
  * (the kinetic energy, a multiplier squared) against the forward sensitivities summed with the
  * same trapezoidal weights. Pendulum, slider-crank, sparse chain; index 3 and 2; fixed and
  * adaptive steps. Refusals and a full record. */
+#include <limits.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -256,6 +257,15 @@ static void refusals(void **state)
     assert_non_null(strstr(ga_last_error(s), "GA_SENSITIVITY_FORWARD"));
     assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 0), GA_ERR_ARG);
     assert_non_null(strstr(ga_last_error(s), "max_steps"));
+    /* records beyond memory: refused before (max_steps + 1) * stride is formed, which wrapped
+     * (LONG_MAX: ga_init crashed; 2^62: a record of 12 doubles that the steps wrote past) */
+    assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, LONG_MAX),
+                     GA_ERR_NOMEM);
+    assert_non_null(strstr(ga_last_error(s), "max_steps = 9223372036854775807"));
+    assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 1L << 62),
+                     GA_ERR_NOMEM);
+    assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 1L << 58),
+                     GA_ERR_NOMEM);
     assert_int_equal(ga_adjoint_gradient(s, NULL, terminal_linear, &J, dJ), GA_ERR_STATE);
     assert_non_null(strstr(ga_last_error(s), "without a recorded run"));
     assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 10), GA_OK);

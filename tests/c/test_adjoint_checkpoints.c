@@ -7,6 +7,7 @@
  * of 1, 7 and 64 steps; the run goes on after the sweep as if it had not happened (state,
  * dense output, events); a run longer than interval * count steps fails the step that does
  * not fit and changes nothing; refusals. */
+#include <limits.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -278,7 +279,8 @@ static void capacity_and_refusals(void **state)
     double q[2][2];
     assert_int_equal(ga_get_q(s, q[0]), GA_OK);
     assert_int_equal(ga_step(s, 1e-2), GA_ERR_NOMEM);
-    assert_non_null(strstr(ga_last_error(s), "adjoint record is full"));
+    assert_non_null(strstr(ga_last_error(s), "adjoint record is full (12 steps: interval = 4 "
+                                             "times 3 checkpoints, ga_set_adjoint_checkpoints)"));
     assert_int_equal(ga_get_q(s, q[1]), GA_OK);
     assert_memory_equal(q[0], q[1], sizeof q[0]);
     double dJ[1];
@@ -300,6 +302,15 @@ static void capacity_and_refusals(void **state)
     assert_int_equal(ga_set_adjoint_checkpoints(t, 4, 0), GA_ERR_ARG);
     assert_int_equal(ga_set_adjoint_checkpoints(t, 1L << 40, 1L << 40), GA_ERR_ARG);
     assert_non_null(strstr(ga_last_error(t), "overflows"));
+    /* sizes beyond memory, refused before anything is allocated or multiplied (the step log's
+     * 11 doubles per step of interval * count wrapped to a small vector) */
+    assert_int_equal(ga_set_adjoint_checkpoints(t, 1, 1676976733973595602L), GA_ERR_NOMEM);
+    assert_non_null(strstr(ga_last_error(t), "checkpoints of"));
+    assert_int_equal(ga_set_adjoint_checkpoints(t, LONG_MAX, 1), GA_ERR_NOMEM);
+    assert_non_null(strstr(ga_last_error(t), "adjoint segment of interval"));
+    assert_int_equal(ga_set_adjoint_checkpoints(t, 1L << 60, 2), GA_ERR_NOMEM);
+    assert_int_equal(ga_set_adjoint_checkpoints(t, 1L << 56, 100), GA_ERR_NOMEM);
+    assert_non_null(strstr(ga_last_error(t), "step log"));
     /* interval 0: the full record of max_steps again (10 steps) */
     assert_int_equal(ga_set_adjoint_checkpoints(t, 4, 1), GA_OK);
     assert_int_equal(ga_set_adjoint_checkpoints(t, 0, 0), GA_OK);

@@ -1,5 +1,6 @@
 // No C++ exception crosses the C ABI: a callback written in C++ that throws makes the call
-// fail with a status (GA_ERR_INTERNAL, or GA_ERR_NOMEM for std::bad_alloc), the message
+// fail with a status (GA_ERR_INTERNAL, or GA_ERR_NOMEM for std::bad_alloc and
+// std::length_error), the message
 // carries what(), the state is kept, and the solver stays usable.
 #include <cstdarg>
 #include <cstddef>
@@ -18,7 +19,9 @@ extern "C" {
 
 namespace {
 
-int throw_kind = 0;  // 0: none, 1: std::runtime_error, 2: int, 3: std::bad_alloc
+// 0: none, 1: std::runtime_error, 2: int, 3: std::bad_alloc, 4: std::length_error (what a
+// vector beyond max_size() throws: memory, not a bug)
+int throw_kind = 0;
 
 int throwing_force(double t, const double *q, const double *v, double *f, void *user)
 {
@@ -26,6 +29,7 @@ int throwing_force(double t, const double *q, const double *v, double *f, void *
     case 1: throw std::runtime_error("model exploded");
     case 2: throw 42;
     case 3: throw std::bad_alloc();
+    case 4: throw std::length_error("cannot create std::vector larger than max_size()");
     default: return pendulum_force(t, q, v, f, user);
     }
 }
@@ -51,9 +55,10 @@ void exceptions_become_statuses(void **)
     // q, v, qdd, lambda, a, a_prev (a failed step drops the kept matrix on purpose)
     const size_t state = 5 * 2 + 1;
 
-    const ga_status expected[] = {GA_ERR_INTERNAL, GA_ERR_INTERNAL, GA_ERR_NOMEM};
-    const char *message[] = {"model exploded", "unknown type", "out of memory"};
-    for (int k = 1; k <= 3; ++k) {
+    const ga_status expected[] = {GA_ERR_INTERNAL, GA_ERR_INTERNAL, GA_ERR_NOMEM, GA_ERR_NOMEM};
+    const char *message[] = {"model exploded", "unknown type", "out of memory",
+                             "out of memory: cannot create std::vector larger"};
+    for (int k = 1; k <= 4; ++k) {
         throw_kind = k;
         assert_int_equal(ga_step(s, 0.01), expected[k - 1]);
         assert_non_null(std::strstr(ga_last_error(s), message[k - 1]));
@@ -76,6 +81,7 @@ int throwing_hook(const ga_solver *, double, const double *, const double *, con
     case 1: throw std::runtime_error("hook exploded");
     case 2: throw 42;
     case 3: throw std::bad_alloc();
+    case 4: throw std::length_error("cannot create std::vector larger than max_size()");
     default: return 0;
     }
 }
