@@ -123,6 +123,11 @@ void Solver::get_state(double *buf) const
 
 ga_status Solver::set_state(const double *buf, std::size_t len, bool internal)
 {
+    return undoing_a_first_setup([&] { return restore_state(buf, len, internal); });
+}
+
+ga_status Solver::restore_state(const double *buf, std::size_t len, bool internal)
+{
     const bool layout2 = len >= 2 && buf[0] == kStateMagic && buf[1] == 2.0;
     const bool layout3 = len >= 2 && buf[0] == kStateMagic && buf[1] == 3.0;
     const Layout l = layout(n_, m_, layout3);

@@ -46,28 +46,32 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
     if (r() > 0 && !initialized_)  // (r is fixed once the solver is set up)
         return diag.fail(GA_ERR_STATE, "%d first-order states declared: the first start "
                          "needs their initial values (ga_init_y)", r());
-    if (auto st = setup())
+    return undoing_a_first_setup([&] {
+        if (auto st = setup())
+            return st;
+        trial_.y = accepted_.y;  // a restart keeps the first-order states it holds
+        const std::vector<unsigned char> active_before = active_;
+        const ga_status st = start(t0, q0, v0);
+        if (st)
+            restore_active(active_before);
         return st;
-    trial_.y = accepted_.y;  // a restart keeps the first-order states it holds
-    const std::vector<unsigned char> active_before = active_;
-    const ga_status st = start(t0, q0, v0);
-    if (st)
-        restore_active(active_before);
-    return st;
+    });
 }
 
 ga_status Solver::init_y(double t0, const double *q0, const double *v0, const double *y0)
 {
-    if (auto st = setup())
+    return undoing_a_first_setup([&] {
+        if (auto st = setup())
+            return st;
+        trial_.y = Eigen::Map<const Vec>(y0, r());
+        if (!all_finite(trial_.y))
+            return diag.fail(GA_ERR_ARG, "y0 contains NaN or Inf");
+        const std::vector<unsigned char> active_before = active_;
+        const ga_status st = start(t0, q0, v0);
+        if (st)
+            restore_active(active_before);
         return st;
-    trial_.y = Eigen::Map<const Vec>(y0, r());
-    if (!all_finite(trial_.y))
-        return diag.fail(GA_ERR_ARG, "y0 contains NaN or Inf");
-    const std::vector<unsigned char> active_before = active_;
-    const ga_status st = start(t0, q0, v0);
-    if (st)
-        restore_active(active_before);
-    return st;
+    });
 }
 
 // Puts back the constraints in use (in place: the linear algebra holds their address).

@@ -270,6 +270,17 @@ ga_status Solver::setup_workspace()
     return GA_OK;
 }
 
+void Solver::forget_setup()
+{
+    workspace_ready_ = false;
+    sparse_backend_ = false;
+    S_ = IterationMatrix{};
+    P_ = IterationMatrix{};
+    O_ = IterationMatrix{};
+    S2_.reset();
+    invalidate_jacobian();
+}
+
 // The stabilized index-2 system, dense or sparse like S_: set up with the workspace when that
 // formulation is chosen, or when it is chosen later (ga_set_formulation), never in a step.
 void Solver::setup_index2()

@@ -198,8 +198,28 @@ public:
     void get_state(double *buf) const;
     // internal: the adjoint sweep's own restores into a recorded run
     ga_status set_state(const double *buf, std::size_t len, bool internal = false);
+    ga_status restore_state(const double *buf, std::size_t len, bool internal);
 
 private:
+    // The first ga_init, ga_init_y or ga_set_state sets the solver up; when it fails (an
+    // exception included) it leaves it as before: not set up, so that what set-up fixes
+    // (patterns, first-order states, the linear solver, redundancy) can still be declared.
+    template <class Call>
+    ga_status undoing_a_first_setup(Call &&call)
+    {
+        struct Undo {
+            Solver &s;
+            bool was_set_up;
+            ~Undo()
+            {
+                if (!was_set_up && !s.initialized_)
+                    s.forget_setup();
+            }
+        } undo{*this, workspace_ready_};
+        return call();
+    }
+    void forget_setup();
+
     ga_status setup();  // chooses the backend and allocates everything; throws std::bad_alloc
     ga_status setup_workspace();  // the part every formulation and option needs
     void setup_projection();

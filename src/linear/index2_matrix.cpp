@@ -62,6 +62,13 @@ struct Index2Matrix::Sparse {};
 Index2Matrix::Index2Matrix() = default;
 Index2Matrix::~Index2Matrix() = default;
 
+void Index2Matrix::reset()
+{
+    dense_.reset();
+    sparse_.reset();
+    active_ = nullptr;
+}
+
 void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const ModelMatrix &M,
                          const ModelMatrix &J, const ModelMatrix &K, const ModelMatrix &C,
                          const unsigned char *active, bool amd_first)

@@ -49,6 +49,7 @@ public:
                const ModelMatrix &J, const ModelMatrix &K, const ModelMatrix &C,
                const unsigned char *active, bool amd_first = false);
     bool ready() const { return dense_ || sparse_; }
+    void reset();  // not set up, as constructed
     bool sparse() const { return sparse_ != nullptr; }
     // sparse, in the reduced (n + 2m) form (else the augmented one, or dense)
     bool sparse_reduced() const;

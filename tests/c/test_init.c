@@ -350,6 +350,96 @@ static void index2_velocity_constraint_with_exact_phi_t(void **state)
     assert_true(cons[0] - 4 * dt[0] - res[0] == cons[1] - res[1]);
 }
 
+/* A first start that fails -- a refused argument, a singular start, a refused checkpoint --
+ * leaves the solver as it was: not set up, so that what set-up fixes can still be declared
+ * (they were refused "after the solver was set up"), and the run that follows is that of a
+ * solver that never made the failed call, bit for bit. */
+static int zero_rate(double t, const double *q, const double *v, const double *y, double *ydot,
+                     void *user)
+{
+    (void)t, (void)q, (void)v, (void)user;
+    ydot[0] = -y[0];
+    return 0;
+}
+static int force_y(double t, const double *q, const double *v, const double *y, double *f,
+                   void *user)
+{
+    (void)y;
+    return pendulum_force(t, q, v, f, user);
+}
+static int massless(double t, const double *q, double *M, void *user)
+{
+    (void)t, (void)q, (void)user;
+    memset(M, 0, 4 * sizeof(double));
+    return 0;
+}
+static void failed_first_start_leaves_the_setup_open(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    double q[2], v[2], bad[2], y0 = 0.5, nan_y = NAN, end[2][2];
+    pendulum_state(&p, 0.6, 0.2, q, v);
+    bad[0] = NAN, bad[1] = q[1];
+    for (int run = 0; run < 2; ++run) {
+        ga_solver *s = make(&p, 0);
+        assert_int_equal(ga_set_first_order(s, 1, force_y, zero_rate), GA_OK);
+        if (run == 1) {
+            assert_int_equal(ga_init_y(s, 0.0, bad, v, &y0), GA_ERR_ARG);
+            assert_int_equal(ga_init_y(s, 0.0, q, v, &nan_y), GA_ERR_ARG);
+            assert_non_null(strstr(ga_last_error(s), "y0"));
+            /* a singular start */
+            assert_int_equal(ga_set_callbacks(s, massless, pendulum_force, pendulum_constraint,
+                                              pendulum_jacobian, &p),
+                             GA_OK);
+            assert_int_equal(ga_init_y(s, 0.0, q, v, &y0), GA_ERR_SINGULAR);
+            assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force,
+                                              pendulum_constraint, pendulum_jacobian, &p),
+                             GA_OK);
+            /* a checkpoint refused after set-up (pivots of a sparse LU that is not there) */
+            size_t len = 0;
+            assert_int_equal(ga_state_size(s, &len), GA_OK);
+            double ckpt[256] = {0};
+            assert_true(len <= 256);
+            {
+                ga_solver *other = make(&p, 0);
+                assert_int_equal(ga_set_first_order(other, 1, force_y, zero_rate), GA_OK);
+                assert_int_equal(ga_init_y(other, 0.0, q, v, &y0), GA_OK);
+                assert_int_equal(ga_get_state(other, ckpt, len), GA_OK);
+                ga_free(other);
+            }
+            /* the first pivot block (layout 4: after 21 + 7 n + m header and state entries,
+             * 4 n + m of the kept matrix, m flags): its "kept" flag neither 0 nor 1, found
+             * only once the solver is set up */
+            ckpt[21 + 7 * 2 + 1 + 4 * 2 + 1 + 1] = 0.5;
+            assert_int_equal(ga_set_state(s, ckpt, len), GA_ERR_ARG);
+            assert_non_null(strstr(ga_last_error(s), "pivots"));
+            /* what set-up fixes is open still */
+            assert_int_equal(ga_set_first_order(s, 1, force_y, zero_rate), GA_OK);
+            assert_int_equal(ga_set_redundant_constraints(s, GA_REDUNDANT_REFUSE), GA_OK);
+            assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_AUTO), GA_OK);
+            const int rows[1] = {0}, cols[1] = {0};
+            assert_int_equal(ga_set_coupling_pattern(s, GA_COUPLING_G_V, 0, rows, cols),
+                             GA_OK);
+            assert_int_equal(ga_set_coupling_pattern(s, GA_COUPLING_G_Q, 0, rows, cols),
+                             GA_OK);
+        } else {
+            const int rows[1] = {0}, cols[1] = {0};
+            assert_int_equal(ga_set_coupling_pattern(s, GA_COUPLING_G_V, 0, rows, cols),
+                             GA_OK);
+            assert_int_equal(ga_set_coupling_pattern(s, GA_COUPLING_G_Q, 0, rows, cols),
+                             GA_OK);
+        }
+        assert_int_equal(ga_init_y(s, 0.0, q, v, &y0), GA_OK);
+        for (int k = 0; k < 20; ++k)
+            assert_int_equal(ga_step(s, 1e-2), GA_OK);
+        assert_int_equal(ga_get_q(s, end[run]), GA_OK);
+        /* set up now: fixed */
+        assert_int_equal(ga_set_first_order(s, 1, force_y, zero_rate), GA_ERR_STATE);
+        ga_free(s);
+    }
+    assert_memory_equal(end[0], end[1], sizeof end[0]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -357,6 +447,7 @@ int main(void)
         cmocka_unit_test(inconsistent_positions_and_velocities_are_projected),
         cmocka_unit_test(consistent_values_are_kept),
         cmocka_unit_test(failed_init_keeps_previous_state),
+        cmocka_unit_test(failed_first_start_leaves_the_setup_open),
         cmocka_unit_test(unconstrained_diagonal_mass_needs_no_factorization),
         cmocka_unit_test(time_dependent_constraint_start),
         cmocka_unit_test(index2_velocity_constraint_with_exact_phi_t),

@@ -359,14 +359,10 @@ static void errors(void **state)
     /* the default refuses, naming the dependent constraint */
     assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_SINGULAR);
     assert_non_null(strstr(ga_last_error(s), "these depend on the ones before them: 1"));
-    assert_int_equal(ga_set_redundant_constraints(s, GA_REDUNDANT_DROP), GA_ERR_STATE);
-    ga_free(s);
-    assert_int_equal(ga_create(2, 2, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, pendulum_mass, pendulum_force, twice_constraint,
-                                      twice_jacobian, &P),
-                     GA_OK);
+    /* the refused first start left the solver not set up: the choice is still open */
     assert_int_equal(ga_set_redundant_constraints(s, GA_REDUNDANT_DROP), GA_OK);
     assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    assert_int_equal(ga_set_redundant_constraints(s, GA_REDUNDANT_DROP), GA_ERR_STATE);
     assert_int_equal(ga_get_active_constraints(s, NULL), GA_ERR_ARG);
     assert_int_equal(ga_get_active_constraints(NULL, active), GA_ERR_ARG);
     ga_free(s);
