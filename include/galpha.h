@@ -119,6 +119,11 @@ typedef enum ga_status {
     GA_ERR_INTERNAL = -10,      /**< unexpected internal error, including a C++ exception thrown
                                      by a user callback written in C++ */
     GA_ERR_STEP_SIZE = -11,     /**< adaptive mode: the step size fell below its minimum */
+    GA_ERR_UNRESOLVED = -12,    /**< the step is not resolved: in the index-3 formulation its
+                                     velocities violate the velocity constraint by more than
+                                     2 % of their size (recoverable: retry with a smaller h,
+                                     or take the stabilized index-2 formulation); see
+                                     ga_set_resolution_check */
     GA_EVENT = 1,               /**< not an error: ga_step, ga_step_adaptive or ga_advance stopped
                                      at a terminal event (or with its event log full); see
                                      ga_set_events */
@@ -459,6 +464,22 @@ typedef enum ga_formulation {
 /** formulation is a ::ga_formulation. Errors: GA_ERR_ARG, GA_ERR_STATE, GA_ERR_NOMEM (index-2
  *  chosen after the workspace was set up, and its system does not fit). */
 GA_API ga_status ga_set_formulation(ga_solver *s, int formulation);
+
+/** The index-3 step's check of its own resolution. Index 3 holds Phi(q) = 0 at every step and
+ *  the velocity constraint Phi_q v + Phi_t = 0 only to O(h^2). Where a step does not resolve
+ *  the motion -- fast rotation at more than about 0.1 rad per step at rho_inf = 0.9 (0.2 at
+ *  0.8, 0.3 at 0.7, 0.5 at 0.5; at rho_inf = 1 at every h), where the index-3 step map itself
+ *  is unstable and every Newton iteration converges -- the velocities turn away from the
+ *  constraints. After each index-3 step the largest |Phi_q v + Phi_t|_i, relative to row i's
+ *  gradient (1-norm) times the model's largest speed (max_j |v_j| + |q_j - q_n,j| / h), is
+ *  compared with `limit` (default 0.02; the shipped scenes stay below 0.007 where they
+ *  converge at order 2): above it the step fails with GA_ERR_UNRESOLVED and changes nothing
+ *  (adaptive steps retry smaller). It sees the unstable step map, not every inaccuracy:
+ *  steps too long for a motion can still end far off with GA_OK (docs/choosing-settings.md).
+ *  One Phi_t per step (ga_set_constraint_dt, or two constraint calls); the last step's value:
+ *  ga_get_info(GA_INFO_VELOCITY_RESIDUAL). limit = INFINITY turns the check off. Errors:
+ *  GA_ERR_ARG (limit not > 0, or NaN), GA_ERR_STATE (from a callback). */
+GA_API ga_status ga_set_resolution_check(ga_solver *s, double limit);
 
 /** Redundant constraints: Phi_q of rank r < m, so that only Phi_q^T lambda is unique and the
  *  saddle-point matrices are singular. */
@@ -1052,9 +1073,14 @@ typedef enum ga_info {
                                    test (<= 1 means converged by the relative test) */
     GA_INFO_ERROR_ESTIMATE = 3, /**< adaptive mode: weighted error norm of the last step
                                      attempted (<= 1: accepted) */
-    GA_INFO_H_NEXT = 4          /**< adaptive mode: step size the controller proposes next */
+    GA_INFO_H_NEXT = 4,         /**< adaptive mode: step size the controller proposes next */
+    GA_INFO_VELOCITY_RESIDUAL = 5 /**< index 3 with constraints: the last step's largest
+                                       |Phi_q v + Phi_t|_i relative to row i's gradient times
+                                       the model's largest speed (ga_set_resolution_check); above its
+                                       limit the step fails with GA_ERR_UNRESOLVED. 0 in
+                                       index 2 (which holds it) */
 } ga_info;
-#define GA_INFO_COUNT 5
+#define GA_INFO_COUNT 6
 
 /** Value of the diagnostic `key` (a ::ga_info); 0 before anything was computed.
  *  Errors: GA_ERR_ARG (NULL or unknown key), GA_ERR_STATE (from a callback). */

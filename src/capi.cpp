@@ -228,6 +228,7 @@ GA_API const char *ga_strerror(int status)
     case GA_ERR_INCONSISTENT: return "inconsistent initial values";
     case GA_ERR_INTERNAL: return "internal error";
     case GA_ERR_STEP_SIZE: return "step size below its minimum";
+    case GA_ERR_UNRESOLVED: return "step not resolved: h too large for the motion";
     case GA_EVENT: return "stopped at an event";
     case GA_STOPPED: return "stopped by the step hook";
     }
@@ -528,6 +529,17 @@ GA_API ga_status ga_set_formulation(ga_solver *s, int formulation)
             c.setup_index2();  // may throw std::bad_alloc: the formulation stays as it was
         c.formulation = static_cast<ga_formulation>(formulation);
         c.invalidate_jacobian();
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_resolution_check(ga_solver *s, double limit)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!(limit > 0.0))
+            return c.diag.fail(GA_ERR_ARG, "resolution check limit %g must be > 0 (INFINITY: "
+                               "no check)", limit);
+        c.max_velocity_residual = limit;
         return GA_OK;
     });
 }
@@ -1143,6 +1155,7 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value)
         case GA_INFO_NEWTON_RATIO: *value = c.last_newton_ratio(); return GA_OK;
         case GA_INFO_ERROR_ESTIMATE: *value = c.control.err_last; return GA_OK;
         case GA_INFO_H_NEXT: *value = c.control.h_next; return GA_OK;
+        case GA_INFO_VELOCITY_RESIDUAL: *value = c.last_velocity_residual(); return GA_OK;
         default: return c.diag.fail(GA_ERR_ARG, "ga_get_info: unknown key %d", key);
         }
     });

@@ -41,7 +41,7 @@ EstimateCoefficients estimate_coefficients(const Params &p, double h)
 bool recoverable(ga_status st)
 {
     return st == GA_ERR_NEWTON || st == GA_ERR_CALLBACK_RETRY || st == GA_ERR_NONFINITE ||
-           st == GA_ERR_SINGULAR;
+           st == GA_ERR_SINGULAR || st == GA_ERR_UNRESOLVED;
 }
 }  // namespace
 

@@ -1,5 +1,7 @@
 #include "matrix.hpp"
 
+#include <cmath>
+
 namespace ga {
 
 void ModelMatrix::set_dense(int rows, int cols)
@@ -61,6 +63,23 @@ void ModelMatrix::multiply_transpose_add(double alpha, const Vec &x, Vec &y) con
     const double *v = values_.data();
     for (std::size_t k = 0; k < row_.size(); ++k)
         y[col_[k]] += alpha * v[k] * x[row_[k]];
+}
+
+void ModelMatrix::multiply_add_row_abs_sums(const Vec &x, Vec &y, Vec &s) const
+{
+    const double *v = values_.data();
+    if (dense_) {  // column by column, as stored
+        for (int j = 0; j < cols_; ++j, v += rows_)
+            for (int i = 0; i < rows_; ++i) {
+                y[i] += v[i] * x[j];
+                s[i] += std::abs(v[i]);
+            }
+        return;
+    }
+    for (std::size_t k = 0; k < row_.size(); ++k) {
+        y[row_[k]] += v[k] * x[col_[k]];
+        s[row_[k]] += std::abs(v[k]);
+    }
 }
 
 }  // namespace ga

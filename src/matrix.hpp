@@ -35,6 +35,8 @@ public:
 
     void multiply_add(double alpha, const Vec &x, Vec &y) const;            // y += a A x
     void multiply_transpose_add(double alpha, const Vec &x, Vec &y) const;  // y += a A^T x
+    // y += A x and s_i += sum_j |A_ij|, in one pass
+    void multiply_add_row_abs_sums(const Vec &x, Vec &y, Vec &s) const;
 
     // Same layout (and pattern) as another matrix, for scratch copies.
     void copy_layout(const ModelMatrix &other);

@@ -488,7 +488,7 @@ ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, Mod
     return GA_OK;
 }
 
-ga_status Model::constraint_dt(double t, const Vec &q, Vec &out)
+ga_status Model::constraint_dt(double t, const Vec &q, Vec &out, bool coarse)
 {
     if (m_ == 0)
         return GA_OK;
@@ -504,7 +504,7 @@ ga_status Model::constraint_dt(double t, const Vec &q, Vec &out)
     // the error of Phi_t into Phi_q v (docs/design-notes.md). For constraints that do not
     // depend on t every difference is 0 exactly.
     const double d = kPhiTStep * std::max(std::fabs(t), 1.0);
-    for (int half = 0; half < 2; ++half) {
+    for (int half = 0; half < (coarse ? 1 : 2); ++half) {
         const double e = half ? 0.5 * d : d;
         if (auto st = constraint(t + e, q, phi_plus_))
             return st;

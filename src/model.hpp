@@ -155,8 +155,9 @@ public:
     // Phi_qq(v, v) + 2 Phi_qt v + Phi_tt.
     ga_status constraint_accel(double t, const Vec &q, const Vec &v, Vec &out);
     // Phi_t: the callback, or extrapolated central differences in t (exactly zero for
-    // time-independent constraints).
-    ga_status constraint_dt(double t, const Vec &q, Vec &out);
+    // time-independent constraints); coarse: one central difference (two calls instead of
+    // four: enough for a check).
+    ga_status constraint_dt(double t, const Vec &q, Vec &out, bool coarse = false);
     // The event functions of ga_set_events or ga_set_events_y: `count` values into g (lambda
     // may be null).
     // Inline: called after every step, where a run with events that never fire should cost

@@ -239,6 +239,9 @@ ga_status Solver::setup_workspace()
     qdd_tmp_.setZero(n_);
     guard_q_.setZero(n_);
     guard_v_.setZero(n_);
+    check_residual_.setZero(m_);
+    check_scale_.setZero(m_);
+    check_phi_t_.setZero(m_);
     lambda_tmp_.setZero(m_);
     eta_total_.setZero(m_);
     if (sens.active())
@@ -549,7 +552,7 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     x.c_count = 0;  // an adaptive step's error estimate computes them (error_norm)
     if (convergence_.rate() >= 0.0)
         theta_prev_ = convergence_.rate();
-    return GA_OK;
+    return check_velocity_constraint(h);
 }
 
 ga_status Solver::prepare_start(double h, bool restart_short)

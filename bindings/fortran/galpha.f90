@@ -21,7 +21,7 @@ module galpha
        GA_ERR_NOMEM = -3, GA_ERR_CALLBACK = -4, GA_ERR_CALLBACK_RETRY = -5, &
        GA_ERR_NONFINITE = -6, GA_ERR_SINGULAR = -7, GA_ERR_NEWTON = -8, &
        GA_ERR_INCONSISTENT = -9, GA_ERR_INTERNAL = -10, GA_ERR_STEP_SIZE = -11, &
-       GA_EVENT = 1, GA_STOPPED = 2
+       GA_ERR_UNRESOLVED = -12, GA_EVENT = 1, GA_STOPPED = 2
   ! ---- options ----------------------------------------------------------------------------
   integer(c_int), parameter, public :: GA_TANGENT_AUTO = 0, GA_TANGENT_FD = 1, &
        GA_TANGENT_NEGLECT = 2
@@ -51,7 +51,8 @@ module galpha
        GA_COUNT_CONSTRAINT_DT_EVALS = 13, GA_COUNT_EVENT_EVALS = 14, &
        GA_COUNT_RATE_EVALS = 15, GA_COUNT_COUPLING_EVALS = 16
   integer(c_int), parameter, public :: GA_INFO_RCOND = 0, GA_INFO_NEWTON_ITERS = 1, &
-       GA_INFO_NEWTON_RATIO = 2, GA_INFO_ERROR_ESTIMATE = 3, GA_INFO_H_NEXT = 4
+       GA_INFO_NEWTON_RATIO = 2, GA_INFO_ERROR_ESTIMATE = 3, GA_INFO_H_NEXT = 4, &
+       GA_INFO_VELOCITY_RESIDUAL = 5
 
   ! ---- callback interfaces ----------------------------------------------------------------
   abstract interface
@@ -382,6 +383,12 @@ module galpha
        type(c_ptr), value :: s
        integer(c_int), value :: formulation
      end function ga_set_formulation
+     integer(c_int) function ga_set_resolution_check(s, limit) &
+          bind(C, name="ga_set_resolution_check")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: limit
+     end function ga_set_resolution_check
      integer(c_int) function ga_set_redundant_constraints(s, mode) &
           bind(C, name="ga_set_redundant_constraints")
        import :: c_int, c_ptr
@@ -605,7 +612,8 @@ module galpha
        ga_state_size, ga_get_state, ga_set_state, ga_get_counter, ga_reset_counters, ga_get_info, &
        ga_set_jacobian_reuse, ga_set_constant_mass, ga_set_pattern, ga_set_pattern_csc, &
        ga_set_linear_solver, &
-       ga_linear_solver_name, ga_set_formulation, ga_set_redundant_constraints, &
+       ga_linear_solver_name, ga_set_formulation, ga_set_resolution_check, &
+       ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
        ga_interpolate, ga_interpolate_qdd, ga_set_output, ga_set_events, ga_get_event_count, &
@@ -639,6 +647,8 @@ module galpha
      procedure :: step => solver_step
      procedure :: set_tolerances => solver_set_tolerances
      procedure :: set_formulation => solver_set_formulation
+     !> set_resolution_check(limit): index 3's velocity-constraint limit (ga_set_resolution_check)
+     procedure :: set_resolution_check => solver_set_resolution_check
      !> set_pattern(which, rows, cols): the sparsity of GA_MATRIX_MASS, _JACOBIAN, _STIFFNESS or
      !> _DAMPING with Fortran (1-based) row and column numbers; the callback of that matrix then
      !> fills size(rows) values in this order (GA_ERR_ARG, without a message, if rows and cols
@@ -1157,6 +1167,12 @@ contains
     integer(c_int), intent(in) :: formulation
     status = ga_set_formulation(this%handle, formulation)
   end function solver_set_formulation
+
+  integer(c_int) function solver_set_resolution_check(this, limit) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: limit
+    status = ga_set_resolution_check(this%handle, limit)
+  end function solver_set_resolution_check
 
   integer(c_int) function solver_set_pattern(this, which, rows, cols) result(status)
     class(galpha_solver), intent(inout) :: this

@@ -414,7 +414,7 @@ static int snapshot(const model *md, ga_solver *s, double *x)
 static void check(ga_solver *s, ga_status st, int changes_solver, const char *call, int seq)
 {
     const int stepping = strcmp(call, "ga_step") == 0 || strcmp(call, "ga_step_adaptive") == 0;
-    if (st > (stepping ? GA_STOPPED : GA_OK) || st < GA_ERR_STEP_SIZE)
+    if (st > (stepping ? GA_STOPPED : GA_OK) || st < GA_ERR_UNRESOLVED)
         SEQ_FAIL("sequence %d: %s returned %d, not a ga_status", seq, call, st);
     if (st < GA_OK && changes_solver && ga_last_error(s)[0] == '\0')
         SEQ_FAIL("sequence %d: %s failed (%s) without a message", seq, call, ga_strerror(st));

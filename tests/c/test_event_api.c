@@ -403,6 +403,9 @@ static void root_at_a_step_end_found_once(void **state)
     sc.level[1] = 0.0;   /* zero at t0 */
     sc.level[2] = 0.75;
     ga_solver *s = released(&sc, M_PI / 2, 0.0, GA_INDEX3);
+    /* (steps of 1/8 do not resolve the swing, which the check sees; these events are
+     * functions of t alone) */
+    assert_int_equal(ga_set_resolution_check(s, INFINITY), GA_OK);
     const int terminal[3] = {0, 0, 0};
     assert_int_equal(ga_set_events(s, 3, levels, NULL, terminal, 0), GA_OK);
     const found f = run_fixed(s, 0.125, 1.0);

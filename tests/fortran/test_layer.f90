@@ -422,6 +422,8 @@ program test_layer
      call ok(r%create(2, 1), 'create for a constraint parameter')
      call ok(r%set_callbacks(plane_mass, plane_force, rail, rail_jacobian), 'callbacks')
      call ok(r%set_formulation(GA_INDEX2_STABILIZED), 'index 2')
+     call ok(r%set_resolution_check(0.02d0), 'set_resolution_check')
+     call expect(r%set_resolution_check(0.0d0) == GA_ERR_ARG, 'set_resolution_check(0) refused')
      call ok(r%set_sensitivity(stiffness, ior(GA_DEPENDS_FORCE, GA_DEPENDS_CONSTRAINT)), &
           'set_sensitivity (constraint)')
      if (i == 1) call ok(r%set_constraint_parameter_derivative(rail_p), &

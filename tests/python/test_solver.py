@@ -163,6 +163,35 @@ def test_status_maps_to_exception_classes():
     s.close()  # idempotent
 
 
+def test_unresolved_fast_rotation_raises_and_keeps_the_state():
+    """Index 3 at 0.2 rad per step (the pendulum spun at 20 rad/s, h = 0.01): the step map is
+    unstable there; the velocity check raises UnresolvedError (a RecoverableError) before the
+    energy is far off, with the state kept; with the check off the run is silently wrong."""
+    q0 = np.array([math.sin(1.0), -math.cos(1.0)])
+    v0 = 20.0 * np.array([math.cos(1.0), math.sin(1.0)])
+    energy = lambda q, v: 0.5 * v @ v + G * q[1]  # noqa: E731
+    e0 = energy(q0, v0)
+    with pendulum() as s:
+        s.init(0.0, q0, v0)
+        with pytest.raises(galpha.UnresolvedError, match="velocity constraint 0") as e:
+            for _ in range(100):
+                state = (s.t, s.q.copy(), s.v.copy(), s.qdd.copy())
+                s.step(0.01)
+        assert isinstance(e.value, galpha.RecoverableError)
+        assert s.t == state[0]
+        for now, before in zip((s.q, s.v, s.qdd), state[1:]):
+            assert np.array_equal(now, before)
+        assert abs(energy(s.q, s.v) / e0 - 1) < 0.1
+        assert s.info(galpha.GA_INFO_VELOCITY_RESIDUAL) > 0.02
+    with pendulum(resolution_check=math.inf) as s:
+        s.init(0.0, q0, v0)
+        for _ in range(100):
+            s.step(0.01)
+        assert abs(energy(s.q, s.v) / e0) > 100.0
+    with pytest.raises(galpha.ArgumentError, match="resolution check limit"):
+        pendulum(resolution_check=0.0)
+
+
 @pytest.mark.parametrize("zero_copy", [False, True])
 def test_inputs_are_read_only(zero_copy):
     def sneaky_mass(t, q, M):

@@ -15,6 +15,7 @@ from ._ffi import (GA_DEPENDS_CONSTRAINT, GA_DEPENDS_FORCE, GA_DEPENDS_MASS,  # 
                    GA_SENSITIVITY_FORWARD, GA_EVENT_BOTH, GA_EVENT_FALLING, GA_EVENT_RISING,  # noqa: F401
                    GA_INDEX2_STABILIZED, GA_INDEX3, GA_INFO_ERROR_ESTIMATE,  # noqa: F401
                    GA_INFO_H_NEXT, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_RCOND,
+                   GA_INFO_VELOCITY_RESIDUAL,
                    GA_INIT_PROJECT, GA_INIT_REFUSE, GA_LINEAR_AUTO, GA_LINEAR_DENSE,
                    GA_LINEAR_DENSE_EIGEN, GA_LINEAR_DENSE_LAPACK, GA_LINEAR_DENSE_UNBLOCKED,
                    GA_LINEAR_SPARSE,
@@ -27,7 +28,7 @@ from ._ffi import (GA_DEPENDS_CONSTRAINT, GA_DEPENDS_FORCE, GA_DEPENDS_MASS,  # 
 from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceError,  # noqa: F401
                      GalphaError, InconsistentError, InternalError, NonFiniteError,
                      OutOfMemoryError, RecoverableError, SingularMatrixError, StateError,
-                     StepSizeError)
+                     StepSizeError, UnresolvedError)
 from .integrate import IntegrateResult, OdeSolution, integrate  # noqa: F401
 from .solver import Sensitivity, Solver  # noqa: F401
 

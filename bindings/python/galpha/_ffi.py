@@ -127,6 +127,7 @@ GA_ERR_NEWTON = -8
 GA_ERR_INCONSISTENT = -9
 GA_ERR_INTERNAL = -10
 GA_ERR_STEP_SIZE = -11
+GA_ERR_UNRESOLVED = -12
 GA_EVENT = 1  # not an error: a stepping call stopped at an event
 GA_STOPPED = 2  # not an error: the step hook asked to stop
 
@@ -153,7 +154,7 @@ GA_EVENT_BOTH, GA_EVENT_RISING, GA_EVENT_FALLING = 0, 1, -1
 GA_EVENT_LOG = 64
 GA_COUPLING_G_Q, GA_COUPLING_G_V = 0, 1
 (GA_INFO_RCOND, GA_INFO_NEWTON_ITERS, GA_INFO_NEWTON_RATIO, GA_INFO_ERROR_ESTIMATE,
- GA_INFO_H_NEXT) = 0, 1, 2, 3, 4
+ GA_INFO_H_NEXT, GA_INFO_VELOCITY_RESIDUAL) = 0, 1, 2, 3, 4, 5
 COUNTERS = ("steps", "failed_steps", "newton_iters", "factorizations", "residuals",
             "mass_evals", "force_evals", "constraint_evals", "jacobian_evals",
             "stiffness_evals", "damping_evals", "accel_evals", "rejected_steps",
@@ -206,6 +207,7 @@ _SIGNATURES = {
     "ga_set_linear_solver": (_I, [_S, _I]),
     "ga_linear_solver_name": (ctypes.c_char_p, [_S]),
     "ga_set_formulation": (_I, [_S, _I]),
+    "ga_set_resolution_check": (_I, [_S, _D]),
     "ga_set_redundant_constraints": (_I, [_S, _I]),
     "ga_get_active_constraints": (_I, [_S, _P(_I)]),
     "ga_set_rescale": (_I, [_S, _I]),

@@ -67,9 +67,17 @@ class StepSizeError(GalphaError, RuntimeError):
     status = _ffi.GA_ERR_STEP_SIZE
 
 
+class UnresolvedError(RecoverableError):
+    """Index 3: the step's velocities violate the velocity constraint far beyond O(h^2) -- h is
+    too large for the motion (ga_set_resolution_check); retry smaller, or take the stabilized
+    index-2 formulation."""
+    status = _ffi.GA_ERR_UNRESOLVED
+
+
 _BY_STATUS = {cls.status: cls for cls in (
     ArgumentError, StateError, OutOfMemoryError, CallbackError, CallbackRetry, NonFiniteError,
-    SingularMatrixError, ConvergenceError, InconsistentError, InternalError, StepSizeError)}
+    SingularMatrixError, ConvergenceError, InconsistentError, InternalError, StepSizeError,
+    UnresolvedError)}
 
 
 def error_for(status, message):

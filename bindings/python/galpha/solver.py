@@ -187,7 +187,7 @@ class Solver:
         whose values then come column by column, as the `data` of such a matrix.
     rho_inf, params, newton, tangent_mode, scaling, predictor, init_mode, formulation, redundant,
     tolerances, reuse, constant_mass, linear_solver, rescale, corrected_start, step_limits,
-    initial_step, output
+    initial_step, output, resolution_check
         Options, as the C setters (ga_set_rho_inf, ga_set_params((alpha_m, alpha_f, beta,
         gamma)), ga_set_newton((tol, max_iter)), ga_set_tolerances((rtol, atol)),
         ga_set_step_limits((h_min, h_max)), ga_set_formulation(galpha.GA_INDEX2_STABILIZED),
@@ -245,7 +245,8 @@ class Solver:
                  params=None, newton=None, tangent_mode=None, scaling=None, predictor=None,
                  init_mode=None, formulation=None, redundant=None, tolerances=None, reuse=None,
                  constant_mass=None, linear_solver=None, rescale=None, corrected_start=None,
-                 step_limits=None, initial_step=None, output=None, patterns=None,
+                 step_limits=None, initial_step=None, output=None, resolution_check=None,
+                 patterns=None,
                  r=0, rate=None, force_y=None, coupling=None, coupling_exact=None,
                  coupling_patterns=None, parameters=None, depends=("force",),
                  parameter_scale=None, force_p=None, mass_p=None, constraint_p=None,
@@ -477,6 +478,8 @@ class Solver:
             self._check(_ffi.ga_set_step_limits(self._ptr, float(step_limits[0]), float(step_limits[1])))
         if initial_step is not None:
             self._check(_ffi.ga_set_initial_step(self._ptr, float(initial_step)))
+        if resolution_check is not None:
+            self._check(_ffi.ga_set_resolution_check(self._ptr, float(resolution_check)))
 
     def _set_sensitivity(self, parameters, depends, scale, force_p, mass_p, constraint_p):
         p = parameters
