@@ -6,6 +6,7 @@
 #ifndef GALPHA_TESTS_API_SEQUENCE_H
 #define GALPHA_TESTS_API_SEQUENCE_H
 
+#include <limits.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -23,7 +24,8 @@ enum { MAX_LINKS = 3, NMAX = 2 * MAX_LINKS, MMAX = MAX_LINKS + 1, MAX_OPS = 64,
 
 typedef enum fault_kind { NONE, RETURN_RETRY, RETURN_FATAL, WRITE_NAN, WRITE_INF, WRITE_HUGE,
                           REENTER, FAULT_KINDS } fault_kind;
-enum { MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS, ACCEL, DT, RATE, CALLBACKS };
+enum { MASS, FORCE, CONSTRAINT, JACOBIAN, STIFFNESS, ACCEL, DT, RATE, EVENT, COUPLING, FORCE_P,
+       MASS_P, CONSTRAINT_P, COST, CALLBACKS };
 
 typedef struct model {
     uint64_t rng;
@@ -55,6 +57,10 @@ typedef struct model {
      * the call at some t (a function of t alone, so that a restored run stops alike) */
     int hook_stops;
     long hook_calls, hook_wrong; /* calls; reads that disagreed or changes let through */
+    /* the step limits last accepted (ga_advance bounds its work with them, then puts them
+     * back) and whether the events are the functions of y (ga_set_events_y) */
+    double h_min, h_max;
+    int ev_y;
 } model;
 
 static uint64_t next(model *md)
@@ -255,12 +261,12 @@ static int time_derivative(double t, const double *q, double *phi_t, void *user)
     return misbehave(md, DT, phi_t, md->m);
 }
 
-/* The adjoint's cost: q_0 at the end. */
+/* The adjoint's costs: q_0 at the end (terminal), q_0^2 / 2 along the run (running). */
 static int adjoint_cost(double t, const double *q, const double *v, const double *qdd,
                         const double *lambda, double *value, double *d_q, double *d_v,
                         double *d_qdd, double *d_lambda, double *d_p, void *user)
 {
-    const model *md = user;
+    model *md = user;
     (void)t, (void)v, (void)qdd, (void)lambda;
     memset(d_q, 0, sizeof(double) * (size_t)md->n);
     memset(d_v, 0, sizeof(double) * (size_t)md->n);
@@ -270,7 +276,17 @@ static int adjoint_cost(double t, const double *q, const double *v, const double
     d_p[0] = d_p[1] = 0.0;
     d_q[0] = 1.0;
     *value = q[0];
-    return 0;
+    return misbehave(md, COST, d_q, md->n);
+}
+static int running_cost(double t, const double *q, const double *v, const double *qdd,
+                        const double *lambda, double *value, double *d_q, double *d_v,
+                        double *d_qdd, double *d_lambda, double *d_p, void *user)
+{
+    const int rc = adjoint_cost(t, q, v, qdd, lambda, value, d_q, d_v, d_qdd, d_lambda, d_p,
+                                user);
+    d_q[0] = q[0];
+    *value = 0.5 * q[0] * q[0];
+    return rc;
 }
 
 /* A pattern declaration: the model's own, or one ga_set_pattern must refuse. */
@@ -320,10 +336,61 @@ static int events(double t, const double *q, const double *v, const double *lamb
                   void *user)
 {
     (void)t, (void)v;
-    const model *md = user;
+    model *md = user;
     for (int k = 0; k < md->ev_count; ++k)
         g[k] = (k == 2 && lambda && md->m > 0 ? lambda[0] : q[k % md->n]) - md->ev_level[k];
-    return 0;
+    return md->ev_count ? misbehave(md, EVENT, g, md->ev_count) : 0;
+}
+/* ga_set_events_y's functions: the second sees y_0 */
+static int events_y(double t, const double *q, const double *v, const double *y,
+                    const double *lambda, double *g, void *user)
+{
+    const int rc = events(t, q, v, lambda, g, user);
+    const model *md = user;
+    if (md->ev_count > 1)
+        g[1] = y[0] - md->ev_level[1];
+    return rc;
+}
+/* The exact coupling of rate() and force_y(): g_v = e_0^T, g_y = -1, f_y = e_0 */
+static int coupling(double t, const double *q, const double *v, const double *y, double *g_q,
+                    double *g_v, double *g_y, double *f_y, void *user)
+{
+    model *md = user;
+    (void)t, (void)q, (void)v, (void)y;
+    memset(g_q, 0, sizeof(double) * (size_t)md->n);
+    memset(g_v, 0, sizeof(double) * (size_t)md->n);
+    memset(f_y, 0, sizeof(double) * (size_t)md->n);
+    g_v[0] = 1.0;
+    g_y[0] = -1.0;
+    f_y[0] = 1.0;
+    return misbehave(md, COUPLING, g_v, md->n);
+}
+/* df/dp: gravity enters every odd force as -p_0; p_1 nothing. M and Phi do not depend on p. */
+static int force_p(double t, const double *q, const double *v, int j, double *f_p, void *user)
+{
+    model *md = user;
+    (void)t, (void)q, (void)v;
+    for (int i = 0; i < md->n; ++i)
+        f_p[i] = j == 0 && i % 2 ? -1.0 : 0.0;
+    return misbehave(md, FORCE_P, f_p, md->n);
+}
+static int mass_p(double t, const double *q, int j, const double *a, double *out, void *user)
+{
+    model *md = user;
+    (void)t, (void)q, (void)j, (void)a;
+    memset(out, 0, sizeof(double) * (size_t)md->n);
+    return misbehave(md, MASS_P, out, md->n);
+}
+static int constraint_p(double t, const double *q, int j, double *phi_p, double *Phi_q_p,
+                        double *Phi_t_p, void *user)
+{
+    model *md = user;
+    (void)t, (void)q, (void)j;
+    memset(phi_p, 0, sizeof(double) * (size_t)md->m);
+    memset(Phi_q_p, 0, sizeof(double) * (size_t)(md->sparse_J ? md->j_nnz : md->m * md->n));
+    if (Phi_t_p)
+        memset(Phi_t_p, 0, sizeof(double) * (size_t)md->m);
+    return md->m ? misbehave(md, CONSTRAINT_P, phi_p, md->m) : 0;
 }
 
 /* The events of `md` set on s (again: the search starts afresh from the current state). */
@@ -346,6 +413,9 @@ static int step_hook(const ga_solver *s, double t, const double *q, const double
 
 static ga_status set_events(const model *md, ga_solver *s)
 {
+    if (md->ev_y)
+        return ga_set_events_y(s, md->ev_count, md->ev_count ? events_y : NULL, md->ev_dir,
+                               md->ev_term, md->ev_lambda);
     return ga_set_events(s, md->ev_count, md->ev_count ? events : NULL, md->ev_dir, md->ev_term,
                          md->ev_lambda);
 }
@@ -413,7 +483,8 @@ static int snapshot(const model *md, ga_solver *s, double *x)
 
 static void check(ga_solver *s, ga_status st, int changes_solver, const char *call, int seq)
 {
-    const int stepping = strcmp(call, "ga_step") == 0 || strcmp(call, "ga_step_adaptive") == 0;
+    const int stepping = strcmp(call, "ga_step") == 0 || strcmp(call, "ga_step_adaptive") == 0 ||
+                         strcmp(call, "ga_advance") == 0;
     if (st > (stepping ? GA_STOPPED : GA_OK) || st < GA_ERR_UNRESOLVED)
         SEQ_FAIL("sequence %d: %s returned %d, not a ga_status", seq, call, st);
     if (st < GA_OK && changes_solver && ga_last_error(s)[0] == '\0')
@@ -440,7 +511,7 @@ static void check_transaction(const model *md, ga_solver *s, ga_status st,
 
 typedef struct seq_stats {
     long long calls, steps_ok, sparse_ok, twin_steps_ok, events, sensitivity_steps_ok,
-        adjoint_ok, hook_calls, hook_stops;
+        adjoint_ok, hook_calls, hook_stops, advance_ok;
 } seq_stats;
 
 /* The restart twin: a few steps from a checkpoint, then the checkpoint restored in the same
@@ -561,7 +632,11 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         md.sens = 1;
         md.sens_forward = methods & GA_SENSITIVITY_FORWARD;
         md.sens_adjoint = (methods & GA_SENSITIVITY_ADJOINT) != 0;
-        SEQ_REQUIRE(ga_set_sensitivity(s, 2, md.p, NULL, GA_DEPENDS_FORCE) == GA_OK);
+        /* what the parameters enter: the force always; M and Phi (which do not depend on
+         * them: derivatives by differences or by mass_p and constraint_p, zero) sometimes */
+        const int depends = GA_DEPENDS_FORCE | (pick(&md, 3) == 0 ? GA_DEPENDS_MASS : 0) |
+                            (pick(&md, 3) == 0 ? GA_DEPENDS_CONSTRAINT : 0);
+        SEQ_REQUIRE(ga_set_sensitivity(s, 2, md.p, NULL, depends) == GA_OK);
         SEQ_REQUIRE(ga_set_sensitivity_method(s, methods, 1 + pick(&md, 40)) == GA_OK);
     }
     const int ops = data ? MAX_OPS : 5 + pick(&md, MAX_OPS - 5);
@@ -574,9 +649,9 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         }
         double before[STATE_MAX];
         ga_status st = GA_OK;
-        int changes = 1;
+        int changes = 1, restore_limits = 0;
         const char *call = "";
-        switch (pick(&md, 40)) {
+        switch (pick(&md, 48)) {
         case 0: call = "ga_set_rho_inf"; st = ga_set_rho_inf(s, edge_value(&md)); break;
         case 1: {
             const double am = edge_value(&md), af = edge_value(&md), b = edge_value(&md);
@@ -603,9 +678,11 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             break;
         }
         case 15: {
-            const double h_min = pick(&md, 2) ? 0.0 : edge_value(&md);
+            const double h_min = pick(&md, 2) ? 0.0 : edge_value(&md), h_max = edge_value(&md);
             call = "ga_set_step_limits";
-            st = ga_set_step_limits(s, h_min, edge_value(&md));
+            st = ga_set_step_limits(s, h_min, h_max);
+            if (st == GA_OK)
+                md.h_min = h_min, md.h_max = h_max;
             break;
         }
         case 16: call = "ga_set_initial_step"; st = ga_set_initial_step(s, edge_value(&md)); break;
@@ -782,11 +859,131 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             }
             break;
         }
+        case 40: {  /* ga_advance over a short interval, its work bounded by h_min */
+            double t = 0.0, after = 0.0;
+            const int len = snapshot(&md, s, before);
+            ga_get_t(s, &t);
+            const double span = step_size(&md);
+            const double t_out = t + span;
+            int limited = 0;
+            if (span > 0.0 && isfinite(t_out))
+                limited = ga_set_step_limits(s, fmax(md.h_min, span / 256.0),
+                                             md.h_max >= span / 256.0 ? md.h_max : 0.0) == GA_OK;
+            call = "ga_advance";
+            st = ga_advance(s, t_out);
+            check_event_log(&md, s, st, seq);
+            stats->steps_ok += st >= GA_OK;
+            stats->advance_ok += st == GA_OK;
+            /* steps accepted before a failure stay: t between where it was and t_out */
+            if (len && ga_get_t(s, &after) == GA_OK && !(after >= t && after <= fmax(t, t_out)))
+                SEQ_FAIL("sequence %d: ga_advance to %.17g from %.17g ended at %.17g", seq,
+                         t_out, t, after);
+            restore_limits = limited;  /* after the checks of the call's status and message */
+            break;
+        }
+        case 41: {  /* events that see y, or the plain ones again */
+            const model kept = md;
+            md.ev_y = md.r && pick(&md, 2);
+            md.ev_count = pick(&md, 4);
+            for (int k = 0; k < 3; ++k) {
+                md.ev_dir[k] = pick(&md, 3) - 1;
+                md.ev_term[k] = pick(&md, 2);
+                md.ev_level[k] = 0.3 + 0.02 * (uniform(&md) - 0.5);
+            }
+            call = md.ev_y ? "ga_set_events_y" : "ga_set_events";
+            st = set_events(&md, s);
+            if (st != GA_OK)
+                md = kept;
+            break;
+        }
+        case 42:
+            call = "ga_set_coupling";
+            st = ga_set_coupling(s, pick(&md, 2) ? coupling : NULL);
+            break;
+        case 43: {  /* the sensitivities' starts and derivative callbacks */
+            double dq0[NMAX], dv0[NMAX];
+            for (int i = 0; i < md.n; ++i)
+                dq0[i] = pick(&md, 8) ? 0.1 * uniform(&md) : edge_value(&md),
+                dv0[i] = pick(&md, 8) ? 0.1 * uniform(&md) : edge_value(&md);
+            switch (pick(&md, 3)) {
+            case 0:
+                call = "ga_set_sensitivity_start";
+                st = ga_set_sensitivity_start(s, pick(&md, 4) - 1, pick(&md, 4) ? dq0 : NULL,
+                                              pick(&md, 4) ? dv0 : NULL);
+                break;
+            case 1:
+                call = "ga_set_parameter_derivatives";
+                st = ga_set_parameter_derivatives(s, pick(&md, 2) ? force_p : NULL,
+                                                  pick(&md, 2) ? mass_p : NULL);
+                break;
+            default:
+                call = "ga_set_constraint_parameter_derivative";
+                st = ga_set_constraint_parameter_derivative(s, pick(&md, 2) ? constraint_p : NULL);
+            }
+            break;
+        }
+        case 44: {  /* adjoint checkpointing (before ga_init; some refused, none allocating
+                     * beyond memory: the fuzzer's malloc limit would take that for a defect) */
+            static const long intervals[] = {0, 1, 3, 7, -1, 1L << 40};
+            const int k = pick(&md, 6);
+            const long interval = intervals[k];
+            const long count = k == 5 ? LONG_MAX / 2 : pick(&md, 12) - 1;
+            call = "ga_set_adjoint_checkpoints";
+            st = ga_set_adjoint_checkpoints(s, interval, count);
+            break;
+        }
+        case 45: {  /* the adjoint with a running cost, a terminal one or both */
+            const int len = snapshot(&md, s, before);
+            double after[STATE_MAX], J, dJ[2];
+            const int which = 1 + pick(&md, 3);
+            call = "ga_adjoint_gradient";
+            st = ga_adjoint_gradient(s, which & 1 ? running_cost : NULL,
+                                     which & 2 ? adjoint_cost : NULL, &J, dJ);
+            stats->adjoint_ok += st == GA_OK;
+            if (len && (snapshot(&md, s, after) != len ||
+                        memcmp(before, after, sizeof(double) * (size_t)len) != 0))
+                SEQ_FAIL("sequence %d: ga_adjoint_gradient changed the state (%s)", seq,
+                         ga_strerror(st));
+            if (st == GA_OK && !(isfinite(J) && isfinite(dJ[0]) && isfinite(dJ[1])))
+                SEQ_FAIL("sequence %d: ga_adjoint_gradient returned GA_OK with J = %g, dJ = "
+                         "(%g, %g)", seq, J, dJ[0], dJ[1]);
+            break;
+        }
+        case 46: {  /* reads added since the first harness */
+            double t = 0.0, x[NMAX], y[1], yd[1], am, af, b, g;
+            int n = 0, m = 0;
+            ga_get_t(s, &t);
+            changes = 0;
+            switch (pick(&md, 4)) {
+            case 0:
+                call = "ga_interpolate_qdd";
+                st = ga_interpolate_qdd(s, t - 1e-4 * uniform(&md), x);
+                break;
+            case 1:
+                call = "ga_get_sensitivity_y";
+                st = ga_get_sensitivity_y(s, pick(&md, 3) - 1, y, yd);
+                break;
+            case 2:
+                call = "ga_get_params";
+                st = ga_get_params(s, &am, &af, &b, &g);
+                break;
+            default:
+                call = "ga_get_size";
+                st = ga_get_size(s, &n, &m);
+                if (st == GA_OK && (n != md.n || m != md.m))
+                    SEQ_FAIL("sequence %d: ga_get_size said %d, %d", seq, n, m);
+            }
+            break;
+        }
+        case 47:
+            call = "ga_set_resolution_check";
+            st = ga_set_resolution_check(s, pick(&md, 3) ? edge_value(&md) : INFINITY);
+            break;
         case 30: {
             double value;
             call = "ga_get_info";
             changes = 0;
-            st = ga_get_info(s, pick(&md, 7) - 1, &value);
+            st = ga_get_info(s, pick(&md, GA_INFO_COUNT + 2) - 1, &value);
             break;
         }
         default: {
@@ -829,6 +1026,8 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         }
         }
         check(s, st, changes, call, seq);
+        if (restore_limits)
+            SEQ_REQUIRE(ga_set_step_limits(s, md.h_min, md.h_max) == GA_OK);
 #ifdef SEQ_TRACE
         {
             double t_now = NAN, h_now = NAN;
