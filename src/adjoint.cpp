@@ -610,21 +610,31 @@ ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, doub
     const EventSet events = events_;
     const long state_id = state_id_, output_for = output_for_, base = r.base;
     const std::vector<double> segment = r.data;
+    const auto restore = [&] {
+        replaying_ = false;
+        const ga_status back = set_state(here.data(), here.size(), true);
+        previous_ = previous;
+        previous_valid_ = previous_valid;
+        start_pending_ = start_pending;
+        events_ = events;
+        model.y_now = &accepted_.y;
+        state_id_ = state_id;
+        output_for_ = output_for;
+        r.data = segment;
+        r.base = base;
+        return back;
+    };
     replaying_ = true;
-    const ga_status st = adjoint_sweep(running, terminal, J, dJ);
-    replaying_ = false;
+    ga_status st = GA_OK;
+    try {
+        st = adjoint_sweep(running, terminal, J, dJ);
+    } catch (...) {  // out of memory in a recomputed segment: the run is restored all the same
+        restore();
+        throw;
+    }
     char message[Diagnostics::kSize];
     diag.copy_to(message);
-    const ga_status back = set_state(here.data(), here.size(), true);
-    previous_ = previous;
-    previous_valid_ = previous_valid;
-    start_pending_ = start_pending;
-    events_ = events;
-    model.y_now = &accepted_.y;
-    state_id_ = state_id;
-    output_for_ = output_for;
-    r.data = segment;
-    r.base = base;
+    const ga_status back = restore();
     if (st) {
         diag.restore(message);
         return st;

@@ -16,11 +16,14 @@ void ModelMatrix::set_dense(int rows, int cols)
 
 void ModelMatrix::set_pattern(int rows, int cols, const int *row, const int *col, int nnz)
 {
+    // copied first: running out of memory leaves the matrix as it was (it was left declared
+    // sparse with a part of its pattern, or none)
+    std::vector<int> r(row, row + nnz), c(col, col + nnz);
     rows_ = rows;
     cols_ = cols;
     dense_ = false;
-    row_.assign(row, row + nnz);
-    col_.assign(col, col + nnz);
+    row_.swap(r);
+    col_.swap(c);
     diagonal_ = rows == cols && row_ == col_;
 }
 

@@ -111,6 +111,7 @@ void KluSystem::setup(int N, std::vector<std::pair<int, int>> entries, Ordering 
                       const KluSystem *like)
 {
     N_ = N;
+    seen_.assign(static_cast<std::size_t>(N), 0);
     // Compressed columns by counting (a sort of all entries was half of ga_init on a long
     // chain); then each column's rows sorted and without duplicates.
     colptr_.assign(N + 1, 0);
@@ -229,7 +230,8 @@ bool KluSystem::pivots_loadable(const double *in) const
         return false;
     if (in[0] == 0.0 || in[1] != N_)
         return true;  // loads as "pivots afresh"
-    std::vector<char> seen(N_, 0);
+    std::vector<char> &seen = seen_;  // (restores must not run out of memory half way)
+    std::fill(seen.begin(), seen.end(), 0);
     for (int k = 0; k < N_; ++k) {
         const double r = in[4 + k], d = in[4 + N_ + k];
         if (!(d > 0.0) || !std::isfinite(d))

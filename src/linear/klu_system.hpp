@@ -89,6 +89,7 @@ private:
     std::vector<int> reverse_cuthill_mckee(const std::vector<std::vector<int>> &adj) const;
 
     int N_ = 0;
+    mutable std::vector<char> seen_;  // pivots_loadable's marks, sized at setup: no allocation
     std::vector<int> colptr_, rowind_;
     std::vector<double> values_;
     std::vector<double> row_scale_;  // D: 1 / the largest entry of each row at the last full

@@ -1,9 +1,13 @@
 /* Every allocation of a call that allocates, failed in turn (issue 17): the call returns
  * GA_ERR_NOMEM with a message, and retried without the failure it works, and the run that
- * follows is bit for bit that of a solver that never met the failure. Calls swept: ga_init,
- * ga_set_state, and the options that allocate after ga_init (ga_set_formulation to index 2,
- * ga_set_tangent_mode to finite differences, ga_set_output) and ga_set_events (replacing
- * an earlier set) -- on the sparse path with
+ * follows is bit for bit that of a solver that never met the failure; an option that failed
+ * and is not retried leaves the run bit for bit that of a solver that never made the call; a
+ * start instead of a failed restore runs as one that never met it. Calls swept: ga_init,
+ * ga_set_state (also on a new solver with events on y, a first-order state, sensitivities and a
+ * step hook), ga_adjoint_gradient with checkpoints (its segments computed again), and the
+ * options that allocate after ga_init (ga_set_formulation to index 2, ga_set_tangent_mode to
+ * finite differences, ga_set_output), ga_set_events and ga_set_events_y (replacing an earlier
+ * set), ga_set_coupling_pattern -- on the sparse path with
  * finite-difference tangents grouped by pattern. malloc and friends are
  * interposed here (not under the sanitizers, whose allocator cannot be made to fail so; nor
  * under valgrind, which replaces them). */
@@ -144,7 +148,8 @@ static ga_solver *make_redundant(void)
 typedef enum call {
     INIT, INIT_INDEX2, INIT_REDUNDANT, SET_STATE, FORMULATION, TANGENT_MODE, OUTPUT, EVENTS,
     SET_FIRST_ORDER, INIT_Y, SET_SENSITIVITY, SENSITIVITY_METHOD, SENSITIVITY_START,
-    INIT_SENSITIVITY, ADJOINT_CHECKPOINTS, STEP_HOOK
+    INIT_SENSITIVITY, ADJOINT_CHECKPOINTS, STEP_HOOK, ADJOINT_GRADIENT, EVENTS_Y,
+    COUPLING_PATTERN, SET_STATE_EVERYTHING
 } call;
 static const char *const kNames[] = {"ga_init", "ga_init (index 2)",
                                      "ga_init (a redundant constraint)", "ga_set_state",
@@ -153,7 +158,11 @@ static const char *const kNames[] = {"ga_init", "ga_init (index 2)",
                                      "ga_init_y", "ga_set_sensitivity",
                                      "ga_set_sensitivity_method", "ga_set_sensitivity_start",
                                      "ga_init (sensitivities)", "ga_set_adjoint_checkpoints",
-                                     "ga_set_step_hook"};
+                                     "ga_set_step_hook",
+                                     "ga_adjoint_gradient (checkpoints)", "ga_set_events_y",
+                                     "ga_set_coupling_pattern",
+                                     "ga_set_state (events, y, sensitivities, hook; new "
+                                     "solver)"};
 
 /* event functions that never fire */
 static int far_away(double t, const double *q, const double *v, const double *lambda,
@@ -173,12 +182,54 @@ static int quiet_hook(const ga_solver *s, double t, const double *q, const doubl
     return 0;
 }
 
+/* the same, seeing y */
+static int far_away_y(double t, const double *q, const double *v, const double *y,
+                      const double *lambda, double *g, void *user)
+{
+    (void)y;
+    return far_away(t, q, v, lambda, g, user);
+}
+
+/* The adjoint's cost: the x of link 0's centre at the end; its value and gradient of the
+ * call under test, which the retried and the undisturbed call must give alike. */
+static double g_J, g_dJ[3];
+static int terminal_x(double t, const double *q, const double *v, const double *qdd,
+                      const double *lambda, double *value, double *d_q, double *d_v,
+                      double *d_qdd, double *d_lambda, double *d_p, void *user)
+{
+    (void)t, (void)v, (void)qdd, (void)lambda, (void)user;
+    memset(d_q, 0, sizeof(double) * N);
+    memset(d_v, 0, sizeof(double) * N);
+    memset(d_qdd, 0, sizeof(double) * N);
+    memset(d_lambda, 0, sizeof(double) * M);
+    memset(d_p, 0, sizeof(double) * 3);
+    d_q[0] = 1.0;
+    *value = q[0];
+    return 0;
+}
+
+/* Events, a first-order state, sensitivities and a step hook, before any start. */
+static void everything(ga_solver *s)
+{
+    assert_int_equal(ga_set_first_order(s, 1, chain_force_y, chain_rate), GA_OK);
+    assert_int_equal(ga_set_events_y(s, 2, far_away_y, NULL, NULL, 1), GA_OK);
+    assert_int_equal(ga_set_sensitivity(s, 3, &g_chain.mass, NULL,
+                                        GA_DEPENDS_FORCE | GA_DEPENDS_MASS),
+                     GA_OK);
+    assert_int_equal(ga_set_step_hook(s, quiet_hook, NULL, 1), GA_OK);
+}
+
 /* The call under test on a solver prepared for it. */
 static ga_status do_call(ga_solver *s, call c, const double *checkpoint, size_t len)
 {
     double q[N], v[N];
+    static const int rows[1] = {0}, cols[1] = {0};
     chain_initial(&g_chain, q, v);
     switch (c) {
+    case ADJOINT_GRADIENT: return ga_adjoint_gradient(s, NULL, terminal_x, &g_J, g_dJ);
+    case EVENTS_Y: return ga_set_events_y(s, 2, far_away_y, NULL, NULL, 1);
+    case COUPLING_PATTERN: return ga_set_coupling_pattern(s, GA_COUPLING_G_V, 1, rows, cols);
+    case SET_STATE_EVERYTHING: return ga_set_state(s, checkpoint, len);
     case INIT:
     case INIT_INDEX2:
     case INIT_REDUNDANT: return ga_init(s, 0.0, q, v);
@@ -215,23 +266,46 @@ static ga_solver *prepare(call c)
         assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
     if (c == EVENTS)
         assert_int_equal(ga_set_events(s, 1, far_away, NULL, NULL, 0), GA_OK);
-    if (c == INIT_Y)
+    if (c == INIT_Y || c == EVENTS_Y || c == COUPLING_PATTERN)
         assert_int_equal(ga_set_first_order(s, 1, chain_force_y, chain_rate), GA_OK);
+    if (c == EVENTS_Y)  /* (replaced by the call) */
+        assert_int_equal(ga_set_events_y(s, 1, far_away_y, NULL, NULL, 0), GA_OK);
+    if (c == SET_STATE_EVERYTHING)
+        everything(s);
     const int sensitivities = c == SENSITIVITY_METHOD || c == SENSITIVITY_START ||
-                              c == INIT_SENSITIVITY || c == ADJOINT_CHECKPOINTS;
+                              c == INIT_SENSITIVITY || c == ADJOINT_CHECKPOINTS ||
+                              c == ADJOINT_GRADIENT;
     if (sensitivities)
         assert_int_equal(ga_set_sensitivity(s, 3, &g_chain.mass, NULL,
                                             GA_DEPENDS_FORCE | GA_DEPENDS_MASS),
                          GA_OK);
     if (c == ADJOINT_CHECKPOINTS)
         assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 10), GA_OK);
-    g_start_before_steps = c == SET_FIRST_ORDER ? 1 : sensitivities || c == SET_SENSITIVITY ? 2 : 0;
-    if (c == INIT_SENSITIVITY)
+    if (c == ADJOINT_GRADIENT) {  /* a recorded run of 7 steps in segments of 2 */
+        assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 10), GA_OK);
+        assert_int_equal(ga_set_adjoint_checkpoints(s, 2, 10), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        for (int i = 0; i < 7; ++i)
+            assert_int_equal(ga_step(s, 1e-3), GA_OK);
+    }
+    g_start_before_steps = c == SET_FIRST_ORDER || c == EVENTS_Y || c == COUPLING_PATTERN
+                               ? 1
+                           : sensitivities || c == SET_SENSITIVITY ? 2 : 0;
+    if (c == INIT_SENSITIVITY || c == ADJOINT_GRADIENT)
         g_start_before_steps = 0;
     if (c != INIT && c != INIT_INDEX2 && c != INIT_REDUNDANT && c != SET_STATE &&
-        c != SET_FIRST_ORDER && c != INIT_Y && !g_start_before_steps && c != INIT_SENSITIVITY)
+        c != SET_FIRST_ORDER && c != INIT_Y && !g_start_before_steps && c != INIT_SENSITIVITY &&
+        c != ADJOINT_GRADIENT && c != SET_STATE_EVERYTHING)
         assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
     return s;
+}
+
+/* Options: a failed one not retried must leave the run as if it had not been made. */
+static int optional(call c)
+{
+    return c == FORMULATION || c == TANGENT_MODE || c == OUTPUT || c == EVENTS ||
+           c == EVENTS_Y || c == COUPLING_PATTERN || c == SENSITIVITY_START ||
+           c == ADJOINT_CHECKPOINTS || c == STEP_HOOK || c == SENSITIVITY_METHOD;
 }
 
 static void sweep(call c)
@@ -243,17 +317,31 @@ static void sweep(call c)
         ga_solver *s = make();
         double q[N], v[N];
         chain_initial(&g_chain, q, v);
-        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        if (c == SET_STATE_EVERYTHING) {
+            everything(s);
+            assert_int_equal(ga_init_y(s, 0.0, q, v, kY0), GA_OK);
+        } else {
+            assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        }
         assert_int_equal(ga_state_size(s, &len), GA_OK);
         assert_true(len <= 1024);
         assert_int_equal(ga_get_state(s, checkpoint, len), GA_OK);
         ga_free(s);
     }
+    /* the run of a solver that never made the call (options only) */
+    double q_without[N];
+    if (optional(c)) {
+        ga_solver *s = prepare(c);
+        steps(s, q_without);
+        ga_free(s);
+    }
     /* the run of a solver that never met a failure */
-    double q_ref[N], q[N];
+    double q_ref[N], q[N], J_ref = 0.0, dJ_ref[3] = {0};
     {
         ga_solver *s = prepare(c);
         assert_int_equal(do_call(s, c, checkpoint, len), GA_OK);
+        J_ref = g_J;
+        memcpy(dJ_ref, g_dJ, sizeof dJ_ref);
         steps(s, q_ref);
         ga_free(s);
     }
@@ -287,6 +375,34 @@ static void sweep(call c)
                 fail_msg("%s, allocation %ld failed: status %d (%s)", kNames[c], k, st,
                          ga_last_error(s));
             assert_true(ga_last_error(s)[0] != '\0');
+            if (optional(c)) {  /* not retried: as if the call had not been made */
+                double q_on[N];
+                steps(s, q_on);
+                if (memcmp(q_on, q_without, sizeof q_on) != 0)
+                    fail_msg("%s, allocation %ld failed: the run differs from one that never "
+                             "made the call", kNames[c], k);
+                ga_free(s);
+                s = prepare(c);  /* the same failure again, to retry it */
+                count = 0;
+                fail_at = k;
+                assert_int_equal(do_call(s, c, checkpoint, len), GA_ERR_NOMEM);
+                fail_at = 0;
+            }
+            if (c == SET_STATE_EVERYTHING) {  /* a start instead of the restore */
+                ga_solver *r = prepare(c);
+                double q0[N], v0[N], q_start[N];
+                chain_initial(&g_chain, q0, v0);
+                count = 0;
+                fail_at = k;
+                assert_int_equal(do_call(r, c, checkpoint, len), GA_ERR_NOMEM);
+                fail_at = 0;
+                assert_int_equal(ga_init_y(r, 0.0, q0, v0, kY0), GA_OK);
+                steps(r, q_start);
+                if (memcmp(q_start, q_ref, sizeof q_start) != 0)
+                    fail_msg("%s, allocation %ld failed: the start after it differs", kNames[c],
+                             k);
+                ga_free(r);
+            }
             const ga_status retry = do_call(s, c, checkpoint, len);
             if (retry != GA_OK)
                 fail_msg("%s, retry after allocation %ld failed: %s", kNames[c], k,
@@ -296,6 +412,8 @@ static void sweep(call c)
         if (memcmp(q, q_ref, sizeof q) != 0)
             fail_msg("%s, allocation %ld failed: the run differs from one without the failure",
                      kNames[c], k);
+        if (c == ADJOINT_GRADIENT && (g_J != J_ref || memcmp(g_dJ, dJ_ref, sizeof g_dJ) != 0))
+            fail_msg("%s, allocation %ld failed: the retried gradient differs", kNames[c], k);
         ga_free(s);
     }
     const off_t printed = lseek(out, 0, SEEK_END);
@@ -305,7 +423,7 @@ static void sweep(call c)
            "printed\n", kNames[c], k - 1, failed, (long)printed);
     assert_int_equal(printed, 0);
 #else
-    (void)c, (void)prepare, (void)do_call, (void)kNames, (void)steps;
+    (void)c, (void)prepare, (void)do_call, (void)kNames, (void)steps, (void)optional;
     printf("  allocation failures cannot be injected under the sanitizers: skipped\n");
 #endif
 }
@@ -326,6 +444,10 @@ static void sensitivity_start_sweep(void **state) { (void)state; sweep(SENSITIVI
 static void init_sensitivity_sweep(void **state) { (void)state; sweep(INIT_SENSITIVITY); }
 static void adjoint_checkpoints_sweep(void **state) { (void)state; sweep(ADJOINT_CHECKPOINTS); }
 static void step_hook_sweep(void **state) { (void)state; sweep(STEP_HOOK); }
+static void adjoint_gradient_sweep(void **state) { (void)state; sweep(ADJOINT_GRADIENT); }
+static void events_y_sweep(void **state) { (void)state; sweep(EVENTS_Y); }
+static void coupling_pattern_sweep(void **state) { (void)state; sweep(COUPLING_PATTERN); }
+static void set_state_everything_sweep(void **state) { (void)state; sweep(SET_STATE_EVERYTHING); }
 
 int main(void)
 {
@@ -340,6 +462,10 @@ int main(void)
         cmocka_unit_test(sensitivity_start_sweep), cmocka_unit_test(init_sensitivity_sweep),
         cmocka_unit_test(adjoint_checkpoints_sweep),
         cmocka_unit_test(step_hook_sweep),
+        cmocka_unit_test(adjoint_gradient_sweep),
+        cmocka_unit_test(events_y_sweep),
+        cmocka_unit_test(coupling_pattern_sweep),
+        cmocka_unit_test(set_state_everything_sweep),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
