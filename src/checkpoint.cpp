@@ -334,6 +334,7 @@ ga_status Solver::rebuild_matrix()
         b_q_ = &r.q_b;
     }
     const ga_tangent_mode mode = model.tangent_mode;
+    const Restore<ga_tangent_mode> keep_mode(model.tangent_mode);
     if (r.central)  // the matrix of the sensitivities (sensitivity_step)
         model.tangent_mode = GA_TANGENT_AUTO;
     if (!st && r.K)

@@ -500,7 +500,7 @@ ga_status Solver::correction_derivative(double t, const Vec &q, const Vec &eta, 
 ga_status Solver::exact_tangents(double t, const State &x, bool &K, bool &C, bool &Z)
 {
     ga_status st = residual(t, x);
-    const ga_tangent_mode mode = model.tangent_mode;
+    const Restore<ga_tangent_mode> keep_mode(model.tangent_mode);
     model.tangent_mode = GA_TANGENT_AUTO;
     K = !K_.zero() && K_.size() > 0;
     C = !C_.zero() && C_.size() > 0 && (model.has_force() || model.cb.damping);
@@ -511,7 +511,6 @@ ga_status Solver::exact_tangents(double t, const State &x, bool &K, bool &C, boo
         st = model.damping(t, x.q, x.v, f_, C_, true);
     if (!st && Z)
         st = model.velocity_constraint_tangent(t, x.q, x.v, J_, Z_, true);
-    model.tangent_mode = mode;
     return st;
 }
 

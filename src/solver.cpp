@@ -506,6 +506,8 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     // let the iteration wander into a singular configuration). The fallbacks of a run in
     // full Newton are all among these.
     const ga_reuse_mode planned_reuse = reuse;
+    const Restore<ga_reuse_mode> keep_reuse(reuse);
+    const Restore<ga_predictor> keep_predictor(predictor);
     if (!converged && reuse == GA_REUSE_AUTO) {
         reuse = GA_REUSE_NEVER;
         const bool go_on = attempt(true);

@@ -66,6 +66,21 @@ struct SaddleWorkspace {
     double sigma = 1.0;           // set by the solve: the first block row's scaling
 };
 
+// Puts a value back when the scope ends, however it ends: options an attempt changes for
+// itself stay as they were when a C++ callback throws through it.
+template <class T>
+class Restore {
+public:
+    explicit Restore(T &x) : x_(x), value_(x) {}
+    ~Restore() { x_ = value_; }
+    Restore(const Restore &) = delete;
+    Restore &operator=(const Restore &) = delete;
+
+private:
+    T &x_;
+    T value_;
+};
+
 class Solver {
 public:
     Solver(int n, int m);
@@ -267,6 +282,7 @@ private:
     // step_hook.cpp: (this->*step)(arg), then the step hook if a step was accepted; a failure
     // of the hook's multipliers or a throwing hook undoes that step.
     ga_status hooked(bool adaptive, double arg, ga_status (Solver::*step)(double));
+    ga_status hooked_step(bool adaptive, double arg, ga_status (Solver::*step)(double));
     StepHook hook_;
     Vec hook_lambda_;  // the multipliers the hook sees, its own: reads from the hook reuse out_
     ga_status residual(double t, const State &x);

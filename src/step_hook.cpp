@@ -49,6 +49,16 @@ ga_status Solver::step_adaptive(double t_stop)
 
 ga_status Solver::hooked(bool adaptive, double arg, ga_status (Solver::*step)(double))
 {
+    try {
+        return hooked_step(adaptive, arg, step);
+    } catch (...) {  // a C++ callback threw: the step failed, and drops the kept matrix as such
+        invalidate_jacobian();
+        throw;
+    }
+}
+
+ga_status Solver::hooked_step(bool adaptive, double arg, ga_status (Solver::*step)(double))
+{
     if (!hook_.fn)
         return (this->*step)(arg);
     const double t_before = accepted_.t;

@@ -9,6 +9,7 @@
 extern "C" {
 #include <cmocka.h>
 }
+#include <cstdio>
 #include <cstring>
 #include <new>
 #include <stdexcept>
@@ -126,11 +127,69 @@ void throwing_step_hook(void **)
     ga_free(s);
 }
 
+// Throws at its countdown-th call (0: never).
+int throw_at = 0;
+int counting_force(double t, const double *q, const double *v, double *f, void *user)
+{
+    if (throw_at > 0 && --throw_at == 0)
+        throw std::runtime_error("thrown in a fallback");
+    return pendulum_force(t, q, v, f, user);
+}
+
+// An exception in the attempts a step falls back to (a fresh matrix, full Newton, the
+// constant-a predictor, which change the iteration's options for their attempt) leaves the
+// options as they were: the run that follows is that of a solver whose step failed without
+// one (both drop the kept matrix).
+void exception_in_a_fallback_changes_no_option(void **)
+{
+    pendulum p{1.0, 1.0, 9.81};
+    double q[2], v[2];
+    pendulum_state(&p, 0.5, 1.0, q, v);
+    int calls = 0;
+    for (int k = 1; calls == 0 || k <= calls; ++k) {
+        ga_solver *s[2];
+        for (auto &x : s) {
+            assert_int_equal(ga_create(2, 1, &x), GA_OK);
+            assert_int_equal(ga_set_callbacks(x, pendulum_mass, counting_force,
+                                              pendulum_constraint, pendulum_jacobian, &p),
+                             GA_OK);
+            assert_int_equal(ga_init(x, 0.0, q, v), GA_OK);
+            for (int i = 0; i < 5; ++i)
+                assert_int_equal(ga_step(x, 0.01), GA_OK);
+            // too few iterations for the tolerance: every attempt and fallback runs, and fails
+            assert_int_equal(ga_set_newton(x, 1e-15, 1), GA_OK);
+        }
+        throw_at = 0;
+        long long before = 0, after = 0;
+        assert_int_equal(ga_get_counter(s[1], GA_COUNT_FORCE_EVALS, &before), GA_OK);
+        assert_int_equal(ga_step(s[1], 0.01), GA_ERR_NEWTON);
+        assert_int_equal(ga_get_counter(s[1], GA_COUNT_FORCE_EVALS, &after), GA_OK);
+        calls = static_cast<int>(after - before);
+        throw_at = k;
+        assert_int_equal(ga_step(s[0], 0.01), GA_ERR_INTERNAL);
+        throw_at = 0;
+        double end[2][2];
+        for (int i = 0; i < 2; ++i) {
+            assert_int_equal(ga_set_newton(s[i], 1e-10, 20), GA_OK);
+            for (int j = 0; j < 20; ++j)
+                assert_int_equal(ga_step(s[i], 0.01), GA_OK);
+            assert_int_equal(ga_get_q(s[i], end[i]), GA_OK);
+            ga_free(s[i]);
+        }
+        if (std::memcmp(end[0], end[1], sizeof end[0]) != 0)
+            fail_msg("thrown at force call %d of %d in the failing step: the run differs", k,
+                     calls);
+    }
+    std::printf("  an exception at each of the %d force calls of a step's attempts and "
+                "fallbacks: no option changed\n", calls);
+}
+
 }  // namespace
 
 int main()
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(exceptions_become_statuses),
-                                       cmocka_unit_test(throwing_step_hook)};
+                                       cmocka_unit_test(throwing_step_hook),
+                                       cmocka_unit_test(exception_in_a_fallback_changes_no_option)};
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
