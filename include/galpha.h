@@ -881,7 +881,10 @@ typedef int (*ga_cost_fn)(double t, const double *q, const double *v, const doub
  *  the exact iteration matrix evaluated again at the recorded state. running (L) or terminal
  *  (G) may be NULL. The recorded run must not contain Taylor steps or fresh starts after the
  *  first step (ga_step sizes over 100 times shorter or longer than the one before). Leaves the
- *  run as it was (it may be continued and asked again). Errors: GA_ERR_ARG (both NULL),
+ *  run as it was (it may be continued and asked again), also when it fails: with checkpoints
+ *  (ga_set_adjoint_checkpoints) the segments are computed again in an iteration matrix of
+ *  their own, allocated by each call, while the run's kept one waits aside, so that the run
+ *  goes on bit for bit as it would have without the call. Errors: GA_ERR_ARG (both NULL),
  *  GA_ERR_STATE (no adjoint recording, before ga_init, a step kind not covered, dropped
  *  redundant constraints), callback and linear-algebra errors. */
 GA_API ga_status ga_adjoint_gradient(ga_solver *s, ga_cost_fn running, ga_cost_fn terminal,

@@ -608,18 +608,24 @@ ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, doub
     const State previous = previous_;
     const bool previous_valid = previous_valid_, start_pending = start_pending_;
     const EventSet events = events_;
-    const long state_id = state_id_, output_for = output_for_, base = r.base;
+    const long state_id = state_id_, base = r.base;
     const std::vector<double> segment = r.data;
+    // The segments are computed in matrices of their own, the run's kept one set aside: it
+    // comes back as it was, without callbacks (one failing while it was rebuilt made the run
+    // go on with a fresh matrix, at Newton's tolerance from the run without the call).
+    KeptMatrix kept;
+    set_aside_matrix(kept);
     const auto restore = [&] {
         replaying_ = false;
-        const ga_status back = set_state(here.data(), here.size(), true);
+        take_back_matrix(kept);
+        const ga_status back = set_state(here.data(), here.size(), true, true);
         previous_ = previous;
         previous_valid_ = previous_valid;
         start_pending_ = start_pending;
         events_ = events;
         model.y_now = &accepted_.y;
         state_id_ = state_id;
-        output_for_ = output_for;
+        output_for_ = -1;  // (its buffers may hold a recomputed step's output now)
         r.data = segment;
         r.base = base;
         return back;
@@ -639,9 +645,8 @@ ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, doub
         diag.restore(message);
         return st;
     }
-    if (back)  // the state is restored; its kept matrix is dropped, as by a failed step
-        diag.append(" (rebuilding the kept iteration matrix after the adjoint sweep: the next "
-                    "step starts with a fresh one)");
+    if (back)  // (its own checkpoint, no callback: not expected)
+        diag.append(" (restoring the run after the adjoint sweep)");
     return back;
 }
 

@@ -121,12 +121,15 @@ void Solver::get_state(double *buf) const
         }
 }
 
-ga_status Solver::set_state(const double *buf, std::size_t len, bool internal)
+ga_status Solver::set_state(const double *buf, std::size_t len, bool internal,
+                            bool keep_matrix)
 {
-    return undoing_a_first_setup([&] { return restore_state(buf, len, internal); });
+    return undoing_a_first_setup(
+        [&] { return restore_state(buf, len, internal, keep_matrix); });
 }
 
-ga_status Solver::restore_state(const double *buf, std::size_t len, bool internal)
+ga_status Solver::restore_state(const double *buf, std::size_t len, bool internal,
+                                bool keep_matrix)
 {
     const bool layout2 = len >= 2 && buf[0] == kStateMagic && buf[1] == 2.0;
     const bool layout3 = len >= 2 && buf[0] == kStateMagic && buf[1] == 3.0;
@@ -280,11 +283,30 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
     }
 
     pivots_forgotten_ = false;
-    S_.load_pivots(buf + l.pivots[0]);
-    S2_.load_pivots(buf + l.pivots[1]);
+    if (!keep_matrix) {  // (else they hold the factors of this very state)
+        S_.load_pivots(buf + l.pivots[0]);
+        S2_.load_pivots(buf + l.pivots[1]);
+    }
     P_.load_pivots(buf + l.pivots[2]);
     O_.load_pivots(buf + l.pivots[3]);
-    if (kept) {
+    if (kept && keep_matrix) {
+        MatrixRecipe &r = recipe_;
+        r.t = buf[11];
+        r.h = buf[12];
+        r.t_b = buf[13];
+        const int tangents = static_cast<int>(buf[14]);
+        r.K = (tangents & 1) != 0;
+        r.C = (tangents & 2) != 0;
+        r.Z = (tangents & 4) != 0;
+        r.central = (tangents & 8) != 0;
+        for (Vec *x : {&r.q, &r.v, &r.qdd, &r.lambda, &r.q_b}) {
+            *x = Eigen::Map<const Vec>(p, x->size());
+            p += x->size();
+        }
+        jacobian_valid_ = true;
+        jacobian_h_ = r.h;
+        schur_valid_ = false;
+    } else if (kept) {
         MatrixRecipe &r = recipe_;
         r.t = buf[11];
         r.h = buf[12];

@@ -284,6 +284,35 @@ void Solver::forget_setup()
     invalidate_jacobian();
 }
 
+// A second step matrix like S_ (and S2_) for the adjoint sweep's recomputed segments; the
+// live ones, with the first-order blocks factorized into them, go into `kept` meanwhile.
+void Solver::set_aside_matrix(KeptMatrix &kept)
+{
+    auto backend = sparse_backend_ ? make_sparse_backend()
+                                   : make_dense_backend(dense_kind(linear_solver));
+    backend->analysis_from(S_.backend());  // the same pattern: its ordering
+    kept.S.setup(std::move(backend), n_, m_, M_, J_, K_, C_, active_ptr());
+    kept.S.reserve_factors();
+    if (S2_.ready()) {
+        kept.S2.setup(n_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_,
+                      active_ptr());
+        kept.S2.reserve_factors();
+    }
+    kept.blocks = blocks_;
+    // nothing above changed the solver; from here on nothing allocates
+    std::swap(S_, kept.S);
+    if (kept.S2.ready())
+        std::swap(S2_, kept.S2);
+}
+
+void Solver::take_back_matrix(KeptMatrix &kept)
+{
+    std::swap(S_, kept.S);
+    if (kept.S2.ready())
+        std::swap(S2_, kept.S2);
+    std::swap(blocks_, kept.blocks);
+}
+
 // The stabilized index-2 system, dense or sparse like S_: set up with the workspace when that
 // formulation is chosen, or when it is chosen later (ga_set_formulation), never in a step.
 void Solver::setup_index2()

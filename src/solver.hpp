@@ -220,8 +220,11 @@ public:
     std::size_t state_size_in(bool layout3) const;  // 4, or layout 3's
     void get_state(double *buf) const;
     // internal: the adjoint sweep's own restores into a recorded run
-    ga_status set_state(const double *buf, std::size_t len, bool internal = false);
-    ga_status restore_state(const double *buf, std::size_t len, bool internal);
+    // keep_matrix (internal): the kept iteration matrix is the one of this checkpoint already
+    // (set aside and taken back): not rebuilt
+    ga_status set_state(const double *buf, std::size_t len, bool internal = false,
+                        bool keep_matrix = false);
+    ga_status restore_state(const double *buf, std::size_t len, bool internal, bool keep_matrix);
 
 private:
     // The first ga_init, ga_init_y or ga_set_state sets the solver up; when it fails (an
@@ -331,6 +334,15 @@ private:
     ga_status adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ);
     ga_status replay_segment(long s);
     bool replaying_ = false;  // a sweep recomputes a segment of the recorded run
+    // The live run's kept iteration matrix (and the first-order blocks factorized with it),
+    // set aside while a sweep recomputes segments in matrices of their own (adjoint.cpp).
+    struct KeptMatrix {
+        IterationMatrix S;
+        Index2Matrix S2;
+        CouplingBlocks blocks;
+    };
+    void set_aside_matrix(KeptMatrix &kept);  // allocates the replay's matrices
+    void take_back_matrix(KeptMatrix &kept);
     Vec eta_total_;       // index 2: the converged step's eta_bar (sum of its increments)
     ga_status factorize(double t, const State &x, double h, bool tangents_K, bool tangents_C,
                         bool tangent_Z, int iter);

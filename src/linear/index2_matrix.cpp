@@ -61,6 +61,8 @@ struct Index2Matrix::Sparse {};
 
 Index2Matrix::Index2Matrix() = default;
 Index2Matrix::~Index2Matrix() = default;
+Index2Matrix::Index2Matrix(Index2Matrix &&) noexcept = default;
+Index2Matrix &Index2Matrix::operator=(Index2Matrix &&) noexcept = default;
 
 void Index2Matrix::reset()
 {

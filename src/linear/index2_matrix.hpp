@@ -39,6 +39,8 @@ class Index2Matrix {
 public:
     Index2Matrix();
     ~Index2Matrix();
+    Index2Matrix(Index2Matrix &&) noexcept;
+    Index2Matrix &operator=(Index2Matrix &&) noexcept;
 
     // Allocates everything (patterns of M, J, K, C: their layouts; B has J's). active: m
     // flags owned by the caller (null: every constraint active); an inactive constraint's
