@@ -725,6 +725,17 @@ ga_status Solver::adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double 
             w.mw.setZero();
         }
     }
+    // A run near the range of double (a free particle in adaptive steps of 1e153, exact for
+    // it) overflows the sweep's products: no such gradient with GA_OK.
+    int bad = -1;
+    for (int j = 0; j < w.np && bad < 0; ++j)
+        if (!std::isfinite(w.dJ[j]))
+            bad = j;
+    if (!std::isfinite(total) || bad >= 0)
+        return diag.fail(GA_ERR_NONFINITE,
+                         "the adjoint sweep overflowed: J = %g, dJ/dp_%d = %g (the recorded "
+                         "run's values or step sizes near the range of double)",
+                         total, bad < 0 ? 0 : bad, w.dJ[bad < 0 ? 0 : bad]);
     *J = total;
     for (int j = 0; j < w.np; ++j)
         dJ[j] = w.dJ[j];

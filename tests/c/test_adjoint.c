@@ -240,6 +240,59 @@ static ga_solver *pendulum_solver(int methods, long max_steps)
     return s;
 }
 
+/* A free particle in gravity, exact for the scheme, in one step of 1e153: its state is finite
+ * (q ~ -5e306), the sweep's products are not -- the gradient is refused, not NaN with GA_OK
+ * (found by the API-sequence fuzzer). */
+static double g_particle_gravity = 9.81;
+static int particle_mass(double t, const double *q, double *M, void *user)
+{
+    (void)t, (void)q, (void)user;
+    M[0] = 1.0;
+    return 0;
+}
+static int particle_force(double t, const double *q, const double *v, double *f, void *user)
+{
+    (void)t, (void)q, (void)v, (void)user;
+    f[0] = -g_particle_gravity;
+    return 0;
+}
+static int particle_cost(double t, const double *q, const double *v, const double *qdd,
+                         const double *lambda, double *value, double *d_q, double *d_v,
+                         double *d_qdd, double *d_lambda, double *d_p, void *user)
+{
+    (void)t, (void)v, (void)qdd, (void)lambda, (void)d_lambda, (void)user;
+    d_q[0] = 1.0, d_v[0] = d_qdd[0] = d_p[0] = 0.0;
+    *value = q[0];
+    return 0;
+}
+static void an_overflowing_sweep_is_refused(void **state)
+{
+    (void)state;
+    ga_solver *s = NULL;
+    const double q0 = 0.0, v0 = 1.0;
+    double J = -1.0, dJ[1] = {-1.0};
+    assert_int_equal(ga_create(1, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, particle_mass, particle_force, NULL, NULL, NULL), GA_OK);
+    assert_int_equal(ga_set_sensitivity(s, 1, &g_particle_gravity, NULL, GA_DEPENDS_FORCE),
+                     GA_OK);
+    assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 10), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, &q0, &v0), GA_OK);
+    assert_int_equal(ga_adjoint_gradient(s, particle_cost, particle_cost, &J, dJ), GA_OK);
+    assert_true(isfinite(J) && isfinite(dJ[0]));
+    assert_int_equal(ga_step(s, 1e153), GA_OK);
+    double q;
+    assert_int_equal(ga_get_q(s, &q), GA_OK);
+    assert_true(isfinite(q) && q < -1e306);
+    J = dJ[0] = -1.0;
+    const ga_status st = ga_adjoint_gradient(s, particle_cost, particle_cost, &J, dJ);
+    if (st != GA_ERR_NONFINITE)
+        print_error("%s\n", ga_last_error(s));
+    assert_int_equal(st, GA_ERR_NONFINITE);
+    assert_non_null(strstr(ga_last_error(s), "adjoint sweep overflowed"));
+    assert_true(J == -1.0 && dJ[0] == -1.0); /* not written */
+    ga_free(s);
+}
+
 static void refusals(void **state)
 {
     (void)state;
@@ -393,6 +446,7 @@ int main(void)
         cmocka_unit_test(chain_adjoint),
         cmocka_unit_test(initial_values_adjoint),
         cmocka_unit_test(refusals),
+        cmocka_unit_test(an_overflowing_sweep_is_refused),
         cmocka_unit_test(full_record_and_uncovered_steps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
