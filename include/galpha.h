@@ -594,7 +594,10 @@ GA_API ga_status ga_interpolate_qdd(const ga_solver *s, double t, double *qdd);
  *  safeguarded by bisection, to within 100 u (|t| + |h|) after it (u the unit round-off; the
  *  tolerance of SUNDIALS IDA), then the rest of the step is searched from there, so that
  *  roots of several functions in one step are found in time order. A function exactly zero
- *  where a search starts does not fire there. docs/algorithms.md sec. 12. */
+ *  where a search starts does not fire there; its sign just past that point (1e-6 of the
+ *  step, or 100 u |t|) stands for it, so that it fires where it next crosses zero within the
+ *  step (a restart at an event whose function crosses again in the first step).
+ *  docs/algorithms.md sec. 12. */
 /**@{*/
 typedef enum ga_event_direction {
     GA_EVENT_BOTH = 0,    /**< any sign change */

@@ -84,7 +84,8 @@ void EventSet::configure(int count, ga_event_fn fn, ga_event_y_fn fn_y, const in
 {
     // everything is allocated before anything changes: a failure leaves the old set
     std::vector<int> dir(count), term(count), fired(count);
-    std::vector<double> lo(count), hi(count), slo(count), shi(count);
+    std::vector<double> lo(count), hi(count), slo(count), shi(count), past(count),
+        start(count);
     std::vector<double> qs(count ? n : 0), vs(count ? n : 0), ls(count && with_lambda ? m : 0);
     std::vector<double> ys(count && fn_y ? r : 0);
     // a whole root fits into an empty log, however many functions cross at it
@@ -103,6 +104,8 @@ void EventSet::configure(int count, ga_event_fn fn, ga_event_y_fn fn_y, const in
     this->fired.swap(fired);
     g_lo.swap(lo);
     g_hi.swap(hi);
+    g_past.swap(past);
+    g_start.swap(start);
     saved_g_lo_.swap(slo);
     saved_g_hi_.swap(shi);
     q.swap(qs);
@@ -167,6 +170,30 @@ ga_status Solver::event_values(double t, double *g)
     return model.event_functions(e.fn(), e.fn_y(), t, q, v, y, lambda, g, e.count());
 }
 
+// A function exactly zero at the start of the search (at ga_init, a restart, or where a
+// search stopped) cannot say from that value where it goes: g = t (0.05 - t) from t0 = 0 fell
+// through zero at 0.05 unseen in a step of 0.1. Its value just past the start says it (as
+// IDA looks past t0): 1e-6 of the interval, or 100 ulps of t where that is more.
+ga_status Solver::event_start_values(const double **start)
+{
+    EventSet &e = events_;
+    *start = e.g_lo.data();
+    bool zero = false;
+    for (int k = 0; k < e.count(); ++k)
+        zero = zero || (e.g_lo[k] == 0.0 && e.g_hi[k] != 0.0);
+    const double span = e.t_hi - e.t_lo;
+    const double past = std::max(1e-6 * span, 100.0 * std::numeric_limits<double>::epsilon() *
+                                                  (std::fabs(e.t_lo) + span));
+    if (!zero || !(past < span))
+        return GA_OK;
+    if (auto st = event_values(e.t_lo + past, e.g_past.data()))
+        return st;
+    for (int k = 0; k < e.count(); ++k)
+        e.g_start[k] = e.g_lo[k] == 0.0 ? e.g_past[k] : e.g_lo[k];
+    *start = e.g_start.data();
+    return GA_OK;
+}
+
 // The rest (t_lo, t_hi] of the last step: what fires there is logged in time order. GA_EVENT
 // at a terminal event or a full log, the search left just after the root (or, if the next
 // root's entries do not fit, before it) for the next call. A failure leaves t_lo and g_lo as
@@ -178,7 +205,9 @@ ga_status Solver::search_events()
         return static_cast<int>(static_cast<Solver *>(self)->event_values(t, g));
     };
     double t_cur = e.t_lo;
-    const double *g_cur = e.g_lo.data();
+    const double *g_cur = nullptr;
+    if (auto st0 = event_start_values(&g_cur))
+        return st0;
     ga_status st = GA_OK;
     while (t_cur < e.t_hi && e.any_crossing(g_cur, e.g_hi.data())) {
         double t_root = 0.0;
@@ -210,7 +239,7 @@ ga_status Solver::search_events()
     }
     if (st == GA_EVENT) {
         e.t_lo = t_cur;
-        if (g_cur != e.g_lo.data())
+        if (g_cur != e.g_lo.data() && g_cur != e.g_start.data())
             std::copy(g_cur, g_cur + e.count(), e.g_lo.begin());
     } else {
         e.t_lo = e.t_hi;
@@ -246,7 +275,10 @@ ga_status Solver::events_after_step()
     if (st)
         return st;
     e.t_hi = accepted_.t;
-    if (e.any_crossing(e.g_lo.data(), e.g_hi.data()))
+    const double *start = nullptr;
+    if (auto st2 = event_start_values(&start))
+        return st2;
+    if (e.any_crossing(start, e.g_hi.data()))
         return search_events();
     e.t_lo = e.t_hi;
     e.g_lo.swap(e.g_hi);
@@ -305,9 +337,13 @@ ga_status Solver::one_step(double h)
     ga_status st = model.event_functions(e.fn(), e.fn_y(), accepted_.t, accepted_.q.data(),
                                          accepted_.v.data(), accepted_.y.data(), nullptr,
                                          e.g_hi.data(), e.count());
+    const double *start = nullptr;
     if (st == GA_OK) {
         e.t_hi = accepted_.t;
-        if (!e.any_crossing(e.g_lo.data(), e.g_hi.data())) {
+        st = event_start_values(&start);
+    }
+    if (st == GA_OK) {
+        if (!e.any_crossing(start, e.g_hi.data())) {
             e.t_lo = e.t_hi;
             e.g_lo.swap(e.g_hi);
             return GA_OK;

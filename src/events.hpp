@@ -105,6 +105,7 @@ public:
     double t_lo = 0.0, t_hi = 0.0;
     std::vector<double> g_lo, g_hi;
     std::vector<double> q, v, lambda, y;  // the interpolated state g is evaluated at
+    std::vector<double> g_past, g_start;  // g just past t_lo, and the search's start values
     EventLocator locator;
     std::vector<int> fired;
 

@@ -271,6 +271,9 @@ private:
     // events.cpp
     ga_status event_values(double t, double *g);
     ga_status search_events();
+    // g at the start of the search over (t_lo, t_hi], functions exactly zero there replaced
+    // by their values just past it (into *start: g_lo itself when none is)
+    ga_status event_start_values(const double **start);
     ga_status resume_events();
     ga_status events_after_step();
     // A step (take_step(h), or adaptive_step(t_stop) if adaptive) with the event search

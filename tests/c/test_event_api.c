@@ -417,6 +417,46 @@ static void root_at_a_step_end_found_once(void **state)
     ga_free(s);
 }
 
+/* g = (t - t0) (t0 + 0.05 - t): zero at the start of the first step, positive inside it, and
+ * falling through zero at t0 + 0.05. With h = 0.1 the values at the step's ends (0, then
+ * negative) showed no crossing and it was never reported (with h = 0.01 it was); every restart
+ * at an event whose function crosses again within the first step is such a case. */
+static double g_t0;
+static int zero_at_start(double t, const double *q, const double *v, const double *lambda,
+                         double *g, void *user)
+{
+    (void)q, (void)v, (void)lambda, (void)user;
+    g[0] = (t - g_t0) * (g_t0 + 0.05 - t);
+    return 0;
+}
+static void a_zero_at_the_start_of_a_step_hides_no_crossing(void **state)
+{
+    (void)state;
+    const double starts[] = {0.0, 1.25};
+    for (size_t i = 0; i < 2; ++i)
+        for (int adaptive = 0; adaptive < 2; ++adaptive) {
+            scene sc = make_scene();
+            g_t0 = starts[i];
+            ga_solver *s = pendulum_new_solver(&sc.p, 1);
+            assert_non_null(s);
+            double q[2], v[2];
+            pendulum_state(&sc.p, 0.5, 0.0, q, v);
+            assert_int_equal(ga_init(s, g_t0, q, v), GA_OK); /* a restart at t0 = 1.25 */
+            assert_int_equal(ga_set_tolerances(s, 1e-3, 1e-3), GA_OK);
+            assert_int_equal(ga_set_initial_step(s, 0.1), GA_OK);
+            assert_int_equal(ga_set_events(s, 1, zero_at_start, NULL, NULL, 0), GA_OK);
+            const ga_status st =
+                adaptive ? ga_step_adaptive(s, g_t0 + 0.1) : ga_step(s, 0.1);
+            assert_int_equal(st, GA_EVENT);
+            double te;
+            int index, direction;
+            assert_int_equal(ga_get_event(s, 0, &te, &index, &direction), GA_OK);
+            assert_int_equal(direction, -1);
+            assert_true(fabs(te - (g_t0 + 0.05)) < 1e-12);
+            ga_free(s);
+        }
+}
+
 /* 89 crossings of three sines in one ga_advance: the call stops when its log is full, the
  * next one goes on, and every root is found once, in order, next to its exact time. */
 static void a_full_log_loses_nothing(void **state)
@@ -746,6 +786,7 @@ int main(void)
         cmocka_unit_test(reuse_does_not_change_the_events),
         cmocka_unit_test(two_roots_in_one_step),
         cmocka_unit_test(root_at_a_step_end_found_once),
+        cmocka_unit_test(a_zero_at_the_start_of_a_step_hides_no_crossing),
         cmocka_unit_test(a_full_log_loses_nothing),
         cmocka_unit_test(chain_events_sparse_and_dense_agree),
         cmocka_unit_test(stopping_at_events_changes_nothing),
