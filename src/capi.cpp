@@ -7,6 +7,7 @@
 #include <exception>
 #include <new>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -64,6 +65,12 @@ ga_status caught(ga::Solver &core, Body &&body)
     }
 }
 
+void forget_refusal(ga_solver *s, std::thread::id me)
+{
+    std::thread::id was = me;
+    s->refused.compare_exchange_strong(was, std::thread::id());
+}
+
 // Runs `body` as one API call on `s`: refuses calls from inside the solver's own callbacks,
 // clears the last error if asked, and converts every C++ exception into a status.
 template <class Body>
@@ -72,12 +79,17 @@ ga_status call(ga_solver *s, bool clear_message, Body &&body)
     if (!s)
         return GA_ERR_ARG;
     bool idle = false;
-    if (!s->busy.compare_exchange_strong(idle, true))
-        return GA_ERR_STATE;  // message left alone: the outer call owns it
+    const std::thread::id me = std::this_thread::get_id();
+    if (!s->busy.compare_exchange_strong(idle, true)) {
+        s->refused.store(me);  // the message is the outer call's: ga_last_error says this
+        return GA_ERR_STATE;
+    }
+    forget_refusal(s, me);
     const TrapsHeld traps(s->core.model);
     if (clear_message)
         s->core.diag.clear();
     const ga_status st = caught(s->core, std::forward<Body>(body));
+    forget_refusal(s, me);  // (a callback's own call refused inside this one)
     s->busy = false;
     return st;
 }
@@ -112,8 +124,12 @@ ga_status reading(const ga_solver *s, const char *name, const char *bad_argument
 {
     if (!s)
         return GA_ERR_ARG;
-    if (s->busy && !s->in_hook)
+    auto *w = const_cast<ga_solver *>(s);
+    if (s->busy && !s->in_hook) {
+        w->refused.store(std::this_thread::get_id());
         return GA_ERR_STATE;
+    }
+    forget_refusal(w, std::this_thread::get_id());
     const ga_status st = body(s->core);
     if (st != GA_OK)
         explain(s, st, name, bad_argument);
@@ -239,6 +255,9 @@ GA_API const char *ga_last_error(const ga_solver *s)
 {
     if (!s)
         return "NULL solver";
+    if (s->refused.load() == std::this_thread::get_id())
+        return "call refused: another call holds this solver (from another thread, or from "
+               "within one of its own callbacks); one solver per thread";
     return s->core.diag.text();
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <atomic>
+#include <thread>
 
 #include "solver.hpp"
 
@@ -13,4 +14,8 @@ struct ga_solver {
     std::atomic<bool> busy{false};
     // true while the step hook runs (inside a busy call): read-only calls are let in
     std::atomic<bool> in_hook{false};
+    // The thread whose last call was refused because another held the solver: the message
+    // belongs to that other call, so ga_last_error tells this thread why instead (cleared
+    // when the thread's own calls start and end).
+    std::atomic<std::thread::id> refused{};
 };

@@ -238,13 +238,19 @@ ga_status Solver::adaptive_step(double t_stop)
             : vel > 0.0          ? 1.0 / vel
                                  : 1e-3 * remaining;
     }
-    if (control.h_max > 0.0)
-        h = std::min(h, control.h_max);
     // The user's minimum, but never below what moves t: at t = -1e300 with h_max = 1 a step
     // of 1 was accepted with t unchanged (and its checkpoint refused).
     const double h_min = std::max(control.h_min, 16.0 * kEps * std::max(std::fabs(t), 1.0));
+    // A proposal below the minimum is tried at the minimum: only a step that fails there
+    // fails the call (an initial estimate of 3e-6 under h_min = 1e-4 failed before any try)
+    h = std::max(h, h_min);
+    if (control.h_max > 0.0)
+        h = std::min(h, control.h_max);
     const double tol = newton_tolerance(true);
     bool rejected = false;
+    // the last recoverable failure, said again if the steps shrink below h_min because of it
+    // (a failing callback ended in "step size fell below the minimum" alone)
+    char last_failure[Diagnostics::kSize] = "";
     for (;;) {
         // Approaching t_stop, no sliver of a last step: up to 1.5 h take it all (the error
         // test decides), up to 2 h split it in two equal steps.
@@ -262,11 +268,15 @@ ga_status Solver::adaptive_step(double t_stop)
         } else if (!rejected && h * 2.0 > remaining) {
             h = 0.5 * remaining;
         }
-        if (h < h_min && !land)
-            return diag.fail(GA_ERR_STEP_SIZE,
-                             "step size %g fell below the minimum %g at t = %.17g (last error "
-                             "estimate %.3g)",
-                             h, h_min, t, control.err_last);
+        if (h < h_min && !land) {
+            diag.fail(GA_ERR_STEP_SIZE,
+                      "step size %g fell below the minimum %g at t = %.17g (last error "
+                      "estimate %.3g)",
+                      h, h_min, t, control.err_last);
+            if (last_failure[0] != '\0')
+                diag.append("; the last attempt failed: %s", last_failure);
+            return GA_ERR_STEP_SIZE;
+        }
         // A sliver is a Taylor step (sliver_step) only when it lands on t_stop; retries after
         // failures stay under error control.
         ga_status st = attempt_step(h, tol, land);
@@ -314,12 +324,14 @@ ga_status Solver::adaptive_step(double t_stop)
                 return GA_OK;
             }
             count(counters, GA_COUNT_REJECTED_STEPS);
+            last_failure[0] = '\0';
             if (sens.adjoint)  // (a replay from a checkpoint cannot know the matrix it left)
                 invalidate_jacobian();
             h *= std::max(kMinShrink, kSafety * std::pow(err, -1.0 / 3.0));
         } else if (recoverable(st)) {
             count(counters, GA_COUNT_FAILED_STEPS);
             invalidate_jacobian();
+            diag.copy_to(last_failure);
             h *= kFailureShrink;
         } else {
             count(counters, GA_COUNT_FAILED_STEPS);

@@ -445,11 +445,11 @@ static void events_on_the_states(void **state)
 }
 
 /* ---- what the API refuses, and failures that leave the solver as it was ---- */
-static int g_fail_rate_after;
+static int g_fail_rate_after, g_always_fail;
 static int failing_rate(double t, const double *q, const double *v, const double *y,
                         double *ydot, void *u)
 {
-    if (g_fail_rate_after-- == 0)
+    if (g_always_fail || g_fail_rate_after-- == 0)
         return 1;
     return em_rate(t, q, v, y, ydot, u);
 }
@@ -489,6 +489,24 @@ static void refusals_and_failures(void **state)
     assert_memory_equal(before + len - 6 * EM_R, after + len - 6 * EM_R, 4 * EM_R * sizeof(double));
     g_fail_rate_after = 1000000;
     assert_int_equal(ga_step(s, 0.01), GA_OK);
+    /* a rate that keeps failing in adaptive steps: the steps shrink below h_min, and the
+     * status says which callback made them (it said "step size fell below the minimum" only) */
+    assert_int_equal(ga_set_step_limits(s, 1e-4, 0.0), GA_OK);
+    {
+        ga_status st = GA_OK;
+        double t_before, t_after;
+        assert_int_equal(ga_get_t(s, &t_before), GA_OK);
+        g_always_fail = 1;
+        st = ga_step_adaptive(s, 1.0);
+        g_always_fail = 0;
+        assert_int_equal(st, GA_ERR_STEP_SIZE);
+        assert_non_null(strstr(ga_last_error(s), "fell below the minimum"));
+        assert_non_null(strstr(ga_last_error(s), "the last attempt failed: rate callback "
+                                                 "returned 1 (recoverable)"));
+        assert_int_equal(ga_get_t(s, &t_after), GA_OK);
+        assert_true(t_after == t_before);
+        g_fail_rate_after = 1000000;
+    }
     /* a restart by ga_init keeps the states it holds */
     double y_now[EM_R], y_restart[EM_R];
     assert_int_equal(ga_get_y(s, y_now, NULL), GA_OK);
