@@ -572,7 +572,8 @@ ga_status Solver::replay_segment(long s)
             diag.append(" (recomputing step %ld from its checkpoint for the adjoint sweep)", k);
             return st;
         }
-        sens.accepted.swap(sens.trial);
+        if (sens.forward)
+            sens.accepted.swap(sens.trial);
         accepted_.swap(trial_);
         accepted_.t = l[0];
         start_pending_ = false;

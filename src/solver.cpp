@@ -411,7 +411,8 @@ void Solver::undo_step(const StepUndo &u)
 {
     previous_.swap(trial_);  // commit's swaps, backwards
     accepted_.swap(trial_);
-    sens.accepted.swap(sens.trial);
+    if (sens.forward)
+        sens.accepted.swap(sens.trial);
     if (sens.adjoint && --adjoint_.steps < adjoint_.unsupported_at)
         adjoint_.unsupported_at = -1;  // that step is gone
     previous_valid_ = u.previous_valid;
@@ -427,7 +428,11 @@ void Solver::undo_step(const StepUndo &u)
 
 void Solver::commit(bool land_on, double t_land)
 {
-    sens.accepted.swap(sens.trial);  // (empty without sensitivities)
+    // The step's derivatives, where forward sensitivities computed them (an adjoint-only run
+    // keeps the start's: its trial ones are scratch, NaN after a failed start, which the next
+    // checkpoint carried and a restore refused)
+    if (sens.forward)
+        sens.accepted.swap(sens.trial);
     accepted_.swap(trial_);    // the new step becomes the state ...
     previous_.swap(trial_);    // ... and the old one the start of the interval for dense output
     if (land_on)

@@ -942,8 +942,8 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             stats->adjoint_ok += st == GA_OK;
             if (len && (snapshot(&md, s, after) != len ||
                         memcmp(before, after, sizeof(double) * (size_t)len) != 0))
-                SEQ_FAIL("sequence %d: ga_adjoint_gradient changed the state (%s)", seq,
-                         ga_strerror(st));
+                SEQ_FAIL("sequence %d: ga_adjoint_gradient changed the state (%s: %s)", seq,
+                         ga_strerror(st), ga_last_error(s));
             if (st == GA_OK && !(isfinite(J) && isfinite(dJ[0]) && isfinite(dJ[1])))
                 SEQ_FAIL("sequence %d: ga_adjoint_gradient returned GA_OK with J = %g, dJ = "
                          "(%g, %g)", seq, J, dJ[0], dJ[1]);

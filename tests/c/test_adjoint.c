@@ -256,6 +256,14 @@ static int particle_force(double t, const double *q, const double *v, double *f,
     f[0] = -g_particle_gravity;
     return 0;
 }
+/* the same with air drag, and a call that fails (counted down; 0: none) */
+static int g_particle_fail_at;
+static int dragged_force(double t, const double *q, const double *v, double *f, void *user)
+{
+    (void)t, (void)q, (void)user;
+    f[0] = -g_particle_gravity - 0.1 * v[0];
+    return g_particle_fail_at > 0 && --g_particle_fail_at == 0;
+}
 static int particle_cost(double t, const double *q, const double *v, const double *qdd,
                          const double *lambda, double *value, double *d_q, double *d_v,
                          double *d_qdd, double *d_lambda, double *d_p, void *user)
@@ -291,6 +299,63 @@ static void an_overflowing_sweep_is_refused(void **state)
     assert_non_null(strstr(ga_last_error(s), "adjoint sweep overflowed"));
     assert_true(J == -1.0 && dJ[0] == -1.0); /* not written */
     ga_free(s);
+}
+
+/* A restart (ga_init) that fails after the start's derivatives were computed, at each force
+ * call in turn, changes nothing of an adjoint-only run: its checkpoints stay those of a twin
+ * that never made the call (but dropped its kept matrix, as a failed start does). (Its steps swapped the unused trial derivatives into the state:
+ * after a start that failed, NaN there made the next restore -- the adjoint sweep's with
+ * checkpoints -- refuse the run's own checkpoint, found by the API-sequence fuzzer.) */
+static void a_failed_restart_changes_no_adjoint_run(void **state)
+{
+    (void)state;
+    const double q0 = 0.0, v0 = 1.0, v_new = -2.0;
+    int calls = 0;
+    for (int k = 1; calls == 0 || k <= calls + 1; ++k) {
+        ga_solver *s[2];
+        double c[2][64];
+        size_t len = 0;
+        for (int i = 0; i < 2; ++i) {
+            assert_int_equal(ga_create(1, 0, &s[i]), GA_OK);
+            assert_int_equal(ga_set_callbacks(s[i], particle_mass, dragged_force, NULL, NULL,
+                                              NULL),
+                             GA_OK);
+            assert_int_equal(ga_set_sensitivity(s[i], 1, &g_particle_gravity, NULL,
+                                                GA_DEPENDS_FORCE),
+                             GA_OK);
+            assert_int_equal(ga_set_sensitivity_method(s[i], GA_SENSITIVITY_ADJOINT, 10), GA_OK);
+            assert_int_equal(ga_init(s[i], 0.0, &q0, &v0), GA_OK);
+            assert_int_equal(ga_step(s[i], 1e-2), GA_OK);
+        }
+        long long before = 0, after = 0;
+        assert_int_equal(ga_get_counter(s[0], GA_COUNT_FORCE_EVALS, &before), GA_OK);
+        g_particle_fail_at = k;
+        const ga_status st = ga_init(s[0], 0.01, &q0, &v_new);
+        g_particle_fail_at = 0;
+        /* (a failed start drops the kept matrix, as a failed step does: so does the twin) */
+        assert_int_equal(ga_set_jacobian_reuse(s[1], GA_REUSE_AUTO), GA_OK);
+        assert_int_equal(ga_get_counter(s[0], GA_COUNT_FORCE_EVALS, &after), GA_OK);
+        if (st == GA_OK) { /* fewer calls than k: every one was failed in turn */
+            calls = (int)(after - before);
+            ga_free(s[0]);
+            ga_free(s[1]);
+            break;
+        }
+        for (int i = 0; i < 2; ++i) {
+            for (int j = 0; j < 3; ++j)
+                assert_int_equal(ga_step(s[i], 1e-2), GA_OK);
+            assert_int_equal(ga_state_size(s[i], &len), GA_OK);
+            assert_true(len <= 64);
+            assert_int_equal(ga_get_state(s[i], c[i], len), GA_OK);
+            ga_free(s[i]);
+        }
+        for (size_t e = 0; e < len; ++e)
+            if (memcmp(&c[0][e], &c[1][e], sizeof(double)) != 0)
+                fail_msg("a restart failing at force call %d changed the run (checkpoint entry "
+                         "%zu: %.17g, not %.17g)", k, e, c[0][e], c[1][e]);
+    }
+    printf("  a restart failed at each of its %d force calls: the run as its twin's\n", calls);
+    assert_true(calls > 2);
 }
 
 static void refusals(void **state)
@@ -447,6 +512,7 @@ int main(void)
         cmocka_unit_test(initial_values_adjoint),
         cmocka_unit_test(refusals),
         cmocka_unit_test(an_overflowing_sweep_is_refused),
+        cmocka_unit_test(a_failed_restart_changes_no_adjoint_run),
         cmocka_unit_test(full_record_and_uncovered_steps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
