@@ -152,7 +152,7 @@ void Solver::record_step()
         double *l = r.log_entry(k);
         std::copy_n(e, 4, l);
         l[4] = r.pending_tol;
-        l[5] = r.pending_sliver ? 1.0 : 0.0;
+        l[5] = (r.pending_sliver ? 1.0 : 0.0) + (r.pending_adaptive ? 2.0 : 0.0);
         std::copy_n(r.pending_reuse, 5, l + 6);
     }
     e += 4;
@@ -171,6 +171,7 @@ void Solver::record_step()
             r.start0[j].a = sens.start[j].a;
             r.start0[j].qdd = sens.start[j].qdd;
             r.start0[j].w = sens.start[j].w;
+            r.start0[j].ydot = sens.start[j].ydot;
         }
     if (r.pending_kind == AdjointRecord::Unsupported && r.unsupported_at < 0)
         r.unsupported_at = r.steps;
@@ -518,7 +519,7 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
             w.dJ[j] += msq.dot(r.sigma0[j].q) + msv.dot(r.start0[j].v) +
                        msa.dot(r.start0[j].a) + msqdd.dot(r.start0[j].qdd);
             if (R > 0)
-                w.dJ[j] += msy.dot(r.sigma0[j].y) + msydot.dot(r.sigma0[j].ydot) +
+                w.dJ[j] += msy.dot(r.sigma0[j].y) + msydot.dot(r.start0[j].ydot) +
                            msw.dot(r.start0[j].w);
         }
         return GA_OK;
@@ -565,7 +566,9 @@ ga_status Solver::replay_segment(long s)
         refresh_steps_left_ = static_cast<int>(l[8]);
         reuse_backoff_ = static_cast<int>(l[9]);
         fd_tangents_ = l[10] != 0.0;
-        ga_status st = attempt_step(h, l[4], l[5] != 0.0);
+        const Restore<bool> keep_mode(adaptive_attempt_);
+        adaptive_attempt_ = l[5] >= 2.0;  // (a fresh start: its first-order states' start)
+        ga_status st = attempt_step(h, l[4], std::fmod(l[5], 2.0) != 0.0);
         if (!st)
             st = sensitivity_step(h);
         if (st) {

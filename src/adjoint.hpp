@@ -28,7 +28,8 @@ struct AdjointRecord {
     long base = 0;
     std::size_t checkpoint_size = 0;
     std::vector<double> checkpoints;
-    // per step k >= 1 (with checkpointing): t, h, rho, kind, Newton tolerance, sliver allowed,
+    // per step k >= 1 (with checkpointing): t, h, rho, kind, Newton tolerance, sliver allowed
+    // (+ 2 for an adaptive step),
     // and the kept matrix's reuse state as the accepted attempt began (valid, theta,
     // refresh steps left, backoff, finite-difference tangents)
     static constexpr std::size_t kLog = 11;
@@ -40,6 +41,7 @@ struct AdjointRecord {
     double pending_rho = 1.0;
     double pending_tol = 0.0;  // how the step was attempted (attempt_step), for its replay
     bool pending_sliver = true;
+    bool pending_adaptive = false;  // an adaptive step (with pending_sliver: log entry 5)
     double pending_reuse[5] = {0, 0, 0, 0, 0};
 
     static std::size_t stride_for(int n, int m, int r)

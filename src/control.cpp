@@ -279,7 +279,12 @@ ga_status Solver::adaptive_step(double t_stop)
         }
         // A sliver is a Taylor step (sliver_step) only when it lands on t_stop; retries after
         // failures stay under error control.
-        ga_status st = attempt_step(h, tol, land);
+        ga_status st = GA_OK;
+        {
+            const Restore<bool> keep_mode(adaptive_attempt_);
+            adaptive_attempt_ = true;
+            st = attempt_step(h, tol, land);
+        }
         double err = 0.0;
         if (st == GA_OK)
             st = error_norm(h, land ? t_stop : trial_.t, err);

@@ -37,43 +37,64 @@ void Solver::set_first_order(int r)
     invalidate_jacobian();
 }
 
-// The w the step starts from (as a_n for q): after ga_init the corrected start of sec. 11,
-// w_0 = y'_0 + (alpha_m1 - alpha_f1) h y''_0, or y'_0 without it; after a change of h, w_n
-// rescaled to the new h, w_n <- y'_n + (h / h_last) (w_n - y'_n), as a_n is (sec. 1.2).
+// The w (and y') the step starts from, as a_n (and qdd_n) for q: after a fresh start those of
+// first_order_starting_values; after a change of h, w_n rescaled to the new h,
+// w_n <- y'_n + (h / h_last) (w_n - y'_n), as a_n is (sec. 1.2).
 void Solver::first_order_start(double h)
 {
     const State &s = accepted_;
     w_start_ = &s.w;
-    if (fresh_start_ && corrected_start) {
-        w_start_ = &w_n_;  // first_order_starting_values filled it
-    } else if (fresh_start_) {
-        w_start_ = &s.ydot;
+    ydot_start_ = &s.ydot;
+    if (fresh_start_) {
+        w_start_ = &w_n_;  // first_order_starting_values filled them
+        ydot_start_ = &ydot_n_;
     } else if (rescale_a && s.h_last > 0.0 && h != s.h_last) {
         w_n_ = s.ydot + (h / s.h_last) * (s.w - s.ydot);
         w_start_ = &w_n_;
     }
 }
 
-// h y''_0 by a central difference of g along the Taylor polynomial of the start at t0 -+ h
-// (the h^2 y''_0 / 2 left out of y cancels in the difference); w_n_ = y'_0 + delta h y''_0.
-// qdd_start_ is the start's consistent qdd.
+// The start of a fresh step's recursion for y. h y''_0 by a central difference of g along the
+// Taylor polynomial of the start at t0 -+ h (the h^2 y''_0 / 2 left out of y cancels in the
+// difference); w_0 = y'_0 + delta h y''_0 with the corrected start (sec. 11), y'_0 without.
+// A state whose rate changes by more than itself within the step, |h y''_0| > |y'_0|, does not
+// follow its start over the step -- a stiff one off its equilibrium, tau' = (u - tau) / T with
+// h / T = 1e4: its y'_0 = 6 / T carried into the step put tau 3 755 off -- and starts the
+// recursion from rest instead, w_0 = y'_0 = 0 in the step: its first step is then implicit in
+// y' alone, monotone, and what it drops, h |y'_0| < h^2 |y''_0|, is within the step's local
+// error where y is smooth (sec. 11, "Stiff start"). Rates that overflow along the polynomial
+// (a stiff nonlinear g) count as such for every state. Fixed steps only: an adaptive step's
+// error control shrinks h until the start is followed. qdd_start_ is the start's qdd.
 ga_status Solver::first_order_starting_values(double h)
 {
     const State &s = accepted_;
     State &x = trial_;  // scratch: the step has not started
-    for (int side = 0; side < 2; ++side) {
+    bool overflow = false;
+    for (int side = 0; side < 2 && !overflow; ++side) {
         const double sh = side == 0 ? h : -h;
         x.q = s.q + sh * s.v + (0.5 * sh * sh) * *qdd_start_;
         x.v = s.v + sh * *qdd_start_;
         x.y = s.y + sh * s.ydot;
         Vec &out = side == 0 ? gx_ : dy_;
         if (auto st = model.rate(s.t + sh, x.q, x.v, x.y, out)) {
-            diag.append(" (corrected starting values of the first-order states, h = %g)", h);
+            if (st == GA_ERR_NONFINITE && all_finite(x.y)) {
+                overflow = true;
+                diag.clear();
+                continue;
+            }
+            diag.append(" (starting values of the first-order states, h = %g)", h);
             return st;
         }
     }
     const double delta = params1.alpha_m - params1.alpha_f;
-    w_n_ = s.ydot + (0.5 * delta) * (gx_ - dy_);
+    for (int k = 0; k < r(); ++k) {
+        const double h_ydd = overflow ? 0.0 : 0.5 * (gx_[k] - dy_[k]);  // h y''_0
+        // (adaptive steps resolve such a start by their error control instead)
+        const bool follows =
+            adaptive_attempt_ || (!overflow && !(std::fabs(h_ydd) > std::fabs(s.ydot[k])));
+        ydot_n_[k] = follows ? s.ydot[k] : 0.0;
+        w_n_[k] = !follows ? 0.0 : corrected_start ? s.ydot[k] + delta * h_ydd : s.ydot[k];
+    }
     return GA_OK;
 }
 
@@ -85,7 +106,7 @@ void Solver::predict_first_order(double h)
     State &x = trial_;
     const FirstOrderParams &p = params1;
     const Vec &w_n = *w_start_;
-    x.ydot = (w_n - p.alpha_f * s.ydot) / (1.0 - p.alpha_f);
+    x.ydot = (w_n - p.alpha_f * *ydot_start_) / (1.0 - p.alpha_f);
     x.y = s.y + h * w_n;
 }
 
@@ -200,7 +221,7 @@ void Solver::finish_first_order(State &x)
 {
     const FirstOrderParams &p = params1;
     const Vec &w_n = *w_start_;
-    x.w = (p.alpha_f * accepted_.ydot - p.alpha_m * w_n + (1.0 - p.alpha_f) * x.ydot) /
+    x.w = (p.alpha_f * *ydot_start_ - p.alpha_m * w_n + (1.0 - p.alpha_f) * x.ydot) /
           (1.0 - p.alpha_m);
     x.w_prev = w_n;
 }

@@ -293,8 +293,10 @@ ga_status Solver::sensitivity_by_differences(double h, bool taylor_step, bool re
                 take(out.v, *v_start_);
                 take(out.a, *a_start_);
                 take(out.qdd, *qdd_start_);
-                if (r() > 0)
+                if (r() > 0) {
                     take(out.w, *w_start_);
+                    take(out.ydot, *ydot_start_);
+                }
             }
             return GA_OK;
         };
@@ -302,15 +304,15 @@ ga_status Solver::sensitivity_by_differences(double h, bool taylor_step, bool re
         const bool first_order = r() > 0;
         const auto fields = [&](StateDerivative &x) {
             std::array<Vec *, 8> f{&x.v, &x.a, &x.qdd, nullptr, nullptr, nullptr, nullptr, nullptr};
-            if (first_order)
+            if (first_order) {
                 f[3] = &x.w;
+                f[7] = &x.ydot;  // (of a start: its y' as the step uses it)
+            }
             if (taylor_step) {
                 f[4] = &x.q;
                 f[5] = &x.lambda;
-                if (first_order) {
+                if (first_order)
                     f[6] = &x.y;
-                    f[7] = &x.ydot;
-                }
             }
             return f;
         };
@@ -583,6 +585,7 @@ ga_status Solver::sensitivity_step(double h)
         // first-order states: the w the step started from, and the predictor with y' = 0
         const FirstOrderParams &p1 = params1;
         const Vec *sw = &sn.w;
+        const Vec &sydot = z.start_given ? z.start[j].ydot : sn.ydot;
         if (r() > 0) {
             if (z.start_given) {
                 sw = &z.start[j].w;
@@ -591,7 +594,7 @@ ga_status Solver::sensitivity_step(double h)
                 sw = &z.w0;
             }
             s1.ydot.setZero();
-            s1.w = (p1.alpha_f * sn.ydot - p1.alpha_m * *sw) / (1.0 - p1.alpha_m);
+            s1.w = (p1.alpha_f * sydot - p1.alpha_m * *sw) / (1.0 - p1.alpha_m);
             s1.y = sn.y + h * ((1.0 - p1.gamma) * *sw + p1.gamma * s1.w);
         }
         // predictor, eqs. (3)-(5) with qdd_{n+1} = 0
@@ -655,7 +658,7 @@ ga_status Solver::sensitivity_step(double h)
             }
             s1.y += z.dy;
             s1.ydot = first_order_newton_coefficient(p1, h) * z.dy;
-            s1.w = (p1.alpha_f * sn.ydot - p1.alpha_m * *sw + (1.0 - p1.alpha_f) * s1.ydot) /
+            s1.w = (p1.alpha_f * sydot - p1.alpha_m * *sw + (1.0 - p1.alpha_f) * s1.ydot) /
                    (1.0 - p1.alpha_m);
         }
         const Vec &dw = index2 ? z.w : z.d;

@@ -260,7 +260,7 @@ ga_status Solver::setup_workspace()
             x->setZero(n_);
         for (Vec *x : {&z_zero_, &z_l_, &z_e_})
             x->setZero(m_);
-        for (Vec *x : {&rate_, &ry_, &gx_, &dy_, &w_n_, &y_tmp_, &z_y_})
+        for (Vec *x : {&rate_, &ry_, &gx_, &dy_, &w_n_, &ydot_n_, &y_tmp_, &z_y_})
             x->setZero(r1);
         schur_valid_ = false;
     }
@@ -454,6 +454,7 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
         AdjointRecord &r = adjoint_;
         r.pending_tol = tol;
         r.pending_sliver = sliver_allowed;
+        r.pending_adaptive = adaptive_attempt_;
         const double reuse[5] = {jacobian_valid_ ? 1.0 : 0.0, theta_prev_,
                                  static_cast<double>(refresh_steps_left_),
                                  static_cast<double>(reuse_backoff_), fd_tangents_ ? 1.0 : 0.0};
@@ -622,7 +623,7 @@ ga_status Solver::prepare_start(double h, bool restart_short)
         a_start_ = &a_n_;
     }
     if (r() > 0) {
-        if (fresh_start_ && corrected_start)
+        if (fresh_start_)
             if (auto st = first_order_starting_values(h))
                 return st;
         first_order_start(h);
@@ -688,6 +689,7 @@ ga_status Solver::sliver_step(double h)
     x.c_count = 1;
     a_start_ = &x.a;  // for the error estimate of adaptive steps: none from this step
     w_start_ = &x.w;  // (likewise for the first-order states)
+    ydot_start_ = &s.ydot;
     last_newton_iters_ = 0;
     // No iteration: the test's verdicts (diverged, which the error estimate reads) are not
     // those of an earlier step's Newton, which a restored checkpoint does not carry.

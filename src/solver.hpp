@@ -471,8 +471,10 @@ private:
     Eigen::PartialPivLU<Mat> C1_lu_;
     Vec z_rhs_, z_zero_, z_d_, z_w_, z_l_, z_e_, z_y_;
     Vec rate_, ry_, gx_, dy_, w_n_, y_tmp_;  // gx_: G x0, or scratch of the start
+    Vec ydot_n_;  // the start's y' as a fresh start's step uses it (first_order.cpp)
     Vec out_y_;  // y at an interpolated time, for consistent output
-    const Vec *w_start_ = nullptr;
+    const Vec *w_start_ = nullptr, *ydot_start_ = nullptr;
+    bool adaptive_attempt_ = false;  // the step being attempted is an adaptive one
     double Cg_q_norm_ = 0.0, Cg_v_norm_ = 0.0;  // |C^-1 g_q|, |C^-1 g_v| (convergence test)
 };
 

@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <math.h>
 #include <stdlib.h>
 
 #include <cmocka.h>
@@ -556,6 +557,94 @@ static void sparse_path_gives_the_dense_solution(void **state)
     }
 }
 
+/* ---- a stiff state started off its equilibrium: tau' = (u(t) - tau) / T, u = -6 cos t ---- */
+/* tau0 = 0 against u(0) = -6: the start's rate 6 / T is no rate the step can follow at
+ * h / T = 1e1 ... 1e10 (h = 1e-2). Carried into the first step it put tau - u at -3 755 (T =
+ * 1e-6) and made Newton fail from T = 1e-7 on. The first step absorbs it: at rho_inf = 0 tau
+ * moves monotonically towards u, else |tau - u| never grows and falls by rho_inf per step;
+ * afterwards order 2 against the exact solution
+ *     tau(t) = A (cos t + T sin t) / (1 + T^2) - A / (1 + T^2) exp(-t / T),  A = -6. */
+static double g_tau_T;
+static int tau_rate(double t, const double *q, const double *v, const double *y,
+                    double *ydot, void *u)
+{
+    (void)q, (void)v, (void)u;
+    ydot[0] = (-6.0 * cos(t) - y[0]) / g_tau_T;
+    return 0;
+}
+static int no_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)q, (void)v, (void)u;
+    f[0] = 0.0;
+    return 0;
+}
+static double tau_exact(double t, double T)
+{
+    const double A = -6.0, decay = t / T < 700.0 ? exp(-t / T) : 0.0;
+    return A * (cos(t) + T * sin(t)) / (1.0 + T * T) - A / (1.0 + T * T) * decay;
+}
+/* tau at t = 1 after steps of h; the largest |tau - u| over the steps after the first, and
+ * |tau_1 - u_1|, with tau_1 between tau_0 and u_1 at rho_inf = 0 */
+static double tau_run(double T, double rho, double h, double *first, double *later,
+                      int *monotone)
+{
+    g_tau_T = T;
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(1, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, one_mass, no_force, NULL, NULL, NULL), GA_OK);
+    assert_int_equal(ga_set_first_order(s, 1, NULL, tau_rate), GA_OK);
+    assert_int_equal(ga_set_rho_inf(s, rho), GA_OK);
+    const double q0 = 0.0, v0 = 0.0, y0 = 0.0;
+    assert_int_equal(ga_init_y(s, 0.0, &q0, &v0, &y0), GA_OK);
+    const int steps = (int)lround(1.0 / h);
+    double tau = 0.0;
+    *later = 0.0;
+    for (int k = 1; k <= steps; ++k) {
+        const ga_status st = ga_step(s, h);
+        if (st != GA_OK)
+            print_error("T = %g, rho_inf %g, step %d: %s\n", T, rho, k, ga_last_error(s));
+        assert_int_equal(st, GA_OK);
+        assert_int_equal(ga_get_y(s, &tau, NULL), GA_OK);
+        const double off = fabs(tau - (-6.0 * cos(k * h)));
+        if (k == 1) {
+            *first = off;
+            *monotone = tau <= 0.0 && tau >= -6.0 * cos(h);
+        } else {
+            *later = fmax(*later, off);
+        }
+    }
+    ga_free(s);
+    return tau;
+}
+static void a_stiff_state_off_its_equilibrium_is_absorbed(void **state)
+{
+    (void)state;
+    const double rhos[] = {0.0, 0.5, 0.9, 1.0};
+    for (double T = 1e-3; T >= 1e-12 * 0.99; T *= 1e-3)
+        for (size_t r = 0; r < 4; ++r) {
+            double first = 0.0, later = 0.0, e[3];
+            int monotone = 0;
+            for (int i = 0; i < 3; ++i) {
+                const double h = 2e-2 / (1 << i);
+                e[i] = fabs(tau_run(T, rhos[r], h, &first, &later, &monotone) -
+                            tau_exact(1.0, T));
+                if (i == 1) {  /* h = 1e-2 */
+                    printf("  T = %.0e, rho_inf %.1f, h = 1e-2: |tau - u| 6 at t0, %.2g after "
+                           "step 1, at most %.2g after\n", T, rhos[r], first, later);
+                    assert_true(first < 6.0);
+                    /* (rho_inf = 1 keeps it: modulus 1, and u's own drift beside it) */
+                    assert_true(later <= (rhos[r] < 1.0 ? 1.0 : 1.01) * first);
+                    if (rhos[r] == 0.0)
+                        assert_true(monotone);
+                }
+            }
+            printf("    error at t = 1 for h = 2e-2, 1e-2, 5e-3: %.2g %.2g %.2g\n", e[0], e[1],
+                   e[2]);
+            if (rhos[r] < 1.0)  /* order 2, or the start's transient damped faster still */
+                assert_true(e[1] <= 0.3 * e[0] + 1e-13 && e[2] <= 0.3 * e[1] + 1e-13);
+        }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -569,6 +658,7 @@ int main(void)
         cmocka_unit_test(events_on_the_states),
         cmocka_unit_test(refusals_and_failures),
         cmocka_unit_test(sparse_path_gives_the_dense_solution),
+        cmocka_unit_test(a_stiff_state_off_its_equilibrium_is_absorbed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
