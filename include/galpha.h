@@ -124,6 +124,9 @@ typedef enum ga_status {
                                      2 % of their size (recoverable: retry with a smaller h,
                                      or take the stabilized index-2 formulation); see
                                      ga_set_resolution_check */
+    GA_ERR_DERIVATIVE = -13,    /**< ga_check_derivatives: a derivative callback disagrees with
+                                     central differences (or a constraint has a zero
+                                     gradient); the message names the worst entries */
     GA_EVENT = 1,               /**< not an error: ga_step, ga_step_adaptive or ga_advance stopped
                                      at a terminal event (or with its event log full); see
                                      ga_set_events */
@@ -1087,6 +1090,29 @@ typedef enum ga_info {
                                        index 2 (which holds it) */
 } ga_info;
 #define GA_INFO_COUNT 6
+
+/** Checks every derivative callback given -- the constraint Jacobian (of ga_set_callbacks),
+ *  ga_set_constraint_dt, ga_set_constraint_accel, ga_set_tangents (K_t, C_t), ga_set_coupling
+ *  (g_q, g_v, g_y, f_y) and the parameter derivatives (ga_set_parameter_derivatives,
+ *  ga_set_constraint_parameter_derivative) -- at the state (t, q, v, qdd, lambda, y) against
+ *  central differences of the callbacks they derive (Phi_q of Phi in q, Phi_t of Phi in t, the
+ *  acceleration term as the second derivative of Phi along (q + s v, t + s), K_t of
+ *  r^q = M qdd - f + Phi_q^T lambda in q, C_t of -f in v, the coupling blocks of g and f, the
+ *  parameter derivatives of f, M qdd, Phi and Phi_q in p_j, perturbed in place and put back).
+ *  qdd may be NULL (zero), lambda (ones, so that K_t's constraint part is checked too) and y
+ *  (zero). Each derivative's worst entry is taken relative to its largest entry (callback or
+ *  differences; on the shipped scenes' correct callbacks the differences agree to 2e-8 at
+ *  worst, a wrong sign or factor shows as 0.5 to 2):
+ *  all within tol (say 1e-6), GA_OK and *worst (may be NULL) the largest; else
+ *  GA_ERR_DERIVATIVE, and ga_last_error names each derivative beyond tol with its worst entry
+ *  and both values. A constraint whose row of Phi_q is zero at q is GA_ERR_DERIVATIVE too
+ *  ("constraint i has a zero gradient"). The solver's state and set-up are not touched; the
+ *  evaluations are counted; O(n) evaluations of each function per derivative. Errors:
+ *  GA_ERR_ARG (NULL q or v, a value not finite, tol not > 0), GA_ERR_STATE (no callbacks, or
+ *  from a callback), callback errors. */
+GA_API ga_status ga_check_derivatives(ga_solver *s, double t, const double *q, const double *v,
+                                      const double *qdd, const double *lambda, const double *y,
+                                      double tol, double *worst);
 
 /** Value of the diagnostic `key` (a ::ga_info); 0 before anything was computed.
  *  Errors: GA_ERR_ARG (NULL or unknown key), GA_ERR_STATE (from a callback). */

@@ -245,6 +245,7 @@ GA_API const char *ga_strerror(int status)
     case GA_ERR_INTERNAL: return "internal error";
     case GA_ERR_STEP_SIZE: return "step size below its minimum";
     case GA_ERR_UNRESOLVED: return "step not resolved: h too large for the motion";
+    case GA_ERR_DERIVATIVE: return "a derivative callback disagrees with finite differences";
     case GA_EVENT: return "stopped at an event";
     case GA_STOPPED: return "stopped by the step hook";
     }
@@ -1177,6 +1178,23 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value)
         case GA_INFO_VELOCITY_RESIDUAL: *value = c.last_velocity_residual(); return GA_OK;
         default: return c.diag.fail(GA_ERR_ARG, "ga_get_info: unknown key %d", key);
         }
+    });
+}
+
+GA_API ga_status ga_check_derivatives(ga_solver *s, double t, const double *q, const double *v,
+                                      const double *qdd, const double *lambda, const double *y,
+                                      double tol, double *worst)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (!q || !v)
+            return c.diag.fail(GA_ERR_ARG, "ga_check_derivatives: q or v is NULL");
+        if (!(tol > 0.0) || !std::isfinite(t))
+            return c.diag.fail(GA_ERR_ARG, "ga_check_derivatives: tol = %g must be > 0, t = %g "
+                               "finite", tol, t);
+        if (!c.model.ready())
+            return c.diag.fail(GA_ERR_STATE, "ga_check_derivatives needs the callbacks "
+                               "(ga_set_callbacks)");
+        return c.check_derivatives(t, q, v, qdd, lambda, y, tol, worst);
     });
 }
 

@@ -248,6 +248,19 @@ ga_status Solver::select_active_constraints(double t, const Vec &q)
 // (a massless coordinate that no constraint fixes). ga_init only (it allocates).
 void Solver::explain_singular_saddle_point()
 {
+    // A row of zeros is no redundancy to drop but a constraint degenerate at this q (the
+    // square of a distance that is zero, a Jacobian callback that left the row out).
+    Vec row_max = Vec::Zero(m_);
+    for (Eigen::Index k = 0; k < J_.size(); ++k) {
+        const int row = J_.dense() ? static_cast<int>(k % J_.rows()) : J_.row_index()[k];
+        row_max[row] = std::max(row_max[row], std::fabs(J_.data()[k]));
+    }
+    for (int i = 0; i < m_; ++i)
+        if (constraint_active(i) && row_max[i] == 0.0) {
+            diag.append(": constraint %d has a zero gradient at this q (its row of Phi_q is "
+                        "zero: ga_check_derivatives checks Phi_q against Phi)", i);
+            return;
+        }
     std::vector<unsigned char> independent(m_);
     const int rank = m_ > 0 ? independent_in_order(J_, n_, m_, independent.data()) : -1;
     if (rank < 0) {

@@ -210,6 +210,10 @@ public:
     int last_newton_iters() const { return last_newton_iters_; }
     double last_newton_ratio() const { return convergence_.ratio(); }
     double last_velocity_residual() const { return velocity_residual_; }
+    // derivative_check.cpp: ga_check_derivatives (the C API validated the pointers)
+    ga_status check_derivatives(double t, const double *q, const double *v, const double *qdd,
+                                const double *lambda, const double *y, double tol,
+                                double *worst);
 
     // Checkpoint (checkpoint.cpp, layout 4): the state, the step-size control, and what
     // rebuilds the kept iteration matrix and the pivots of every sparse LU bit for bit, so

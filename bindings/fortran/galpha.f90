@@ -21,7 +21,7 @@ module galpha
        GA_ERR_NOMEM = -3, GA_ERR_CALLBACK = -4, GA_ERR_CALLBACK_RETRY = -5, &
        GA_ERR_NONFINITE = -6, GA_ERR_SINGULAR = -7, GA_ERR_NEWTON = -8, &
        GA_ERR_INCONSISTENT = -9, GA_ERR_INTERNAL = -10, GA_ERR_STEP_SIZE = -11, &
-       GA_ERR_UNRESOLVED = -12, GA_EVENT = 1, GA_STOPPED = 2
+       GA_ERR_UNRESOLVED = -12, GA_ERR_DERIVATIVE = -13, GA_EVENT = 1, GA_STOPPED = 2
   ! ---- options ----------------------------------------------------------------------------
   integer(c_int), parameter, public :: GA_TANGENT_AUTO = 0, GA_TANGENT_FD = 1, &
        GA_TANGENT_NEGLECT = 2
@@ -389,6 +389,14 @@ module galpha
        type(c_ptr), value :: s
        real(c_double), value :: limit
      end function ga_set_resolution_check
+     integer(c_int) function ga_check_derivatives(s, t, q, v, qdd, lambda, y, tol, worst) &
+          bind(C, name="ga_check_derivatives")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s, qdd, lambda, y
+       real(c_double), value :: t, tol
+       real(c_double), intent(in) :: q(*), v(*)
+       real(c_double), intent(out) :: worst
+     end function ga_check_derivatives
      integer(c_int) function ga_set_redundant_constraints(s, mode) &
           bind(C, name="ga_set_redundant_constraints")
        import :: c_int, c_ptr
@@ -613,6 +621,7 @@ module galpha
        ga_set_jacobian_reuse, ga_set_constant_mass, ga_set_pattern, ga_set_pattern_csc, &
        ga_set_linear_solver, &
        ga_linear_solver_name, ga_set_formulation, ga_set_resolution_check, &
+       ga_check_derivatives, &
        ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
@@ -649,6 +658,9 @@ module galpha
      procedure :: set_formulation => solver_set_formulation
      !> set_resolution_check(limit): index 3's velocity-constraint limit (ga_set_resolution_check)
      procedure :: set_resolution_check => solver_set_resolution_check
+     !> check_derivatives(t, q, v, worst [, qdd, lambda, y, tol]): the derivative callbacks
+     !> against central differences (ga_check_derivatives; tol 1e-6 unless given)
+     procedure :: check_derivatives => solver_check_derivatives
      !> set_pattern(which, rows, cols): the sparsity of GA_MATRIX_MASS, _JACOBIAN, _STIFFNESS or
      !> _DAMPING with Fortran (1-based) row and column numbers; the callback of that matrix then
      !> fills size(rows) values in this order (GA_ERR_ARG, without a message, if rows and cols
@@ -1167,6 +1179,26 @@ contains
     integer(c_int), intent(in) :: formulation
     status = ga_set_formulation(this%handle, formulation)
   end function solver_set_formulation
+
+  integer(c_int) function solver_check_derivatives(this, t, q, v, worst, qdd, lambda, y, tol) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t, q(:), v(:)
+    real(c_double), intent(out) :: worst
+    real(c_double), intent(in), optional, target :: qdd(:), lambda(:), y(:)
+    real(c_double), intent(in), optional :: tol
+    type(c_ptr) :: pqdd, plambda, py
+    real(c_double) :: tolerance
+    pqdd = c_null_ptr
+    plambda = c_null_ptr
+    py = c_null_ptr
+    tolerance = 1d-6
+    if (present(qdd)) pqdd = c_loc(qdd)
+    if (present(lambda)) plambda = c_loc(lambda)
+    if (present(y)) py = c_loc(y)
+    if (present(tol)) tolerance = tol
+    status = ga_check_derivatives(this%handle, t, q, v, pqdd, plambda, py, tolerance, worst)
+  end function solver_check_derivatives
 
   integer(c_int) function solver_set_resolution_check(this, limit) result(status)
     class(galpha_solver), intent(inout) :: this

@@ -485,7 +485,7 @@ static void check(ga_solver *s, ga_status st, int changes_solver, const char *ca
 {
     const int stepping = strcmp(call, "ga_step") == 0 || strcmp(call, "ga_step_adaptive") == 0 ||
                          strcmp(call, "ga_advance") == 0;
-    if (st > (stepping ? GA_STOPPED : GA_OK) || st < GA_ERR_UNRESOLVED)
+    if (st > (stepping ? GA_STOPPED : GA_OK) || st < GA_ERR_DERIVATIVE)
         SEQ_FAIL("sequence %d: %s returned %d, not a ga_status", seq, call, st);
     if (st < GA_OK && changes_solver && ga_last_error(s)[0] == '\0')
         SEQ_FAIL("sequence %d: %s failed (%s) without a message", seq, call, ga_strerror(st));

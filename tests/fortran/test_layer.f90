@@ -178,7 +178,7 @@ program test_layer
   type(galpha_solver) :: s, r
   real(c_double) :: q(2), v(2), a(2), lam(1), q2(2), v2(2), lam2(1), x, am, af, beta, gam
   real(c_double), allocatable :: ckpt(:), back(:)
-  real(c_double) :: quarter, ag, bg, ag_next, te
+  real(c_double) :: quarter, ag, bg, ag_next, te, worst
   integer(c_int) :: index, direction
   real(c_double), parameter :: rho = 0.8d0
   integer :: n, m, i, nstate
@@ -423,6 +423,9 @@ program test_layer
      call ok(r%set_callbacks(plane_mass, plane_force, rail, rail_jacobian), 'callbacks')
      call ok(r%set_formulation(GA_INDEX2_STABILIZED), 'index 2')
      call ok(r%set_resolution_check(0.02d0), 'set_resolution_check')
+     call ok(r%check_derivatives(0.0d0, [0.5d0, 1.0d0], [0.0d0, 0.0d0], worst), &
+          'check_derivatives')
+     call expect(worst < 1d-6, 'check_derivatives: the callbacks agree with differences')
      call expect(r%set_resolution_check(0.0d0) == GA_ERR_ARG, 'set_resolution_check(0) refused')
      call ok(r%set_sensitivity(stiffness, ior(GA_DEPENDS_FORCE, GA_DEPENDS_CONSTRAINT)), &
           'set_sensitivity (constraint)')

@@ -778,3 +778,35 @@ def test_ctrl_c_stops_a_run_every_time():
             s.step(1e-4)          # consistent: it steps on from the last accepted state
             assert s.t == pytest.approx(t + 1e-4)
     assert stopped == 30
+
+
+def test_check_derivatives_names_a_wrong_tangent():
+    """ga_check_derivatives through the binding: the pendulum's exact K_t = lambda I agrees,
+    a sign flipped in it is named with both values (DerivativeError)."""
+    def stiffness(t, q, v, qdd, lam, K):
+        K[:] = lam[0] * np.eye(2)
+
+    def wrong(t, q, v, qdd, lam, K):
+        K[:] = lam[0] * np.eye(2)
+        K[1, 1] = -K[1, 1]
+
+    q, v = Q0, np.array([0.3, 0.2])
+    with pendulum(stiffness=stiffness) as s:
+        worst = s.check_derivatives(0.0, q, v, lam=[2.0])
+        assert 0.0 <= worst < 1e-8
+    with pendulum(stiffness=wrong) as s:
+        with pytest.raises(galpha.DerivativeError, match=r"K_t\(1, 1\) = -2 by the callback"):
+            s.check_derivatives(0.0, q, v, lam=[2.0])
+    with pendulum() as s:
+        with pytest.raises(galpha.DerivativeError, match="constraint 0 has a zero gradient"):
+            s.check_derivatives(0.0, [0.0, 0.0], [0.0, 0.0])
+        with pytest.raises(ValueError):
+            s.check_derivatives(0.0, [1.0], [0.0, 0.0])
+
+
+def test_sizes_refused_by_name():
+    """Solver(2, 3) says why, not only "invalid argument"."""
+    with pytest.raises(galpha.ArgumentError, match=r"n=2, m=3.*0 <= m <= n"):
+        galpha.Solver(2, 3, mass)
+    with pytest.raises(galpha.ArgumentError, match="n >= 1"):
+        galpha.Solver(0, 0, mass)

@@ -26,6 +26,7 @@ from ._ffi import (GA_DEPENDS_CONSTRAINT, GA_DEPENDS_FORCE, GA_DEPENDS_MASS,  # 
                    GA_REUSE_AUTO, GA_REUSE_NEVER, GA_TANGENT_AUTO, GA_TANGENT_FD,
                    GA_TANGENT_NEGLECT)
 from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceError,  # noqa: F401
+                     DerivativeError,
                      GalphaError, InconsistentError, InternalError, NonFiniteError,
                      OutOfMemoryError, RecoverableError, SingularMatrixError, StateError,
                      StepSizeError, UnresolvedError)

@@ -128,6 +128,7 @@ GA_ERR_INCONSISTENT = -9
 GA_ERR_INTERNAL = -10
 GA_ERR_STEP_SIZE = -11
 GA_ERR_UNRESOLVED = -12
+GA_ERR_DERIVATIVE = -13
 GA_EVENT = 1  # not an error: a stepping call stopped at an event
 GA_STOPPED = 2  # not an error: the step hook asked to stop
 
@@ -200,6 +201,8 @@ _SIGNATURES = {
     "ga_get_counter": (_I, [_S, _I, _P(ctypes.c_longlong)]),
     "ga_reset_counters": (_I, [_S]),
     "ga_get_info": (_I, [_S, _I, _P(_D)]),
+    "ga_check_derivatives": (_I, [_S, _D, c_double_p, c_double_p, c_double_p, c_double_p,
+                             c_double_p, _D, _P(_D)]),
     "ga_set_jacobian_reuse": (_I, [_S, _I]),
     "ga_set_constant_mass": (_I, [_S, _I]),
     "ga_set_pattern": (_I, [_S, _I, _I, _P(_I), _P(_I)]),

@@ -74,10 +74,16 @@ class UnresolvedError(RecoverableError):
     status = _ffi.GA_ERR_UNRESOLVED
 
 
+class DerivativeError(GalphaError, ValueError):
+    """Solver.check_derivatives: a derivative callback disagrees with central differences (or
+    a constraint has a zero gradient); the message names the worst entries."""
+    status = _ffi.GA_ERR_DERIVATIVE
+
+
 _BY_STATUS = {cls.status: cls for cls in (
     ArgumentError, StateError, OutOfMemoryError, CallbackError, CallbackRetry, NonFiniteError,
     SingularMatrixError, ConvergenceError, InconsistentError, InternalError, StepSizeError,
-    UnresolvedError)}
+    UnresolvedError, DerivativeError)}
 
 
 def error_for(status, message):

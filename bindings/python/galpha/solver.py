@@ -263,6 +263,10 @@ class Solver:
         self._compiled.append(keep)
         self._hook = None
         self.n, self.m = int(n), int(m)
+        if self.n < 1 or self.m < 0 or self.m > self.n:  # (ga_create has no solver to say why)
+            raise error_for(_ffi.GA_ERR_ARG,
+                            f"Solver(n={self.n}, m={self.m}): needs n >= 1 coordinates and "
+                            "0 <= m <= n constraints")
         handle = ctypes.c_void_p()
         self._check(_ffi.ga_create(self.n, self.m, ctypes.byref(handle)))
         self._ptr = handle
@@ -1019,6 +1023,31 @@ class Solver:
     def reset_counters(self):
         """Set every work counter of `stats` to zero."""
         self._check(_ffi.ga_reset_counters(self._handle()))
+
+    @_serialized
+    def check_derivatives(self, t, q, v, qdd=None, lam=None, y=None, tol=1e-6):
+        """Every derivative callback given (jacobian, stiffness, damping, constraint_accel,
+        constraint_dt, coupling, force_p, mass_p, constraint_p) at (t, q, v, qdd, lam, y)
+        against central differences of what it derives (ga_check_derivatives). Returns the
+        largest relative difference; raises DerivativeError naming each derivative beyond tol
+        with its worst entry (or a constraint with a zero gradient). qdd defaults to zero, lam
+        to ones, y to zero."""
+        arrays = []
+        for x, size in ((q, self.n), (v, self.n), (qdd, self.n), (lam, self.m), (y, None)):
+            if x is None:
+                arrays.append(None)
+                continue
+            a = np.ascontiguousarray(x, dtype=float).ravel()
+            if size is not None and a.size != size:
+                raise ValueError(f"an array of {size} values expected, got {a.size}")
+            arrays.append(a)
+        if arrays[0] is None or arrays[1] is None:
+            raise ValueError("q and v are required")
+        worst = ctypes.c_double()
+        self._check(_ffi.ga_check_derivatives(
+            self._handle(), float(t), *[None if a is None else self._dp(a) for a in arrays],
+            float(tol), ctypes.byref(worst)))
+        return worst.value
 
     @_serialized
     def info(self, key):
