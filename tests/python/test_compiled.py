@@ -376,8 +376,10 @@ def test_numba_example():
     # the exact m g (3 - 2 cos theta0) at the bottom
     script = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "python",
                           "numba_pendulum.py")
-    out = subprocess.run([sys.executable, script], check=True, capture_output=True,
-                         text=True).stdout
+    # (the example imports the source tree's package: it is told which library this process
+    # loaded, wherever the build tree lies)
+    out = subprocess.run([sys.executable, script], check=True, capture_output=True, text=True,
+                         env=dict(os.environ, GALPHA_LIBRARY=galpha._ffi.path)).stdout
     import re
     peak, exact = map(float, re.search(r"peak rod force = ([0-9.]+) N \(exact ([0-9.]+)\)",
                                        out).groups())
@@ -449,3 +451,25 @@ def test_first_order_slots_compiled():
     for a, b in zip(*runs):
         np.testing.assert_array_equal(a, b)
     assert runs[1][3] > 0 and runs[1][4] > 0
+
+
+def test_a_cfunc_with_another_signature_is_refused():
+    """numba's cfunc carries its signature: a mass callback declared without `user` (three
+    arguments) was accepted and ended in a misleading SingularMatrixError."""
+    from numba import cfunc, types
+    dp = types.CPointer(types.float64)
+
+    @cfunc(types.int32(types.float64, dp, dp))
+    def short_mass(t, q, M):
+        return 0
+
+    with pytest.raises(TypeError, match=r"short_mass has the signature int\(double, pointer, "
+                       r"pointer\).*calls it as int\(double, pointer, pointer, pointer\)"):
+        galpha.Solver(2, 1, short_mass, None, lambda t, q, phi: None, lambda t, q, J: None)
+
+    @cfunc(types.int64(types.float64, dp, dp, types.voidptr))
+    def wide_mass(t, q, M, u):
+        return 0
+
+    with pytest.raises(TypeError, match="wide_mass has the signature"):
+        galpha.Solver(2, 1, wide_mass, None, lambda t, q, phi: None, lambda t, q, J: None)

@@ -19,6 +19,11 @@ import galpha  # noqa: E402
 import galpha.ensemble  # noqa: E402
 import ensemble_models  # noqa: E402
 
+# What a subprocess needs to import the galpha this process imported (the source tree's, or
+# an installed one) and to load the same library: the build tree may lie anywhere.
+SUBPROCESS_PATH = os.pathsep.join([HERE, os.path.dirname(os.path.dirname(galpha.__file__))])
+SUBPROCESS_LIBRARY = galpha._ffi.path
+
 GRID = np.array([[L, g] for L in (0.5, 1.0, 1.5, 2.0) for g in (9.0, 9.81, 11.0)])
 TIMES = [0.0, 0.2, 0.4]
 
@@ -92,8 +97,9 @@ def test_threads_with_compiled_callbacks(workers, chunk):
 def test_dask_local_cluster(serial):
     distributed = pytest.importorskip("distributed")
     # the workers are new processes: they find the test models and galpha by PYTHONPATH
-    old = os.environ.get("PYTHONPATH")
-    os.environ["PYTHONPATH"] = os.pathsep.join([HERE, PACKAGE] + ([old] if old else []))
+    old = os.environ.get("PYTHONPATH"), os.environ.get("GALPHA_LIBRARY")
+    os.environ["PYTHONPATH"] = os.pathsep.join([SUBPROCESS_PATH] + ([old[0]] if old[0] else []))
+    os.environ["GALPHA_LIBRARY"] = SUBPROCESS_LIBRARY
     try:
         with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                       dashboard_address=None) as cluster, \
@@ -103,10 +109,11 @@ def test_dask_local_cluster(serial):
             same(serial, galpha.ensemble.run(ensemble_models.pendulum, GRID, TIMES,
                                              client=client, chunk_size=1))
     finally:
-        if old is None:
-            del os.environ["PYTHONPATH"]
-        else:
-            os.environ["PYTHONPATH"] = old
+        for name, value in zip(("PYTHONPATH", "GALPHA_LIBRARY"), old):
+            if value is None:
+                del os.environ[name]
+            else:
+                os.environ[name] = value
 
 
 def test_mpi_two_ranks(serial, tmp_path):
@@ -115,7 +122,7 @@ def test_mpi_two_ranks(serial, tmp_path):
     if mpirun is None:
         pytest.skip("mpirun not found (Debian: openmpi-bin)")
     np.save(tmp_path / "grid.npy", GRID)
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([HERE, PACKAGE]),
+    env = dict(os.environ, PYTHONPATH=SUBPROCESS_PATH, GALPHA_LIBRARY=SUBPROCESS_LIBRARY,
                OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OMPI_MCA_rmaps_base_oversubscribe="1")
     out = tmp_path / "res.npz"
@@ -248,7 +255,7 @@ def test_mpi_rank_failure_is_reported(tmp_path):
     if mpirun is None:
         pytest.skip("mpirun not found (Debian: openmpi-bin)")
     np.save(tmp_path / "grid.npy", GRID[:3])
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([HERE, PACKAGE]),
+    env = dict(os.environ, PYTHONPATH=SUBPROCESS_PATH, GALPHA_LIBRARY=SUBPROCESS_LIBRARY,
                OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OMPI_MCA_rmaps_base_oversubscribe="1")
     out = subprocess.run([mpirun, "-n", "2", sys.executable, "-m", "galpha.ensemble",
@@ -257,3 +264,57 @@ def test_mpi_rank_failure_is_reported(tmp_path):
                          env=env, capture_output=True, text=True, timeout=300)
     assert out.returncode != 0
     assert "must return a galpha.ensemble.Case" in out.stderr
+
+
+@pytest.mark.parametrize("engine", ["serial", "threads", "processes"])
+def test_a_model_that_returns_no_case_is_a_type_error(engine):
+    """Every chunk says so (threads and processes cached the wrong object before checking it
+    and said AttributeError from the second chunk on)."""
+    with pytest.raises(TypeError, match="must return a galpha.ensemble.Case, not int"):
+        galpha.ensemble.run(ensemble_models.not_a_case, GRID, TIMES, engine=engine, workers=2,
+                            chunk_size=1)
+
+
+@pytest.mark.parametrize("engine", ["threads", "processes"])
+def test_ctrl_c_stops_the_sweep_at_once(engine):
+    """Ctrl-C in the middle of a sweep: the pending runs are cancelled, the running ones end
+    (threads between runs, worker processes terminated), Interrupted carries what finished;
+    no process is left. (It was raised when the whole sweep had finished.)"""
+    import multiprocessing
+    import signal
+    import threading
+    import time
+    grid = np.repeat(GRID, 100, axis=0)  # 1 200 runs, about 20 s on two workers
+    timer = threading.Timer(1.5, signal.pthread_kill,
+                            (threading.main_thread().ident, signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(galpha.ensemble.Interrupted) as e:
+            galpha.ensemble.run(ensemble_models.pendulum, grid, TIMES, engine=engine,
+                                workers=2, chunk_size=4)
+    finally:
+        timer.cancel()
+    elapsed = time.monotonic() - start
+    res = e.value.result
+    done = np.count_nonzero(res.status != 2)
+    print("  %s: interrupted after %.1f s, %d of %d runs finished" % (engine, elapsed, done,
+                                                                      len(grid)))
+    assert isinstance(e.value, KeyboardInterrupt)
+    assert elapsed < 6.0
+    assert 0 < done < len(grid)
+    assert np.all(res.status[res.status != 2] == 0)
+    assert np.all(np.isnan(res.q[res.status == 2]))
+    assert all(m == "not run: the sweep was interrupted" for m, st in zip(res.message,
+                                                                       res.status) if st == 2)
+    assert multiprocessing.active_children() == []
+
+
+def test_a_sweep_in_a_worker_importing_the_script_is_refused():
+    """A script without the __main__ guard is imported as __mp_main__ by spawned workers (Dask's
+    LocalCluster): the sweep it would start again there is refused, by name."""
+    code = ("import galpha.ensemble, ensemble_models\n"
+            "galpha.ensemble.run(ensemble_models.pendulum, GRID, TIMES)\n")
+    scope = {"__name__": "__mp_main__", "GRID": GRID, "TIMES": TIMES}
+    with pytest.raises(RuntimeError, match=r'if __name__ == "__main__":'):
+        exec(code, scope)

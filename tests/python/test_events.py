@@ -198,3 +198,18 @@ def test_solver_level_events_and_failures():
         assert s.advance(2.0) is False and s.events == []
         with pytest.raises(TypeError):
             s.set_events([3.0])
+
+
+@pytest.mark.parametrize("value, shown", [(None, "None"), ("0.5", "'0.5'"),
+                                          (np.array([0.1, 0.2]), "array")])
+def test_an_event_function_returning_no_number_is_named(value, shown):
+    """None was reported as "g[0] = nan is not finite", a string "0.5" taken as 0.5, an array of
+    two values gave numpy's bare "setting an array element with a sequence"."""
+    def odd(t, q, v, lam):
+        return value
+    with galpha.Solver(2, 1, mass, force, constraint, jacobian) as s:
+        s.init(0.0, *state(0.5, 0.0))
+        s.set_events([odd])
+        with pytest.raises(TypeError, match=r"event function 0 \(odd\) returned %s.*expected "
+                           r"one number" % shown):
+            s.step(1e-2)

@@ -19,10 +19,11 @@ Engines: "serial"; "threads" (the C library is re-entrant and ctypes releases th
 runs, so compiled callbacks run in parallel; Python callbacks take the GIL); "processes"
 (concurrent.futures); client=<dask.distributed.Client> (Debian: python3-distributed); "mpi"
 (mpi4py, Debian: python3-mpi4py): every rank calls run() with the same arguments, rank 0 gets
-the result, the others None -- `mpirun -n 4 python3 -m galpha.ensemble module:model ...` runs a
+the result, the others None -- `mpirun -n 2 python3 -m galpha.ensemble module:model ...` runs a
 sweep from the command line. Nothing here imports dask or mpi4py unless asked for.
 """
 import concurrent.futures
+import inspect
 import math
 import os
 import pickle
@@ -33,7 +34,7 @@ import numpy as np
 from .errors import GalphaError
 from .integrate import _Fields, _progress_bar
 
-__all__ = ["Case", "EnsembleResult", "run"]
+__all__ = ["Case", "EnsembleResult", "Interrupted", "run"]
 
 
 class Case:
@@ -70,7 +71,8 @@ class Case:
 class EnsembleResult(_Fields):
     """times (T,); q, v (runs, T, n); lam (runs, T, m); y (runs, T, r) with first-order states;
     status (runs,) 0, 1 if a terminal event or the step hook ended the run before the last
-    output time (what it reached is recorded; Case.summary is called), or the negative
+    output time (what it reached is recorded; Case.summary is called), 2 for a run an
+    interrupted sweep did not make (Interrupted.result), or the negative
     ga_status of a failure (-4 for an exception in a callback); message (list of str, "" for
     success); steps (runs,) accepted steps; summary: dict of
     arrays (runs, ...) from Case.summary (NaN for failed runs); failures: [(run, message)].
@@ -96,10 +98,11 @@ def _case(model):
         key = pickle.dumps(model)
     case = cases.get(key)
     if case is None:
-        case = cases[key] = model()
-        if not isinstance(case, Case):
+        case = model()
+        if not isinstance(case, Case):  # (checked before it is kept: every chunk says so)
             raise TypeError("the model must return a galpha.ensemble.Case, not %s"
                             % type(case).__name__)
+        cases[key] = case
     return case
 
 
@@ -147,14 +150,28 @@ def _one(case, p, init, times, h):
     return out, status, message, s.stats["steps"], summary
 
 
-def _run_chunk(model, indices, P, initial, times, h):
-    """Runs the parameter sets P (rows) with this worker's case of the model."""
+def _run_chunk(model, indices, P, initial, times, h, cancel=None):
+    """Runs the parameter sets P (rows) with this worker's case of the model; with `cancel`
+    (threads: a threading.Event) it stops between runs once that is set."""
     case = _case(model)
     results = []
     for k, i in enumerate(indices):
+        if cancel is not None and cancel.is_set():
+            break
         init = None if initial is None else tuple(x[k] for x in initial)
         results.append((int(i),) + _one(case, P[k], init, times, h))
     return results
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during run(): the pending runs were cancelled and the workers stopped (processes
+    terminated); `result` is the EnsembleResult of the runs that finished, those that did not
+    with status 2 ("not run") and NaN values."""
+
+    def __init__(self, result):
+        super().__init__("ensemble interrupted: %d of %d runs finished"
+                         % (int(np.count_nonzero(result.status != 2)), len(result.status)))
+        self.result = result
 
 
 # ---- the whole sweep ---------------------------------------------------------------------
@@ -183,6 +200,13 @@ def run(model, parameters, times, *, initial=None, h=None, engine="serial", work
     progress : a progress bar over the runs (tqdm, optional; not under MPI): None shows it on
         a terminal once the sweep has lasted a second, True always, False never.
     """
+    # A script without `if __name__ == "__main__":` runs its sweep again in every process that
+    # imports it as __mp_main__ (the spawned workers of processes, Dask's LocalCluster): they
+    # would start workers of their own, without end (a Dask script hung for over ten minutes).
+    caller = inspect.currentframe().f_back
+    if caller is not None and caller.f_globals.get("__name__") == "__mp_main__":
+        raise RuntimeError("galpha.ensemble.run() called while a worker process imports the "
+                           "main script: put the sweep under `if __name__ == \"__main__\":`")
     P = np.ascontiguousarray(parameters, dtype=float)
     if P.ndim == 1:
         P = P[:, None]
@@ -204,9 +228,9 @@ def run(model, parameters, times, *, initial=None, h=None, engine="serial", work
         raise ValueError("unknown engine %r" % (engine,))
     workers = int(workers or os.cpu_count() or 1)
 
-    def task(idx):
+    def task(idx, cancel=None):
         return (model, idx, P[idx], None if initial is None else tuple(x[idx] for x in initial),
-                times, h)
+                times, h, cancel)
 
     if engine == "mpi":
         if comm is None:
@@ -240,6 +264,8 @@ def run(model, parameters, times, *, initial=None, h=None, engine="serial", work
             results.extend(part)
             if bar is not None:
                 bar.update(len(part))
+        cancel = threading.Event()
+        ex = futures = None
         try:
             if engine == "serial":
                 for c in pieces:
@@ -252,20 +278,63 @@ def run(model, parameters, times, *, initial=None, h=None, engine="serial", work
                 for f in as_completed(futures):
                     collect(f.result())
             else:
-                pool = (concurrent.futures.ThreadPoolExecutor if engine == "threads" else
-                        concurrent.futures.ProcessPoolExecutor)
-                with pool(max_workers=workers) as ex:
-                    futures = [ex.submit(_run_chunk, *task(c)) for c in pieces]
-                    for f in concurrent.futures.as_completed(futures):
-                        collect(f.result())
+                threads = engine == "threads"
+                ex = (concurrent.futures.ThreadPoolExecutor if threads else
+                      concurrent.futures.ProcessPoolExecutor)(max_workers=workers)
+                futures = [ex.submit(_run_chunk, *task(c, cancel if threads else None))
+                           for c in pieces]
+                for f in concurrent.futures.as_completed(futures):
+                    collect(f.result())
+        except KeyboardInterrupt:
+            # Stop now: nothing pending runs, running chunks end (threads between runs,
+            # processes terminated), and what finished is handed back.
+            cancel.set()
+            if engine == "dask" and futures:
+                client.cancel(futures)
+            elif ex is not None:
+                for f in futures or ():
+                    f.cancel()
+                if engine == "threads":  # finished runs of the chunks that stop now
+                    ex.shutdown(wait=True)
+                    for f in futures or ():
+                        if f.done() and not f.cancelled() and f.exception() is None:
+                            part = f.result()
+                            if part and part[0][0] not in {r[0] for r in results}:
+                                collect(part)
+                else:
+                    _terminate(ex)
+                ex = None
+            raise Interrupted(_stack(results, runs, times, partial=True)) from None
         finally:
+            if ex is not None:
+                ex.shutdown(wait=True)
             if bar is not None:
                 bar.close()
     return _stack(results, runs, times)
 
 
-def _stack(results, runs, times):
+def _terminate(ex):
+    """A process pool's workers, running or idle, terminated and reaped."""
+    processes = list(getattr(ex, "_processes", {}).values())
+    ex.shutdown(wait=False, cancel_futures=True)
+    for p in processes:
+        if p.is_alive():
+            p.terminate()
+    for p in processes:
+        p.join(timeout=5)
+
+
+def _stack(results, runs, times, partial=False):
     results = sorted(results, key=lambda r: r[0])
+    if partial:  # (an interrupted sweep: the runs not made, as "not run")
+        done = {r[0] for r in results}
+        shapes = results[0][1] if results else None
+        for i in range(runs):
+            if i not in done:
+                out = ([np.full_like(x, np.nan) for x in shapes] if shapes is not None
+                       else [np.full((len(times), 0), np.nan)] * 4)
+                results.append((i, out, 2, "not run: the sweep was interrupted", 0, None))
+        results = sorted(results, key=lambda r: r[0])
     if [r[0] for r in results] != list(range(runs)):
         raise RuntimeError("ensemble: runs missing from the workers' results")
     q, v, lam, y = (np.stack([r[1][k] for r in results]) for k in range(4))

@@ -68,6 +68,39 @@ def native_address(fn):
     return None
 
 
+def _kind(ctype):
+    """'i', 'd' or 'p' (any pointer) of a ctypes type, else its name."""
+    if ctype is _i:
+        return "i"
+    if ctype is _d:
+        return "d"
+    if ctype is _vp or (isinstance(ctype, type) and issubclass(ctype, ctypes._Pointer)):
+        return "p"
+    return getattr(ctype, "__name__", repr(ctype))
+
+
+def _c_signature(kinds):
+    names = {"i": "int", "d": "double", "p": "pointer"}
+    return "%s(%s)" % (names.get(kinds[0], kinds[0]),
+                       ", ".join(names.get(k, k) for k in kinds[1:]))
+
+
+def check_compiled_signature(fn, ctype, what="callback"):
+    """A numba cfunc carries its signature: one that is not the C callback's is refused by
+    name (it was accepted and failed far from here, e.g. as a singular matrix)."""
+    proto = getattr(fn, "ctypes", None)
+    if not hasattr(fn, "native_name") or proto is None:
+        return  # an address or a ctypes pointer: nothing to compare with
+    got = [_kind(getattr(proto, "restype", None))] + [_kind(a) for a in
+                                                      (getattr(proto, "argtypes", None) or ())]
+    want = [_kind(ctype._restype_)] + [_kind(a) for a in ctype._argtypes_]
+    if got != want:
+        raise TypeError("the compiled %s has the signature %s (numba: %s); galpha calls it as "
+                        "%s (see the header's ga_*_fn)" % (what, _c_signature(got),
+                                                           getattr(fn, "_sig", "?"),
+                                                           _c_signature(want)))
+
+
 def user_pointer(user):
     """(address, what keeps it alive) of the `user` argument passed to compiled callbacks: None
     (NULL), an int address, a numpy array (its data), or a ctypes object (its address)."""
@@ -624,6 +657,7 @@ class Solver:
             return None
         address = native_address(fn)
         if address is not None:
+            check_compiled_signature(fn, ctype, getattr(fn, "__name__", "callback"))
             self._compiled.append(fn)
             return ctype(address)
         if not callable(fn):
@@ -864,7 +898,13 @@ class Solver:
 
         def evaluate(t, q, v, lam, g, y=None):
             for k, fn in enumerate(functions):
-                g[k] = fn(t, q, v, lam, y) if states else fn(t, q, v, lam)
+                value = fn(t, q, v, lam, y) if states else fn(t, q, v, lam)
+                # a number, or a 0-d or one-element array: None, strings and arrays of several
+                # values are said to be what they are (numpy took "0.5" as 0.5)
+                if isinstance(value, (str, bytes)) or value is None or np.size(value) != 1:
+                    raise TypeError("event function %d (%s) returned %r: expected one number"
+                                    % (k, getattr(fn, "__name__", "?"), value))
+                g[k] = float(np.reshape(value, ()))
 
         def trampoline(t, q, v, lam, g, u):
             if lam:
@@ -910,6 +950,7 @@ class Solver:
         n, m = self.n, self.m
         address = native_address(fn)
         if address is not None:
+            check_compiled_signature(fn, _HOOK, "step hook")
             uaddr, keep = user_pointer(user) if user is not None else (self._user_address, None)
             cb = _HOOK(address)
             hold = (fn, keep)
