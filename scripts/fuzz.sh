@@ -3,7 +3,7 @@
 # builds galpha with clang, coverage instrumentation, ASan and UBSan in build-fuzz, then
 #
 #   scripts/fuzz.sh [RUNS]          CI: deterministic. A fixed seed, a fixed number of inputs
-#                                   (default 150000, about two minutes here), no corpus
+#                                   (default 60000, about two minutes here), no corpus
 #                                   reloading, from the committed corpus (tests/fuzz/corpus) and
 #                                   findings (tests/fuzz/regressions) into a fresh directory:
 #                                   the same inputs on every machine, so that a red run means
@@ -25,7 +25,7 @@ mode=${1:-ci}
 case "$mode" in
     explore) seconds=${2:?explore SECONDS} ;;
     merge) ;;
-    ci) runs=150000 ;;
+    ci) runs=60000 ;;
     *) runs=$mode; mode=ci ;;
 esac
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo \
