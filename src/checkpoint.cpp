@@ -152,18 +152,19 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
     for (std::size_t k = 4; k < len; ++k)
         if (!std::isfinite(buf[k]))
             return diag.fail(GA_ERR_ARG, "checkpoint entry %zu is not finite", k);
-    // The step-size controller's entries as a solver writes them: h_last and h_next are 0 (no
-    // step yet, no proposal) or steps that move t (ga_step refuses others); err_prev is not
-    // negative; grew is a flag. Anything else was not written by galpha, and would fail later,
-    // far from here (h_last = 1e-320 multiplies a_n by 1e317 when it is rescaled for the next
-    // step; h_next = 1e-320 ends the next adaptive step below its minimum).
+    // The step-size controller's entries as a solver writes them: h_last is 0 (no step yet) or
+    // a step that moves t (ga_step refuses others), h_next 0 (no proposal) or positive;
+    // err_prev is not negative; grew is a flag. Anything else was not written by galpha, and
+    // would fail later, far from here (h_last = 1e-320 multiplies a_n by 1e317 when it is
+    // rescaled for the next step). (h_next may be a proposal that no longer moves t -- 7e-15
+    // made near t = 0, then a ga_step to t = 1000: the solver refused its own checkpoint;
+    // an adaptive step raises a proposal to its minimum.)
     const double t = buf[4];
-    for (const int k : {5, 6}) {
-        const double h = buf[k];
-        if (h < 0.0 || (h > 0.0 && t + h == t && t - h == t))
-            return diag.fail(GA_ERR_ARG, "checkpoint entry %d (%s = %g) is not a step from "
-                             "t = %.17g", k, k == 5 ? "h_last" : "h_next", h, t);
-    }
+    if (buf[5] < 0.0 || (buf[5] > 0.0 && t + buf[5] == t && t - buf[5] == t))
+        return diag.fail(GA_ERR_ARG, "checkpoint entry 5 (h_last = %g) is not a step from "
+                         "t = %.17g", buf[5], t);
+    if (buf[6] < 0.0)
+        return diag.fail(GA_ERR_ARG, "checkpoint entry 6 (h_next = %g) is negative", buf[6]);
     if (buf[7] < 0.0 || !is_flag(buf[8]))
         return diag.fail(GA_ERR_ARG, "checkpoint entries 7-8 (err_prev = %g, grew = %g) are "
                          "not those of galpha's step-size control", buf[7], buf[8]);
