@@ -23,6 +23,11 @@ constexpr double kMinLocalTolerance = 1e-14;
 // before it counts: a's benign oscillation along the constraints (sec. 1.5c) stays below.
 constexpr double kTransientAllowance = 10.0;
 constexpr double kRoundoffUlps = 64.0;
+// The index-3 estimate solves with the step's own factorization where it was made within this
+// relative distance of q_{n+1}: 1e-3 halved Andrews' factorizations and left its steps as they
+// were; 1e-2 cost it 13 % more steps (measured: design-notes.md, "The cost of the index-3
+// estimate").
+constexpr double kFactorizedNearby = 1e-3;
 constexpr double kSafety = 0.9;
 constexpr double kMaxGrowth = 2.0, kMinShrink = 0.2;
 constexpr double kFailureShrink = 0.25;
@@ -88,15 +93,43 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
     const auto [cq, cv] = estimate_coefficients(p, h);
     Vec &eq = dq_, &ev = dw_;  // scratch
     if (consistent_estimate()) {
-        // Into the output's workspace: when the step is accepted they are its output.
         output_for_ = -1;
-        const Vec *y_before = model.y_now;
-        model.y_now = &x.y;
-        const ga_status st = consistent_output(t_end, x.q, x.v, "the error estimate");
-        model.y_now = y_before;
-        if (st)
-            return st;
-        x.c = out_qdd_;
+        estimate_is_output_ = false;
+        // ... where its Phi_q is that of q_{n+1} closely enough: a matrix kept from earlier
+        // steps projects onto the null space of an older Phi_q, and Andrews' mechanism (1e3
+        // rad/s) then took 13 % more steps with its accelerations' errors spread 6 times wider
+        // over the tolerances (docs/design-notes.md).
+        double moved = 0.0;
+        for (int i = 0; i < n_ && jacobian_valid_; ++i)
+            moved = std::max(moved,
+                             std::fabs(x.q[i] - recipe_.q[i]) / (std::fabs(x.q[i]) + 1.0));
+        if (jacobian_valid_ && moved <= kFactorizedNearby) {
+            // With the step's own factorization (the accelerations need only be consistent
+            // to the estimate's accuracy): the step's qdd corrected onto the acceleration-level
+            // constraint along S_11^-1 Phi_q^T, S_11 = beta' M + gamma' C_t + K_t ~ beta' M,
+            // instead of a saddle-point matrix of M factorized for it at every step (a third
+            // of an adaptive run's work on the slider-crank: design-notes.md, "The cost of
+            // the index-3 estimate").
+            if (auto st = model.constraint_accel(t_end, x.q, x.v, c_)) {
+                diag.append(" (consistent accelerations for the error estimate at t = %.17g)",
+                            t_end);
+                return st;
+            }
+            J_.multiply_add(1.0, x.qdd, c_);  // Phi_q qdd + the acceleration term
+            rq_.setZero();
+            S_.solve(rq_, c_, guard_q_, lambda_tmp_, step_row_scale(p, h, scaling));
+            x.c = x.qdd + guard_q_;
+        } else {
+            // Into the output's workspace: when the step is accepted they are its output.
+            const Vec *y_before = model.y_now;
+            model.y_now = &x.y;
+            const ga_status st = consistent_output(t_end, x.q, x.v, "the error estimate");
+            model.y_now = y_before;
+            if (st)
+                return st;
+            x.c = out_qdd_;
+            estimate_is_output_ = true;
+        }
         x.c_prev = s.c;
         x.c_dt = h;
         const bool sliver = x.sliver_span > 0.0;  // too close to difference twice
@@ -133,13 +166,25 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
         // estimate from a counts unprojected too.
         const double err_unprojected =
             convergence_.diverged() ? weighted_error_norm(s, x, gq, gv, h, noise_q, noise_v) : 0.0;
-        // The projection with O_, factorized at the step's end for the accelerations:
-        // [sigma M Phi_q^T; Phi_q 0] [x; y] = [sigma M e; 0]
-        for (Vec *e : {&eq, &ev, &gq, &gv}) {
-            rq_.setZero();
-            out_M_.multiply_add(-out_sigma_, *e, rq_);
-            phi_.setZero();
-            O_.solve(rq_, phi_, *e, lambda_tmp_);
+        if (!estimate_is_output_) {
+            // Onto null(Phi_q) with the step's factorization too: e - x with
+            // S [x; y] = [0; Phi_q e] (along S_11^-1 Phi_q^T, as above)
+            for (Vec *e : {&eq, &ev, &gq, &gv}) {
+                rq_.setZero();
+                phi_.setZero();
+                J_.multiply_add(-1.0, *e, phi_);
+                S_.solve(rq_, phi_, qdd_tmp_, lambda_tmp_, step_row_scale(p, h, scaling));
+                *e -= qdd_tmp_;
+            }
+        } else {
+            // The projection with O_, factorized at the step's end for the accelerations:
+            // [sigma M Phi_q^T; Phi_q 0] [x; y] = [sigma M e; 0]
+            for (Vec *e : {&eq, &ev, &gq, &gv}) {
+                rq_.setZero();
+                out_M_.multiply_add(-out_sigma_, *e, rq_);
+                phi_.setZero();
+                O_.solve(rq_, phi_, *e, lambda_tmp_);
+            }
         }
         const double err_a =
             std::max(err_unprojected, weighted_error_norm(s, x, gq, gv, h, noise_q, noise_v));
@@ -298,7 +343,7 @@ ga_status Solver::adaptive_step(double t_stop)
                 }
                 const double h_prev = accepted_.h_last;  // the accepted step before this one
                 commit(land, t_stop);
-                if (consistent_estimate())  // the estimate's accelerations are the output
+                if (consistent_estimate() && estimate_is_output_)  // (they are the output)
                     output_for_ = state_id_;
                 // Predictive controller (Gustafsson, as in Radau5 and SciPy's Radau; k = 3 for
                 // a local error O(h^3)): the elementary proposal s err^(-1/k), reduced when

@@ -132,10 +132,11 @@ static void reading_does_not_change_the_run(void **state)
     }
 }
 
-/* Adaptive index-3 steps solve the acceleration-level equations at their end for their error
- * estimate: after such a step, the output is those values, read without another
- * factorization, and bit for bit what a solver restored at that state computes afresh.
- * Every scene of the catalog, dense and sparse. */
+/* After an adaptive index-3 step the output is the acceleration-level solution at its end:
+ * computed once when read (the error estimate solves with the step's own factorization now,
+ * or gives the output with it where it had to solve for it), no more on a second read, and
+ * bit for bit what a solver restored at that state computes afresh. Every scene of the
+ * catalog, dense and sparse. */
 static void adaptive_index3_output_comes_with_the_step(void **state)
 {
     (void)state;
@@ -158,7 +159,10 @@ static void adaptive_index3_output_comes_with_the_step(void **state)
             assert_int_equal(ga_get_lambda(s, lam[0]), GA_OK);
             assert_int_equal(ga_get_qdd(s, qdd[0]), GA_OK);
             assert_int_equal(ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &f1), GA_OK);
-            assert_true(f1 == f0);
+            assert_true(f1 - f0 <= 1);
+            assert_int_equal(ga_get_lambda(s, lam[1]), GA_OK);
+            assert_int_equal(ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &f0), GA_OK);
+            assert_true(f0 == f1);
             assert_int_equal(ga_get_state(s, ckpt, len), GA_OK);
             assert_int_equal(ga_set_state(r, ckpt, len), GA_OK);
             assert_int_equal(ga_get_lambda(r, lam[1]), GA_OK);
