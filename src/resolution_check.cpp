@@ -7,14 +7,19 @@
 // converging. That is what this check sees, at the cost of one Phi_t.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "solver.hpp"
 
 namespace ga {
 
+namespace {
+constexpr double kNewtonFloorUlps = 64.0;  // the Newton test's round-off floor of q (newton.cpp)
+}
+
 // After the step's Newton iteration converged: trial_ holds the step, J_ Phi_q at the last
-// iterate but one (within Newton's tolerance of q_{n+1}).
-ga_status Solver::check_velocity_constraint(double h)
+// iterate but one (within Newton's tolerance of q_{n+1}); tol: that iteration's tolerance.
+ga_status Solver::check_velocity_constraint(double h, double tol)
 {
     velocity_residual_ = 0.0;
     if (formulation != GA_INDEX3 || m_ == 0 || !(max_velocity_residual < kNoCheck))
@@ -29,18 +34,27 @@ ga_status Solver::check_velocity_constraint(double h)
     // velocity included where v passes through zero (a pendulum's turning point). (Against
     // the speeds of its own coordinates only, a link that starts to fall from the horizontal
     // measured an O(h^2) residual against the second-order motion along the link: 0.22.)
-    double top = 0.0;
-    for (int j = 0; j < n_; ++j)
+    double top = 0.0, q_max = 0.0;
+    for (int j = 0; j < n_; ++j) {
         top = std::max(top, std::fabs(x.v[j]) + std::fabs(x.q[j] - s.q[j]) / h);
+        q_max = std::max(q_max, std::fabs(x.q[j]));
+    }
+    // Newton leaves q within tol |q| (its floor: 64 ulps), and v = gamma' times that off
+    // (eq. 6): noise that grows as h shrinks, not the step map's mode. Counted as noise, a
+    // step from rest at rtol 1e-9 (|v| ~ h |qdd|) was refused down to h = 4e-15.
+    const double noise =
+        newton_coefficients(params, h).gamma_prime *
+        std::max(tol, kNewtonFloorUlps * std::numeric_limits<double>::epsilon()) * q_max;
     residual = phi_t;
     scale.setZero();
     J_.multiply_add_row_abs_sums(x.v, residual, scale);  // Phi_q v + Phi_t, sum_j |Phi_q,ij|
-    scale = top * scale + phi_t.cwiseAbs();
     int worst = -1;
     for (int i = 0; i < m_; ++i) {
+        const double row = scale[i];
+        scale[i] = top * row + std::fabs(phi_t[i]);
         if (!constraint_active(i) || !(scale[i] > 0.0))
             continue;
-        const double ratio = std::fabs(residual[i]) / scale[i];
+        const double ratio = std::max(0.0, std::fabs(residual[i]) - noise * row) / scale[i];
         if (ratio > velocity_residual_ || !(ratio == ratio)) {
             velocity_residual_ = ratio;
             worst = i;

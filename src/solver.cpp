@@ -589,7 +589,7 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     x.c_count = 0;  // an adaptive step's error estimate computes them (error_norm)
     if (convergence_.rate() >= 0.0)
         theta_prev_ = convergence_.rate();
-    return check_velocity_constraint(h);
+    return check_velocity_constraint(h, tol);
 }
 
 ga_status Solver::prepare_start(double h, bool restart_short)

@@ -454,7 +454,7 @@ private:
     Vec guard_q_, guard_v_;  // index-3 error estimate: the estimate from a (control.cpp)
     bool estimate_is_output_ = false;  // its accelerations are the consistent output's
     // resolution_check.cpp: the index-3 step's velocity constraint, and its largest ratio
-    ga_status check_velocity_constraint(double h);
+    ga_status check_velocity_constraint(double h, double tol);
     Vec check_residual_, check_scale_, check_phi_t_;
     double velocity_residual_ = 0.0;
     IterationMatrix S_;
