@@ -151,9 +151,10 @@ void Solver::record_step()
     if (r.interval > 0) {
         double *l = r.log_entry(k);
         std::copy_n(e, 4, l);
-        l[4] = r.pending_tol;
-        l[5] = (r.pending_sliver ? 1.0 : 0.0) + (r.pending_adaptive ? 2.0 : 0.0);
-        std::copy_n(r.pending_reuse, 5, l + 6);
+        const StepReport &report = step_report_;  // of the attempt accepted
+        l[4] = report.plan.tol;
+        l[5] = (report.plan.sliver_allowed ? 1.0 : 0.0) + (report.adaptive ? 2.0 : 0.0);
+        std::copy_n(report.reuse_before, kReuseStateSize, l + 6);
     }
     e += 4;
     for (const Vec *v : {&x.q, &x.v, &x.qdd, &x.lambda})

@@ -39,10 +39,6 @@ struct AdjointRecord {
     // the step being taken, until commit
     Kind pending_kind = Regular;
     double pending_rho = 1.0;
-    double pending_tol = 0.0;  // how the step was attempted (attempt_step), for its replay
-    bool pending_sliver = true;
-    bool pending_adaptive = false;  // an adaptive step (with pending_sliver: log entry 5)
-    double pending_reuse[5] = {0, 0, 0, 0, 0};
 
     static std::size_t stride_for(int n, int m, int r)
     {

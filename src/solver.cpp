@@ -445,27 +445,43 @@ void Solver::commit(bool land_on, double t_land)
     count(counters, GA_COUNT_STEPS);
 }
 
+// What the attempt of a step from accepted_ is to be; reads, changes nothing.
+StepPlan Solver::plan_step(double h, double tol, bool sliver_allowed) const
+{
+    const State &s = accepted_;
+    StepPlan plan;
+    plan.h = h;
+    plan.tol = tol;
+    plan.sliver_allowed = sliver_allowed;
+    const double short_limit = s.h_last / kShortStepRatio;
+    const bool short_step = s.h_last > 0.0 && h < short_limit;
+    if (sliver_allowed && short_step && s.sliver_span + h <= short_limit) {
+        plan.kind = StepPlan::Sliver;
+        return plan;
+    }
+    // Short steps beyond a sliver's span are the caller's new step size: Algorithm 1 again,
+    // started afresh from the consistent state the slivers left (Taylor steps do not last).
+    plan.restart_short = short_step && s.sliver_span > 0.0;
+    plan.fresh = start_pending_ || long_after_short(h) || plan.restart_short;
+    return plan;
+}
+
 // One step from accepted_ into trial_. accepted_ is only read.
 ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
 {
     if (formulation == GA_INDEX2_STABILIZED && !S2_.ready())
         return diag.fail(GA_ERR_INTERNAL, "the stabilized index-2 system was not set up");
-    if (adjoint_.interval > 0) {  // how to repeat it (adjoint checkpointing)
-        AdjointRecord &r = adjoint_;
-        r.pending_tol = tol;
-        r.pending_sliver = sliver_allowed;
-        r.pending_adaptive = adaptive_attempt_;
-        const double reuse[5] = {jacobian_valid_ ? 1.0 : 0.0, theta_prev_,
-                                 static_cast<double>(refresh_steps_left_),
-                                 static_cast<double>(reuse_backoff_), fd_tangents_ ? 1.0 : 0.0};
-        std::copy_n(reuse, 5, r.pending_reuse);
-    }
+    const StepPlan plan = plan_step(h, tol, sliver_allowed);
+    StepReport &report = step_report_;
+    report.plan = plan;
+    report.adaptive = adaptive_attempt_;
+    const double reuse_state[kReuseStateSize] = {
+        jacobian_valid_ ? 1.0 : 0.0, theta_prev_, static_cast<double>(refresh_steps_left_),
+        static_cast<double>(reuse_backoff_), fd_tangents_ ? 1.0 : 0.0};
+    std::copy_n(reuse_state, kReuseStateSize, report.reuse_before);
     if (pivots_forgotten_)  // after a layout-2 checkpoint: pivots as a new solver picks them
         forget_pivots();
-    const State &s = accepted_;
-    const double short_limit = s.h_last / kShortStepRatio;
-    const bool short_step = s.h_last > 0.0 && h < short_limit;
-    if (sliver_allowed && short_step && s.sliver_span + h <= short_limit) {
+    if (plan.kind == StepPlan::Sliver) {
         if (sens.active()) {
             sens.step_done = false;
             if (sens.forward) {
@@ -477,17 +493,15 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
         }
         return sliver_step(h);
     }
-    // Short steps beyond a sliver's span are the caller's new step size: Algorithm 1 again,
-    // started afresh from the consistent state the slivers left (Taylor steps do not last).
-    const bool restart_short = short_step && s.sliver_span > 0.0;
+    const State &s = accepted_;
+    const bool restart_short = plan.restart_short;
     if (sens.active()) {  // sensitivity.cpp: starts that are not the linear map, by differences
         sens.start_given = false;
         sens.step_done = false;
-        const bool fresh = start_pending_ || long_after_short(h) || restart_short;
-        if (fresh && (sens.forward || start_pending_)) {
+        if (plan.fresh && (sens.forward || start_pending_)) {
             if (auto st = sensitivity_by_differences(h, false, restart_short))
                 return st;
-        } else if (fresh) {
+        } else if (plan.fresh) {
             sens.start_given = true;  // (adjoint only: recorded as a start not covered)
         }
     }

@@ -16,6 +16,7 @@
 #include "params.hpp"
 #include "adjoint.hpp"
 #include "sensitivity.hpp"
+#include "step_plan.hpp"
 
 namespace ga {
 
@@ -257,6 +258,7 @@ private:
     double newton_tolerance(bool adaptive) const;
     // sliver_allowed: a step over kShortStepRatio times shorter than the one before is a
     // Taylor step (sliver_step)
+    StepPlan plan_step(double h, double tol, bool sliver_allowed) const;
     ga_status attempt_step(double h, double tol, bool sliver_allowed);
     ga_status sliver_step(double h);
     // A step this many times shorter than the one before is a Taylor step that ends like a
@@ -480,6 +482,7 @@ private:
     Vec out_y_;  // y at an interpolated time, for consistent output
     const Vec *w_start_ = nullptr, *ydot_start_ = nullptr;
     bool adaptive_attempt_ = false;  // the step being attempted is an adaptive one
+    StepReport step_report_;  // of the last attempt (attempt_step)
     double Cg_q_norm_ = 0.0, Cg_v_norm_ = 0.0;  // |C^-1 g_q|, |C^-1 g_v| (convergence test)
 };
 
