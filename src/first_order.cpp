@@ -40,9 +40,9 @@ void Solver::set_first_order(int r)
 // The w (and y') the step starts from, as a_n (and qdd_n) for q: after a fresh start those of
 // first_order_starting_values; after a change of h, w_n rescaled to the new h,
 // w_n <- y'_n + (h / h_last) (w_n - y'_n), as a_n is (sec. 1.2).
-void Solver::first_order_start(double h)
+void Solver::first_order_start(const State &from, double h)
 {
-    const State &s = accepted_;
+    const State &s = from;
     w_start_ = &s.w;
     ydot_start_ = &s.ydot;
     if (fresh_start_) {
@@ -65,9 +65,9 @@ void Solver::first_order_start(double h)
 // error where y is smooth (sec. 11, "Stiff start"). Rates that overflow along the polynomial
 // (a stiff nonlinear g) count as such for every state. Fixed steps only: an adaptive step's
 // error control shrinks h until the start is followed. qdd_start_ is the start's qdd.
-ga_status Solver::first_order_starting_values(double h)
+ga_status Solver::first_order_starting_values(const State &from, double h)
 {
-    const State &s = accepted_;
+    const State &s = from;
     State &x = trial_;  // scratch: the step has not started
     bool overflow = false;
     for (int side = 0; side < 2 && !overflow; ++side) {

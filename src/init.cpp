@@ -298,9 +298,9 @@ void Solver::explain_singular_saddle_point()
 // velocity offset that lets the first step absorb its own position error
 // l_0 = h^3 (1 - 6 beta - 3 delta_alpha)/6 qddd_0 instead of passing it to a_1 and lambda.
 // Without them lambda carries an O(h) transient (index 3) or an O(delta_alpha h) one (index 2).
-ga_status Solver::starting_values(double h)
+ga_status Solver::starting_values(const State &from, double h)
 {
-    const State &s = accepted_;
+    const State &s = from;
     const Params &p = params;
     const double delta_alpha = p.alpha_m - p.alpha_f;
     // h qddd_0 = (qdd(t0 + h) - qdd(t0 - h)) / 2 along the Taylor polynomial of the start

@@ -253,6 +253,26 @@ void Solver::shift_state(const State &from, const StateDerivative &s, double shi
     }
 }
 
+// Before an attempt: the starts that are not the linear map of the step before -- a Taylor
+// step, a fresh start -- by differences of the start functions (forward); with the adjoint
+// only, the record learns that its sweep does not cover them.
+ga_status Solver::sensitivity_before_attempt(const StepPlan &plan)
+{
+    sens.step_done = false;
+    if (plan.kind == StepPlan::Sliver) {
+        if (sens.forward)
+            return sensitivity_by_differences(plan.h, true, false);
+        sens.step_done = true;  // (adjoint only: recorded as a step not covered)
+        return GA_OK;
+    }
+    sens.start_given = false;
+    if (plan.fresh && (sens.forward || start_pending_))
+        return sensitivity_by_differences(plan.h, false, plan.restart_short);
+    if (plan.fresh)
+        sens.start_given = true;  // (adjoint only: recorded as a start not covered)
+    return GA_OK;
+}
+
 // A fresh start (the first step's corrected starting values, a step after Taylor steps, a
 // step far longer than the one before) or a Taylor step: their computations differenced along
 // the derivative of the state and p_j. A Taylor step's derivative is that of the step; a
@@ -262,15 +282,15 @@ ga_status Solver::sensitivity_by_differences(double h, bool taylor_step, bool re
     for (int j = 0; j < sens.np; ++j) {
         StateDerivative &out = taylor_step ? sens.trial[j] : sens.start[j];
         const StateDerivative &s = sens.accepted[j];
-        // The perturbed state takes accepted_'s place while the computation runs (the
-        // accepted one waits in sens_scratch_).
+        // The start functions run from the perturbed state, sens_scratch_ (evaluate is called
+        // between perturb(true) and perturb(false) only).
         const auto perturb = [&](bool on, double shift) {
             if (on)
                 shift_state(accepted_, s, shift, sens_scratch_);
-            accepted_.swap(sens_scratch_);
         };
         const auto evaluate = [&](int side) {
-            if (auto st = taylor_step ? sliver_step(h) : prepare_start(h, restart_short))
+            if (auto st = taylor_step ? sliver_step(sens_scratch_, h)
+                                      : prepare_start(sens_scratch_, h, restart_short))
                 return st;
             const auto take = [side](Vec &to, const Vec &from) {
                 if (side == 0)

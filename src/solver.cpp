@@ -462,11 +462,12 @@ StepPlan Solver::plan_step(double h, double tol, bool sliver_allowed) const
     // Short steps beyond a sliver's span are the caller's new step size: Algorithm 1 again,
     // started afresh from the consistent state the slivers left (Taylor steps do not last).
     plan.restart_short = short_step && s.sliver_span > 0.0;
-    plan.fresh = start_pending_ || long_after_short(h) || plan.restart_short;
+    plan.fresh = start_pending_ || long_after_short(s, h) || plan.restart_short;
     return plan;
 }
 
-// One step from accepted_ into trial_. accepted_ is only read.
+// One attempt of a step from accepted_ into trial_ (accepted_ is only read): the plan, the
+// report of how it begins, what the sensitivities do before it, then the step.
 ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
 {
     if (formulation == GA_INDEX2_STABILIZED && !S2_.ready())
@@ -481,31 +482,19 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     std::copy_n(reuse_state, kReuseStateSize, report.reuse_before);
     if (pivots_forgotten_)  // after a layout-2 checkpoint: pivots as a new solver picks them
         forget_pivots();
-    if (plan.kind == StepPlan::Sliver) {
-        if (sens.active()) {
-            sens.step_done = false;
-            if (sens.forward) {
-                if (auto st = sensitivity_by_differences(h, true, false))
-                    return st;
-            } else {
-                sens.step_done = true;  // (adjoint only: recorded as a step not covered)
-            }
-        }
-        return sliver_step(h);
-    }
+    if (sens.active())
+        if (auto st = sensitivity_before_attempt(plan))
+            return st;
+    return plan.kind == StepPlan::Sliver ? sliver_step(accepted_, h) : regular_step(plan);
+}
+
+// Algorithm 1 (or its index-2 form) from accepted_ into trial_.
+ga_status Solver::regular_step(const StepPlan &plan)
+{
+    const double h = plan.h, tol = plan.tol;
     const State &s = accepted_;
     const bool restart_short = plan.restart_short;
-    if (sens.active()) {  // sensitivity.cpp: starts that are not the linear map, by differences
-        sens.start_given = false;
-        sens.step_done = false;
-        if (plan.fresh && (sens.forward || start_pending_)) {
-            if (auto st = sensitivity_by_differences(h, false, restart_short))
-                return st;
-        } else if (plan.fresh) {
-            sens.start_given = true;  // (adjoint only: recorded as a start not covered)
-        }
-    }
-    if (auto st = prepare_start(h, restart_short))
+    if (auto st = prepare_start(accepted_, h, restart_short))
         return st;
 
     // After a reused matrix was too slow, the next steps start with a fresh one; how many
@@ -606,9 +595,9 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     return check_velocity_constraint(h, tol);
 }
 
-ga_status Solver::prepare_start(double h, bool restart_short)
+ga_status Solver::prepare_start(const State &from, double h, bool restart_short)
 {
-    const State &s = accepted_;
+    const State &s = from;
     // The start of the step. a_n carries the shift delta_alpha h_last; rescaled to the h of
     // this step the scheme stays second order under any sequence of step sizes (docs/algorithms.md
     // sec. 1.2): a_n <- qdd_n + (h / h_last) (a_n - qdd_n).
@@ -616,7 +605,7 @@ ga_status Solver::prepare_start(double h, bool restart_short)
     v_start_ = &s.v;
     qdd_start_ = &s.qdd;
     lambda_start_ = &s.lambda;
-    const bool long_after_short = this->long_after_short(h);
+    const bool long_after_short = Solver::long_after_short(s, h);
     fresh_start_ = start_pending_ || long_after_short || restart_short;
     model.y_now = &s.y;  // the forces the start's own evaluations see
     if (long_after_short) {
@@ -628,7 +617,7 @@ ga_status Solver::prepare_start(double h, bool restart_short)
         lambda_start_ = &lambda_n_;
     }
     if (fresh_start_ && corrected_start) {
-        if (auto st = starting_values(h))  // sets a_start_ and, in index 3, v_start_
+        if (auto st = starting_values(s, h))  // sets a_start_ and, in index 3, v_start_
             return st;
     } else if (fresh_start_) {
         a_start_ = qdd_start_;
@@ -638,9 +627,9 @@ ga_status Solver::prepare_start(double h, bool restart_short)
     }
     if (r() > 0) {
         if (fresh_start_)
-            if (auto st = first_order_starting_values(h))
+            if (auto st = first_order_starting_values(s, h))
                 return st;
-        first_order_start(h);
+        first_order_start(s, h);
     }
     return GA_OK;
 }
@@ -655,9 +644,9 @@ ga_status Solver::prepare_start(double h, bool restart_short)
 // O(h^2) in the third derivative, with h at most 1e-2 of the step before), v projected onto
 // the velocity constraint, and qdd, lambda from the acceleration-level equations at its end,
 // as at ga_init; the recursion for a then goes on as if the sliver had not been taken.
-ga_status Solver::sliver_step(double h)
+ga_status Solver::sliver_step(const State &from, double h)
 {
-    const State &s = accepted_;
+    const State &s = from;
     State &x = trial_;
     x.t = s.t + h;
     x.q = s.q + h * s.v + (0.5 * h * h) * s.qdd;

@@ -260,7 +260,8 @@ private:
     // Taylor step (sliver_step)
     StepPlan plan_step(double h, double tol, bool sliver_allowed) const;
     ga_status attempt_step(double h, double tol, bool sliver_allowed);
-    ga_status sliver_step(double h);
+    ga_status regular_step(const StepPlan &plan);
+    ga_status sliver_step(const State &from, double h);
     // A step this many times shorter than the one before is a Taylor step that ends like a
     // restart (sliver_step).
     static constexpr double kShortStepRatio = 100.0;
@@ -299,7 +300,7 @@ private:
     Vec hook_lambda_;  // the multipliers the hook sees, its own: reads from the hook reuse out_
     ga_status residual(double t, const State &x);
     // first_order.cpp: the parts of a step that concern first-order states.
-    void first_order_start(double h);
+    void first_order_start(const State &from, double h);
     void predict_first_order(double h);
     ga_status first_order_matrix(double t, const State &x, bool central = false);
     // The mechanical update depends on dy: f_y is in the Newton system (Z = Sol(f_y) != 0).
@@ -308,14 +309,15 @@ private:
     void first_order_correction(const NewtonCoefficients &c, Vec &dw);
     void update_first_order(const NewtonCoefficients &c, double h, State &x, UpdateSizes &size);
     void finish_first_order(State &x);
-    ga_status first_order_starting_values(double h);
+    ga_status first_order_starting_values(const State &from, double h);
     double first_order_error_sum(double h, double scale);
-    // The start of a step from accepted_ (a_start_, v_start_, qdd_start_, lambda_start_ and
-    // fresh_start_): rescaled, corrected, or consistent again after short steps.
-    ga_status prepare_start(double h, bool restart_short);
-    bool long_after_short(double h) const
+    // The start of a step from `from` (a_start_, v_start_, qdd_start_, lambda_start_ and
+    // fresh_start_, which point into it): rescaled, corrected, or consistent again after
+    // short steps. `from` is accepted_, or a perturbed copy (sensitivity_by_differences).
+    ga_status prepare_start(const State &from, double h, bool restart_short);
+    static bool long_after_short(const State &from, double h)
     {
-        return accepted_.h_last > 0.0 && h > kShortStepRatio * accepted_.h_last;
+        return from.h_last > 0.0 && h > kShortStepRatio * from.h_last;
     }
     // sensitivity.cpp
     template <class Perturb, class Evaluate>
@@ -325,6 +327,7 @@ private:
     ga_status project_seeds(const State &x, int j, StateDerivative &s);
     static void shift_state(const State &from, const StateDerivative &s, double shift, State &to);
     ga_status sensitivity_by_differences(double h, bool taylor_step, bool restart_short);
+    ga_status sensitivity_before_attempt(const StepPlan &plan);
     ga_status parameter_residual(int j, double t, const State &x);
     ga_status rate_parameter_residual(int j, double t, const State &x);
     ga_status constraint_parameter_terms(int j, double t, const State &x, bool velocity,
@@ -376,7 +379,7 @@ private:
                                        Vec &lambda);
     ga_status acceleration_level(double t, const Vec &q, const Vec &v, SaddleWorkspace &w,
                                  Vec &qdd, Vec &lambda);
-    ga_status starting_values(double h);
+    ga_status starting_values(const State &from, double h);
     void explain_singular_saddle_point();
     ga_status select_active_constraints(double t, const Vec &q);
     const unsigned char *active_ptr() const { return active_.empty() ? nullptr : active_.data(); }
