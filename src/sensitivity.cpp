@@ -253,6 +253,26 @@ void Solver::shift_state(const State &from, const StateDerivative &s, double shi
     }
 }
 
+// The sensitivities' and the adjoint record's part of a commit, and of its undoing.
+void Solver::sensitivity_on_commit()
+{
+    // The step's derivatives, where forward sensitivities computed them (an adjoint-only run
+    // keeps the start's: its trial ones are scratch, NaN after a failed start, which the next
+    // checkpoint carried and a restore refused)
+    if (sens.forward)
+        sens.accepted.swap(sens.trial);
+    if (sens.adjoint)
+        record_step();
+}
+
+void Solver::sensitivity_on_undo()
+{
+    if (sens.forward)
+        sens.accepted.swap(sens.trial);
+    if (sens.adjoint && --adjoint_.steps < adjoint_.unsupported_at)
+        adjoint_.unsupported_at = -1;  // that step is gone
+}
+
 // Before an attempt: the starts that are not the linear map of the step before -- a Taylor
 // step, a fresh start -- by differences of the start functions (forward); with the adjoint
 // only, the record learns that its sweep does not cover them.

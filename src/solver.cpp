@@ -411,10 +411,8 @@ void Solver::undo_step(const StepUndo &u)
 {
     previous_.swap(trial_);  // commit's swaps, backwards
     accepted_.swap(trial_);
-    if (sens.forward)
-        sens.accepted.swap(sens.trial);
-    if (sens.adjoint && --adjoint_.steps < adjoint_.unsupported_at)
-        adjoint_.unsupported_at = -1;  // that step is gone
+    if (sens.active())
+        sensitivity_on_undo();
     previous_valid_ = u.previous_valid;
     start_pending_ = u.start_pending;
     if (u.adaptive)
@@ -428,17 +426,12 @@ void Solver::undo_step(const StepUndo &u)
 
 void Solver::commit(bool land_on, double t_land)
 {
-    // The step's derivatives, where forward sensitivities computed them (an adjoint-only run
-    // keeps the start's: its trial ones are scratch, NaN after a failed start, which the next
-    // checkpoint carried and a restore refused)
-    if (sens.forward)
-        sens.accepted.swap(sens.trial);
     accepted_.swap(trial_);    // the new step becomes the state ...
     previous_.swap(trial_);    // ... and the old one the start of the interval for dense output
     if (land_on)
         accepted_.t = t_land;  // exactly, not t_n + h rounded
-    if (sens.adjoint)
-        record_step();
+    if (sens.active())  // (before the counters: the adjoint's checkpoints hold them)
+        sensitivity_on_commit();
     previous_valid_ = true;
     start_pending_ = false;
     ++state_id_;

@@ -328,6 +328,8 @@ private:
     static void shift_state(const State &from, const StateDerivative &s, double shift, State &to);
     ga_status sensitivity_by_differences(double h, bool taylor_step, bool restart_short);
     ga_status sensitivity_before_attempt(const StepPlan &plan);
+    void sensitivity_on_commit();  // after the states' swap in commit
+    void sensitivity_on_undo();    // after undo_step's swaps
     ga_status parameter_residual(int j, double t, const State &x);
     ga_status rate_parameter_residual(int j, double t, const State &x);
     ga_status constraint_parameter_terms(int j, double t, const State &x, bool velocity,
