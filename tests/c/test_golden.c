@@ -68,6 +68,7 @@ static struct run_context {
     double hook_sum;   /* what the hook saw */
     long hook_calls;
     double dummy_p;    /* a parameter no callback reads: the initial values' sensitivity */
+    int np;            /* parameters of the run's sensitivities (the cost writes np of dJ/dp) */
     long events, stops, steps; /* events logged, GA_STOPPED returned, steps at the end */
 } g;
 
@@ -121,8 +122,8 @@ static int golden_running(double t, const double *q, const double *v, const doub
     }
     for (int i = 0; i < m; ++i)
         d_lambda[i] = 0.0;
-    for (int j = 0; j < kMaxParams; ++j)
-        d_p[j] = 0.0; /* (np <= kMaxParams; the solver reads np entries) */
+    for (int j = 0; j < g.np; ++j)
+        d_p[j] = 0.0;
     return 0;
 }
 static int golden_terminal(double t, const double *q, const double *v, const double *qdd,
@@ -136,7 +137,7 @@ static int golden_terminal(double t, const double *q, const double *v, const dou
         d_q[i] = i == 0 ? 1.0 : 0.0, d_v[i] = 0.0, d_qdd[i] = 0.0;
     for (int i = 0; i < m; ++i)
         d_lambda[i] = i == 0 ? 0.1 : 0.0;
-    for (int j = 0; j < kMaxParams; ++j)
+    for (int j = 0; j < g.np; ++j)
         d_p[j] = 0.0;
     return 0;
 }
@@ -235,6 +236,7 @@ static uint64_t golden_run(int scene, int mode, feature f)
             dv0[0] = 1.0;
             assert_int_equal(ga_set_sensitivity_start(s, 0, NULL, dv0), GA_OK);
         }
+        g.np = np;
         if (adjoint)
             assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_ADJOINT, 4000),
                              GA_OK);
