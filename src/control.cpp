@@ -101,8 +101,8 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
         // over the tolerances (docs/design-notes.md).
         double moved = 0.0;
         for (int i = 0; i < n_ && jacobian_valid_; ++i)
-            moved = std::max(moved,
-                             std::fabs(x.q[i] - recipe_.q[i]) / (std::fabs(x.q[i]) + 1.0));
+            moved = std::max(moved, model.space.distance(x.q, recipe_.q, i) /
+                                        (model.space.magnitude(x.q, i) + 1.0));
         if (jacobian_valid_ && moved <= kFactorizedNearby) {
             // With the step's own factorization (the accelerations need only be consistent
             // to the estimate's accuracy): the step's qdd corrected onto the acceleration-level
@@ -151,7 +151,7 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
         // Newton test's floors): what the estimate from a makes of that round-off widens its
         // weights (as atol does; subtracted instead, the error jumped between 0 and O(1) and
         // the predictive controller shrank the steps without end).
-        const double q_max = std::max(s.q.cwiseAbs().maxCoeff(), x.q.cwiseAbs().maxCoeff());
+        const double q_max = std::max(model.space.max_magnitude(s.q), model.space.max_magnitude(x.q));
         const auto a_noise = [&](double step) {
             return kRoundoffUlps * kEps * q_max / (p.beta * step * step);
         };
@@ -228,7 +228,9 @@ double Solver::weighted_error_norm(const State &s, const State &x, const Vec &eq
     double sum = 0.0;
     for (int i = 0; i < n_; ++i) {
         const double wq =
-            scale * (atol + rtol * std::max(std::fabs(s.q[i]), std::fabs(x.q[i]))) + noise_q;
+            scale * (atol + rtol * std::max(model.space.magnitude(s.q, i),
+                                            model.space.magnitude(x.q, i))) +
+            noise_q;
         const double wv =
             scale * (atol + rtol * std::max(std::fabs(s.v[i]), std::fabs(x.v[i]))) + noise_v;
         sum += (eq[i] / wq) * (eq[i] / wq) + (ev[i] / wv) * (ev[i] / wv);
@@ -272,7 +274,8 @@ ga_status Solver::adaptive_step(double t_stop)
         const double scale = control.calibration();
         double acc = 0.0, vel = 0.0;  // |qdd|_w^2, |v|_w^2
         for (int i = 0; i < n_; ++i) {
-            const double w = scale * (control.atol + control.rtol * std::fabs(accepted_.q[i]));
+            const double w =
+                scale * (control.atol + control.rtol * model.space.magnitude(accepted_.q, i));
             acc += (accepted_.qdd[i] / w) * (accepted_.qdd[i] / w);
             vel += (accepted_.v[i] / w) * (accepted_.v[i] / w);
         }

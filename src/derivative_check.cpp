@@ -129,9 +129,9 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
         for (int j = 0; j < n && !st; ++j) {
             Vec qq = q;
             const double e = step_for(q[j]);
-            qq[j] = q[j] + e;
+            model.space.shift_coordinate(qq, q, j, e);
             st = model.constraint(t, qq, phi1);
-            qq[j] = q[j] - e;
+            model.space.shift_coordinate(qq, q, j, -e);
             if (!st)
                 st = model.constraint(t, qq, phi2);
             if (!st) {
@@ -168,16 +168,17 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
     if (!st && m > 0 && model.cb.constraint_accel) {
         // Phi_qq(v, v) + 2 Phi_qt v + Phi_tt = d^2/ds^2 Phi(q + s v, t + s) at s = 0
         Worst w{"constraint acceleration term", "Phi along (q + s v, t + s), second"};
-        Vec accel(m), phi0(m);
-        const double e = 1.2e-4 * std::max({1.0, std::fabs(t), q.cwiseAbs().maxCoeff()}) /
-                         std::max(1.0, v.cwiseAbs().maxCoeff());
+        Vec accel(m), phi0(m), qq(q.size());
+        const double e =
+            1.2e-4 * std::max({1.0, std::fabs(t), model.space.max_magnitude(q)}) /
+            std::max(1.0, v.cwiseAbs().maxCoeff());
         st = model.constraint_accel(t, q, v, accel);
         if (!st)
             st = model.constraint(t, q, phi0);
         if (!st)
-            st = model.constraint(t + e, q + e * v, phi1);
+            model.space.shifted(q, e, v, qq), st = model.constraint(t + e, qq, phi1);
         if (!st)
-            st = model.constraint(t - e, q - e * v, phi2);
+            model.space.shifted(q, -e, v, qq), st = model.constraint(t - e, qq, phi2);
         if (!st) {
             col_fd = (phi1 - 2.0 * phi0 + phi2) / (e * e);
             compare(w, 0, accel, col_fd, 0.0);
@@ -195,9 +196,9 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
             for (int j = 0; j < n && !st; ++j) {
                 Vec qq = q;
                 const double e = step_for(q[j]);
-                qq[j] = q[j] + e;
+                model.space.shift_coordinate(qq, q, j, e);
                 st = residual_at(qq, v, r1);
-                qq[j] = q[j] - e;
+                model.space.shift_coordinate(qq, q, j, -e);
                 if (!st)
                     st = residual_at(qq, v, r2);
                 if (!st) {

@@ -72,7 +72,7 @@ ga_status Solver::first_order_starting_values(const State &from, double h)
     bool overflow = false;
     for (int side = 0; side < 2 && !overflow; ++side) {
         const double sh = side == 0 ? h : -h;
-        x.q = s.q + sh * s.v + (0.5 * sh * sh) * *qdd_start_;
+        model.space.taylor(s.q, s.v, *qdd_start_, sh, x.q);
         x.v = s.v + sh * *qdd_start_;
         x.y = s.y + sh * s.ydot;
         Vec &out = side == 0 ? gx_ : dy_;

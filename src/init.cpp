@@ -307,7 +307,7 @@ ga_status Solver::starting_values(const State &from, double h)
     State &x = trial_;  // scratch: the step has not started
     for (int side = 0; side < 2; ++side) {
         const double sh = side == 0 ? h : -h;
-        x.q = s.q + sh * s.v + (0.5 * sh * sh) * *qdd_start_;
+        model.space.taylor(s.q, s.v, *qdd_start_, sh, x.q);
         x.v = s.v + sh * *qdd_start_;
         if (r() > 0) {  // the forces at t0 -+ h see y there (to first order: see first_order.cpp)
             y_tmp_ = s.y + sh * s.ydot;
@@ -364,7 +364,7 @@ ga_status Solver::project_positions(double t, Vec &q)
                              "[I Phi_q^T; Phi_q 0] = %.3g) at projection iteration %d",
                              S_.rcond(), it + 1);
         S_.solve(rq_, phi_, dq_, dlambda_);
-        q += dq_;
+        model.space.increment(q, dq_);
         if (auto st = model.constraint(t, q, phi_))
             return st;
         const double previous = norm;
@@ -372,7 +372,7 @@ ga_status Solver::project_positions(double t, Vec &q)
         if (!std::isfinite(norm) || norm > 1e6 * std::max(norm0, init_tol))
             break;  // diverging
         const bool roundoff = dq_.lpNorm<Eigen::Infinity>() <=
-                              16.0 * kEps * std::max(q.lpNorm<Eigen::Infinity>(), 1.0);
+                              16.0 * kEps * std::max(model.space.max_magnitude(q), 1.0);
         if (norm <= init_tol && (norm == 0.0 || roundoff || norm > 0.5 * previous))
             return GA_OK;
     }

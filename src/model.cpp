@@ -101,7 +101,7 @@ void ColumnGroups::build(const ModelMatrix &A)
 }
 
 Model::Model(int n, int m, Counters &counters, Diagnostics &diag)
-    : n_(n), m_(m), counters_(counters), diag_(diag)
+    : space(n), n_(n), m_(m), counters_(counters), diag_(diag)
 {
 }
 
@@ -311,14 +311,14 @@ ga_status Model::velocity_constraint_tangent(double t, const Vec &q, const Vec &
                                              const ModelMatrix &J, ModelMatrix &Z,
                                              bool central)
 {
-    const double q_scale = std::max(q.lpNorm<Eigen::Infinity>(), 1.0);
+    const double q_scale = std::max(space.max_magnitude(q), 1.0);
     const double e = (central ? std::cbrt(kEps) : std::sqrt(kEps)) * q_scale /
                      std::max(v.lpNorm<Eigen::Infinity>(), 1.0);
-    q_pert_ = q + e * v;
+    space.shifted(q, e, v, q_pert_);
     if (auto st = jacobian(t + e, q_pert_, Z))
         return st;
     if (central) {
-        q_pert_ = q - e * v;
+        space.shifted(q, -e, v, q_pert_);
         if (auto st = jacobian(t - e, q_pert_, J_pert_))
             return st;
     }
@@ -377,18 +377,18 @@ ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
         auto Kd = K.as_dense();
         for (int j = 0; j < n_; ++j) {
             const double e = central ? central_increment(q[j]) : fd_increment(q[j]);
-            q_pert_[j] = q[j] + e;
+            space.shift_coordinate(q_pert_, q, j, e);
             if (auto st = perturbed_residual(t, q_pert_, v, qdd, lambda, M, r_pert_))
                 return st;
             if (central) {
-                q_pert_[j] = q[j] - e;
+                space.shift_coordinate(q_pert_, q, j, -e);
                 if (auto st = perturbed_residual(t, q_pert_, v, qdd, lambda, M, r_minus_))
                     return st;
                 Kd.col(j) = (r_pert_ - r_minus_) / (2.0 * e);
             } else {
                 Kd.col(j) = (r_pert_ - rq) / e;
             }
-            q_pert_[j] = q[j];
+            space.restore_coordinate(q_pert_, q, j);
         }
         return GA_OK;
     }
@@ -401,13 +401,13 @@ ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
         for (int p = k_groups_.start[g]; p < k_groups_.start[g + 1]; ++p) {
             const int j = k_groups_.cols[p];
             step_[j] = central ? central_increment(q[j]) : fd_increment(q[j]);
-            q_pert_[j] = q[j] + step_[j];
+            space.shift_coordinate(q_pert_, q, j, step_[j]);
         }
         if (auto st = perturbed_residual(t, q_pert_, v, qdd, lambda, M, r_pert_))
             return st;
         if (central) {
             for (int p = k_groups_.start[g]; p < k_groups_.start[g + 1]; ++p)
-                q_pert_[k_groups_.cols[p]] = q[k_groups_.cols[p]] - step_[k_groups_.cols[p]];
+                space.shift_coordinate(q_pert_, q, k_groups_.cols[p], -step_[k_groups_.cols[p]]);
             if (auto st = perturbed_residual(t, q_pert_, v, qdd, lambda, M, r_minus_))
                 return st;
         }
@@ -418,7 +418,7 @@ ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
             K.data()[k] = (r_pert_[ri[k]] - base[ri[k]]) / (span * step_[ci[k]]);
         }
         for (int p = k_groups_.start[g]; p < k_groups_.start[g + 1]; ++p)
-            q_pert_[k_groups_.cols[p]] = q[k_groups_.cols[p]];
+            space.restore_coordinate(q_pert_, q, k_groups_.cols[p]);
     }
     return GA_OK;
 }
@@ -533,13 +533,13 @@ ga_status Model::constraint_accel(double t, const Vec &q, const Vec &v, Vec &out
     // Along the path s -> (q + s v, t + s) the velocity constraint is
     // g(s) = Phi_q v + Phi_t, and g'(0) = Phi_qq(v, v) + 2 Phi_qt v + Phi_tt. Central
     // difference of g, with an increment that moves q by ~cbrt(eps) relative to its size.
-    const double qscale = std::max(q.lpNorm<Eigen::Infinity>(), 1.0);
+    const double qscale = std::max(space.max_magnitude(q), 1.0);
     const double vscale = std::max(v.lpNorm<Eigen::Infinity>(), 1.0);
     const double s = std::cbrt(kEps) * qscale / vscale;
     for (int side = 0; side < 2; ++side) {
         const double sig = side == 0 ? s : -s;
         Vec &g = side == 0 ? g_plus_ : g_minus_;
-        q_pert_ = q + sig * v;
+        space.shifted(q, sig, v, q_pert_);
         if (auto st = jacobian(t + sig, q_pert_, J_pert_))
             return st;
         if (auto st = constraint_dt(t + sig, q_pert_, g))
@@ -630,17 +630,30 @@ ga_status Model::coupling_block(double t, const Vec &q, const Vec &v, const Vec 
     const auto evaluate = [&](Vec &out) {
         return of_q ? rate(t, q_pert_, v, y, out) : rate(t, q, v_pert_, y, out);
     };
+    // q moves through the space, v is a vector
+    const auto shift = [&](int j, double e) {
+        if (of_q)
+            space.shift_coordinate(x, q, j, e);
+        else
+            x[j] = v[j] + e;
+    };
+    const auto restore = [&](int j) {
+        if (of_q)
+            space.restore_coordinate(x, q, j);
+        else
+            x[j] = v[j];
+    };
     const double span = central ? 2.0 : 1.0;
     if (pattern.dense()) {
         for (int j = 0; j < n_; ++j) {
-            const double e = central ? central_increment(x[j]) : fd_increment(x[j]), keep = x[j];
-            x[j] = keep + e;
+            const double e = central ? central_increment(x[j]) : fd_increment(x[j]);
+            shift(j, e);
             ga_status st = evaluate(rate_pert_);
             if (!st && central) {
-                x[j] = keep - e;
+                shift(j, -e);
                 st = evaluate(rate_minus_);
             }
-            x[j] = keep;
+            restore(j);
             if (st)
                 return st;
             G.col(j) = (rate_pert_ - (central ? rate_minus_ : ydot)) / (span * e);
@@ -655,11 +668,11 @@ ga_status Model::coupling_block(double t, const Vec &q, const Vec &v, const Vec 
             for (int k = groups.start[g]; k < groups.start[g + 1]; ++k) {
                 const int j = groups.cols[k];
                 step_[j] = central ? central_increment(x[j]) : fd_increment(x[j]);
-                x[j] = (of_q ? q[j] : v[j]) + (side == 0 ? step_[j] : -step_[j]);
+                shift(j, side == 0 ? step_[j] : -step_[j]);
             }
             const ga_status st = evaluate(side == 0 ? rate_pert_ : rate_minus_);
             for (int k = groups.start[g]; k < groups.start[g + 1]; ++k)
-                x[groups.cols[k]] = of_q ? q[groups.cols[k]] : v[groups.cols[k]];
+                restore(groups.cols[k]);
             if (st)
                 return st;
         }

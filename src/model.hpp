@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "configuration_space.hpp"
 #include "diagnostics.hpp"
 #include "matrix.hpp"
 
@@ -62,6 +63,8 @@ class Model {
 public:
     Model(int n, int m, Counters &counters, Diagnostics &diag);
 
+    // The problem's q: where it lives and how it moves (configuration_space.hpp)
+    const ConfigurationSpace space;
     Callbacks cb;
     // The caller's floating-point environment while a call runs with its traps held (the C
     // shim sets it when the caller has traps enabled): callbacks run in it, galpha's own

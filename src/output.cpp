@@ -104,7 +104,7 @@ ga_status Solver::interpolate(double t, double *q, double *v, double *qdd, doubl
     const double h01 = (3 - 2 * th) * th * th, h11 = (th - 1) * th * th;
     const bool consistent = output == GA_OUTPUT_CONSISTENT && (qdd || (lambda && m_ > 0));
     if (consistent || q)
-        out_q_ = h00 * a.q + (h10 * h) * a.v + h01 * b.q + (h11 * h) * b.v;
+        model.space.hermite(a.q, a.v, b.q, b.v, h, h00, h10, h01, h11, out_q_);
     if (consistent || v)
         out_v_ = h00 * a.v + (h10 * h) * a.qdd + h01 * b.v + (h11 * h) * b.qdd;
     if (q)

@@ -36,8 +36,8 @@ ga_status Solver::check_velocity_constraint(double h, double tol)
     // measured an O(h^2) residual against the second-order motion along the link: 0.22.)
     double top = 0.0, q_max = 0.0;
     for (int j = 0; j < n_; ++j) {
-        top = std::max(top, std::fabs(x.v[j]) + std::fabs(x.q[j] - s.q[j]) / h);
-        q_max = std::max(q_max, std::fabs(x.q[j]));
+        top = std::max(top, std::fabs(x.v[j]) + model.space.distance(x.q, s.q, j) / h);
+        q_max = std::max(q_max, model.space.magnitude(x.q, j));
     }
     // Newton leaves q within tol |q| (its floor: 64 ulps), and v = gamma' times that off
     // (eq. 6): noise that grows as h shrinks, not the step map's mode. Counted as noise, a

@@ -144,7 +144,7 @@ ga_status Solver::sensitivity_start(const State &x)
         const auto perturb = [&](bool on, double shift) {
             if (!on)
                 return;
-            z.xq = x.q + shift * s.q;
+            model.space.shifted(x.q, shift, s.q, z.xq);
             z.xv = x.v + shift * s.v;
         };
         const auto evaluate = [&](int side) {
@@ -215,10 +215,10 @@ ga_status Solver::project_seeds(const State &x, int j, StateDerivative &s)
     z.rl = z.cv;
     const double s_max = s.q.lpNorm<Eigen::Infinity>();
     if (s_max > 0.0) {
-        const double e = std::cbrt(kEps) * std::max(x.q.lpNorm<Eigen::Infinity>(), 1.0) / s_max;
+        const double e = std::cbrt(kEps) * std::max(model.space.max_magnitude(x.q), 1.0) / s_max;
         for (int side = 0; side < 2; ++side) {
             const double sign = side == 0 ? 1.0 : -1.0;
-            z.xq = x.q + (sign * e) * s.q;
+            model.space.shifted(x.q, sign * e, s.q, z.xq);
             if (auto st = model.jacobian(x.t, z.xq, z.J_pert))
                 return st;
             if (auto st = model.constraint_dt(x.t, z.xq, z.rv))
@@ -234,12 +234,12 @@ ga_status Solver::project_seeds(const State &x, int j, StateDerivative &s)
 }
 
 // The state moved by `shift` times the derivative of parameter j (the quantities a step reads).
-void Solver::shift_state(const State &from, const StateDerivative &s, double shift, State &to)
+void Solver::shift_state(const State &from, const StateDerivative &s, double shift, State &to) const
 {
     to.t = from.t;
     to.h_last = from.h_last;
     to.sliver_span = from.sliver_span;
-    to.q = from.q + shift * s.q;
+    model.space.shifted(from.q, shift, s.q, to.q);
     to.v = from.v + shift * s.v;
     to.qdd = from.qdd + shift * s.qdd;
     to.lambda = from.lambda + shift * s.lambda;
@@ -527,9 +527,9 @@ ga_status Solver::correction_derivative(double t, const Vec &q, const Vec &eta, 
     const double s_max = s.lpNorm<Eigen::Infinity>();
     if (s_max == 0.0)
         return GA_OK;
-    const double e = std::cbrt(kEps) * std::max(q.lpNorm<Eigen::Infinity>(), 1.0) / s_max;
+    const double e = std::cbrt(kEps) * std::max(model.space.max_magnitude(q), 1.0) / s_max;
     for (int side = 0; side < 2; ++side) {
-        z.d = q + (side == 0 ? e : -e) * s;
+        model.space.shifted(q, side == 0 ? e : -e, s, z.d);
         if (auto st = model.jacobian(t, z.d, z.J_pert))
             return st;
         z.J_pert.multiply_transpose_add(side == 0 ? -0.5 / e : 0.5 / e, eta, out);

@@ -48,8 +48,9 @@ DenseKind dense_kind(ga_linear_solver choice)
 // show: the iterate needs no check of its own.
 constexpr Eigen::Index kBlock = 512;
 
-void apply_update(const Vec &dq, const Vec &dw, const Vec &dlambda, double gamma_prime,
-                  double beta_prime, State &x, UpdateSizes &size)
+void apply_update(const ConfigurationSpace &space, const Vec &dq, const Vec &dw,
+                  const Vec &dlambda, double gamma_prime, double beta_prime, State &x,
+                  UpdateSizes &size)
 {
     const bool separate_dw = &dw != &dq;
     double v_max = 0.0;
@@ -60,13 +61,13 @@ void apply_update(const Vec &dq, const Vec &dw, const Vec &dlambda, double gamma
         auto q = x.q.segment(i, len), v = x.v.segment(i, len), qdd = x.qdd.segment(i, len);
         size.increments_finite = size.increments_finite && all_finite(d.data(), len) &&
                                  (!separate_dw || all_finite(w.data(), len));
-        q += d;
+        space.increment(q, d);
         v += gamma_prime * w;
         qdd += beta_prime * w;
         size.dq = std::max(size.dq, d.cwiseAbs().maxCoeff());
         if (separate_dw)
             size.dw = std::max(size.dw, w.cwiseAbs().maxCoeff());
-        size.q = std::max(size.q, q.cwiseAbs().maxCoeff());
+        size.q = std::max(size.q, space.max_magnitude(q));
         v_max = std::max(v_max, v.cwiseAbs().maxCoeff());
         size.qdd = std::max(size.qdd, qdd.cwiseAbs().maxCoeff());
     }
@@ -642,7 +643,7 @@ ga_status Solver::sliver_step(const State &from, double h)
     const State &s = from;
     State &x = trial_;
     x.t = s.t + h;
-    x.q = s.q + h * s.v + (0.5 * h * h) * s.qdd;
+    model.space.taylor(s.q, s.v, s.qdd, h, x.q);
     x.v = s.v + h * s.qdd;
     if (!all_finite(x.q) || !all_finite(x.v))
         return diag.fail(GA_ERR_NONFINITE,
@@ -823,8 +824,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
         else
             qdd = (an - p.alpha_f * qdd_n) / (1.0 - p.alpha_f);
         a = (p.alpha_f * qdd_n - p.alpha_m * an + (1.0 - p.alpha_f) * qdd) / (1.0 - p.alpha_m);
-        q = s.q.segment(i, len) + h * v_n.segment(i, len) +
-            (h * h) * ((0.5 - p.beta) * an + p.beta * a);                               // eq. (4)
+        model.space.newmark(q, s.q.segment(i, len), v_n.segment(i, len), an, a, h, p.beta);  // (4)
         v = v_n.segment(i, len) + h * ((1.0 - p.gamma) * an + p.gamma * a);            // eq. (5)
         finite = finite && all_finite(q.data(), len) && all_finite(v.data(), len) &&
                  all_finite(qdd.data(), len);
@@ -923,7 +923,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
             first_order_correction(c, index2 ? dw_ : dq_);
         count(counters, GA_COUNT_NEWTON_ITERS);
         UpdateSizes size;
-        apply_update(dq_, *dw, dlambda_, c.gamma_prime, c.beta_prime, x, size);
+        apply_update(model.space, dq_, *dw, dlambda_, c.gamma_prime, c.beta_prime, x, size);
         if (r() > 0)
             update_first_order(c, h, x, size);
         if (!size.increments_finite || !size.iterate_finite)

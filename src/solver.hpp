@@ -325,7 +325,7 @@ private:
                                  double increment = 0.0);
     ga_status sensitivity_start(const State &x);
     ga_status project_seeds(const State &x, int j, StateDerivative &s);
-    static void shift_state(const State &from, const StateDerivative &s, double shift, State &to);
+    void shift_state(const State &from, const StateDerivative &s, double shift, State &to) const;
     ga_status sensitivity_by_differences(double h, bool taylor_step, bool restart_short);
     ga_status sensitivity_before_attempt(const StepPlan &plan);
     void sensitivity_on_commit();  // after the states' swap in commit
