@@ -10,15 +10,6 @@ namespace ga {
 
 namespace {
 const double kEps = std::numeric_limits<double>::epsilon();
-// Tolerance calibration (docs/algorithms.md sec. 9): the local error test is against
-// kCalibration sqrt(rtol) times the weights atol + rtol |y|, i.e. a tolerance ~ tol^(3/2). An
-// order-2 method whose steps keep the local error at tol' ends with a global error
-// ~ tol'^(2/3); controlled so, it ends ~ tol, from 1e-3 to 1e-8 (docs/design-notes.md,
-// "Tolerance proportionality").
-constexpr double kCalibration = 0.5;
-// ... but a local tolerance is never asked below this, relative: round-off. At rtol 1e-10 the
-// calibration asked 5e-16, and index-3 steps of the pendulum shrank below their minimum.
-constexpr double kMinLocalTolerance = 1e-14;
 // How far the index-3 estimate from a may lie above the one from consistent accelerations
 // before it counts: a's benign oscillation along the constraints (sec. 1.5c) stays below.
 constexpr double kTransientAllowance = 10.0;
@@ -28,9 +19,6 @@ constexpr double kRoundoffUlps = 64.0;
 // were; 1e-2 cost it 13 % more steps (measured: design-notes.md, "The cost of the index-3
 // estimate").
 constexpr double kFactorizedNearby = 1e-3;
-constexpr double kSafety = 0.9;
-constexpr double kMaxGrowth = 2.0, kMinShrink = 0.2;
-constexpr double kFailureShrink = 0.25;
 
 // The constants of (a) and (b): e_q = c_q (a_{n+1} - a_n), e_v = c_v h^3 qddd'
 struct EstimateCoefficients {
@@ -49,11 +37,6 @@ bool recoverable(ga_status st)
            st == GA_ERR_SINGULAR || st == GA_ERR_UNRESOLVED;
 }
 }  // namespace
-
-double Control::calibration() const
-{
-    return std::max(kCalibration * std::sqrt(std::min(rtol, 1.0)), kMinLocalTolerance / rtol);
-}
 
 // Index 3 with constraints and a multiplier transient damped at least as fast as at the default
 // rho_inf = 0.9 (its double root -alpha_f / (1 - alpha_f), sec. 1.4): the error estimate
@@ -266,11 +249,8 @@ ga_status Solver::adaptive_step(double t_stop)
         return diag.fail(GA_ERR_ARG, "t_stop = %.17g is not after t = %.17g", t_stop, t);
     double h = control.h_next;
     if (!(h > 0.0)) {
-        // First step, unless the user gave one: half the step over which the acceleration
-        // alone moves q by the position tolerance, (h^2 / 2) |qdd|_w = 1 in the weighted norm
-        // of the error test (each coordinate against its calibrated atol + rtol |q_i|, so that
-        // a long chain is not measured by its largest coordinate); the controller grows it
-        // quickly.
+        // First step: the weighted RMS norms of qdd and v at the start (each coordinate
+        // against its calibrated atol + rtol |q_i|), from which the controller proposes.
         const double scale = control.calibration();
         double acc = 0.0, vel = 0.0;  // |qdd|_w^2, |v|_w^2
         for (int i = 0; i < n_; ++i) {
@@ -281,41 +261,19 @@ ga_status Solver::adaptive_step(double t_stop)
         }
         acc = std::sqrt(acc / n_);
         vel = std::sqrt(vel / n_);
-        h = control.h_init > 0.0 ? control.h_init
-            : acc > 0.0          ? 0.5 * std::sqrt(2.0 / acc)
-            : vel > 0.0          ? 1.0 / vel
-                                 : 1e-3 * remaining;
+        h = control.first_step(acc, vel, remaining);
     }
-    // The user's minimum, but never below what moves t: at t = -1e300 with h_max = 1 a step
-    // of 1 was accepted with t unchanged (and its checkpoint refused).
-    const double h_min = std::max(control.h_min, 16.0 * kEps * std::max(std::fabs(t), 1.0));
-    // A proposal below the minimum is tried at the minimum: only a step that fails there
-    // fails the call (an initial estimate of 3e-6 under h_min = 1e-4 failed before any try)
-    h = std::max(h, h_min);
-    if (control.h_max > 0.0)
-        h = std::min(h, control.h_max);
+    const double h_min = control.minimum_step(t);
+    h = control.bounded(h, h_min);
     const double tol = newton_tolerance(true);
     bool rejected = false;
     // the last recoverable failure, said again if the steps shrink below h_min because of it
     // (a failing callback ended in "step size fell below the minimum" alone)
     char last_failure[Diagnostics::kSize] = "";
     for (;;) {
-        // Approaching t_stop, no sliver of a last step: up to 1.5 h take it all (the error
-        // test decides), up to 2 h split it in two equal steps.
-        // After a rejection only the clamp to t_stop applies (else the stretch would undo the
-        // shrink).
-        // Stretched, a step stays within h_max.
         bool land = false;
         const double h_planned = h;
-        const double stretch = rejected ? 1.0
-                               : control.h_max > 0.0 ? std::min(1.5, std::max(1.0, control.h_max / h))
-                                                     : 1.5;
-        if (h * stretch >= remaining) {
-            h = remaining;
-            land = true;
-        } else if (!rejected && h * 2.0 > remaining) {
-            h = 0.5 * remaining;
-        }
+        h = control.approach(h, remaining, rejected, land);
         if (h < h_min && !land) {
             diag.fail(GA_ERR_STEP_SIZE,
                       "step size %g fell below the minimum %g at t = %.17g (last error "
@@ -348,44 +306,19 @@ ga_status Solver::adaptive_step(double t_stop)
                 commit(land, t_stop);
                 if (consistent_estimate() && estimate_is_output_)  // (they are the output)
                     output_for_ = state_id_;
-                // Predictive controller (Gustafsson, as in Radau5 and SciPy's Radau; k = 3 for
-                // a local error O(h^3)): the elementary proposal s err^(-1/k), reduced when
-                // the error grew faster than the step size explains,
-                //     fac = s min(1, (h / h_prev) (err_prev / err)^(1/k)) err^(-1/k),
-                // growth at most 2, none right after a rejection or on two consecutive steps
-                // (sec. 1.2). No dead band for small growth: it kept the estimates well below
-                // the tolerance and cost accuracy for the same work (design-notes.md, "Step-size
-                // control"). The first step's estimate has no velocity part (no a history) and
-                // is blind to a start from rest: no base for a prediction (err_prev = 0: none).
-                // A step shortened to land on t_stop (down to a sliver, when t_stop was that
-                // close) was not the controller's choice: no prediction from it, and unless
-                // its error asks for less, the next step takes the one planned.
-                const bool shortened = land && h < h_planned;
-                const double e = std::max(err, 1e-10);
-                double fac = kSafety * std::pow(e, -1.0 / 3.0);
-                if (!shortened && control.err_prev > 0.0 && h_prev > 0.0)
-                    fac *= std::min(1.0, (h / h_prev) * std::cbrt(control.err_prev / e));
-                fac = std::clamp(fac, kMinShrink, kMaxGrowth);
-                if (fac > 1.0 && (rejected || control.grew))
-                    fac = 1.0;
-                control.grew = fac > 1.0;
-                if (!shortened)  // nor a base for the next prediction
-                    control.err_prev = h_prev > 0.0 ? e : 0.0;
-                control.h_next = shortened && fac >= 1.0 ? h_planned : h * fac;
-                if (control.h_max > 0.0)
-                    control.h_next = std::min(control.h_next, control.h_max);
+                control.accept(err, h, h_planned, h_prev, land, rejected);
                 return GA_OK;
             }
             count(counters, GA_COUNT_REJECTED_STEPS);
             last_failure[0] = '\0';
             if (sens.adjoint)  // (a replay from a checkpoint cannot know the matrix it left)
                 invalidate_jacobian();
-            h *= std::max(kMinShrink, kSafety * std::pow(err, -1.0 / 3.0));
+            h = StepController::after_rejection(h, err);
         } else if (recoverable(st)) {
             count(counters, GA_COUNT_FAILED_STEPS);
             invalidate_jacobian();
             diag.copy_to(last_failure);
-            h *= kFailureShrink;
+            h = StepController::after_failure(h);
         } else {
             count(counters, GA_COUNT_FAILED_STEPS);
             invalidate_jacobian();

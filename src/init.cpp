@@ -140,9 +140,7 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
     previous_valid_ = false;
     events_.restart();
     start_pending_ = true;  // corrected starting values need the h of the first step
-    control.h_next = 0.0;
-    control.err_prev = 0.0;  // no accepted step: no base for the predictive controller
-    control.grew = false;
+    control.reset();  // no accepted step: no proposal, no base for a prediction
     if (formulation == GA_INDEX2_STABILIZED)
         prefactor_index2();
     return GA_OK;

@@ -14,6 +14,7 @@
 #include "model.hpp"
 #include "newton.hpp"
 #include "params.hpp"
+#include "step_controller.hpp"
 #include "adjoint.hpp"
 #include "sensitivity.hpp"
 #include "step_plan.hpp"
@@ -40,19 +41,6 @@ struct State {
     void allocate(int n, int m);
     void allocate_first_order(int r);
     void swap(State &other);  // pointer swaps only: no allocation, no copy
-};
-
-// Step-size control (adaptive mode, control.cpp): options and the controller's own state.
-struct Control {
-    double rtol = 1e-6, atol = 1e-6;
-    double h_min = 0.0, h_max = 0.0, h_init = 0.0;  // 0: automatic / unlimited
-    // controller state (part of the checkpoint)
-    double h_next = 0.0, err_prev = 0.0;  // err_prev 0: none (see control.cpp)
-    bool grew = false;
-    double err_last = 0.0;  // error norm of the last accepted step
-    // The factor on the error test's weights (tolerance calibration, control.cpp): the local
-    // error tolerance is calibration() (atol + rtol |y|).
-    double calibration() const;
 };
 
 // The matrix and scratch of an acceleration-level solve (init.cpp): the step's own at the
@@ -105,7 +93,7 @@ public:
     ga_output output = GA_OUTPUT_CONSISTENT;
     bool rescale_a = true;
     bool corrected_start = true;
-    Control control;
+    StepController control;  // step sizes of adaptive mode (step_controller.hpp)
     // First-order states: the method's parameters (from rho_inf, or from alpha_f after
     // ga_set_params) and whether the coupling blocks are in the iteration matrix.
     FirstOrderParams params1;
@@ -273,7 +261,7 @@ private:
     struct StepUndo {
         bool previous_valid, start_pending, adaptive;
     };
-    Control undo_control_;  // the controller before the step (adaptive steps)
+    StepController undo_control_;  // the controller before the step (adaptive steps)
     void undo_step(const StepUndo &u);
     // events.cpp
     ga_status event_values(double t, double *g);

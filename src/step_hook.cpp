@@ -63,7 +63,7 @@ ga_status Solver::hooked_step(bool adaptive, double arg, ga_status (Solver::*ste
         return (this->*step)(arg);
     const double t_before = accepted_.t;
     const StepUndo undo{previous_valid_, start_pending_, adaptive};
-    const Control control_before = control;
+    const StepController control_before = control;
     if (events_.active())
         events_.save();
     const ga_status st = (this->*step)(arg);
