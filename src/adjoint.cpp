@@ -18,9 +18,10 @@
 
 namespace ga {
 
-void AdjointRecord::allocate(int n_, int m_, int r_, int np, long capacity_)
+void AdjointRecord::allocate(int nq_, int nv_, int m_, int r_, int np, long capacity_)
 {
-    n = n_;
+    nq = nq_;
+    nv = nv_;
     m = m_;
     r = r_;
     capacity = capacity_;
@@ -33,15 +34,15 @@ void AdjointRecord::allocate(int n_, int m_, int r_, int np, long capacity_)
     for (auto *set : {&sigma0, &start0}) {
         set->resize(np);
         for (StateDerivative &x : *set)
-            x.allocate(n_, m_, r_);
+            x.allocate(nv_, m_, r_);
     }
 }
 
-void AdjointRecord::allocate_checkpointed(int n_, int m_, int r_, int np, long interval_,
-                                          long count, std::size_t state_size)
+void AdjointRecord::allocate_checkpointed(int nq_, int nv_, int m_, int r_, int np,
+                                          long interval_, long count, std::size_t state_size)
 {
     const long full = max_steps;
-    allocate(n_, m_, r_, np, interval_);
+    allocate(nq_, nv_, m_, r_, np, interval_);
     max_steps = full;
     interval = interval_;
     capacity = interval_ * count;
@@ -53,7 +54,7 @@ void AdjointRecord::allocate_checkpointed(int n_, int m_, int r_, int np, long i
 ga_status Solver::set_adjoint_checkpoints(long interval, long count)
 {
     // (interval * count fits in a long: the C API checked it)
-    const std::size_t stride = AdjointRecord::stride_for(n_, m_, r());
+    const std::size_t stride = AdjointRecord::stride_for(nq_, nv_, m_, r());
     if (interval > 0 && !fits_doubles(static_cast<std::size_t>(interval) + 1, stride))
         return diag.fail(GA_ERR_NOMEM, "an adjoint segment of interval = %ld steps (%zu doubles "
                          "each) is larger than memory can hold", interval, stride);
@@ -69,16 +70,16 @@ ga_status Solver::set_adjoint_checkpoints(long interval, long count)
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
     record.max_steps = adjoint_.max_steps;
     if (interval > 0)
-        record.allocate_checkpointed(n_, m_, r(), sens.np, interval, count, state_size());
+        record.allocate_checkpointed(nq_, nv_, m_, r(), sens.np, interval, count, state_size());
     else
-        record.allocate(n_, m_, r(), sens.np, adjoint_.max_steps);
+        record.allocate(nq_, nv_, m_, r(), sens.np, adjoint_.max_steps);
     adjoint_ = std::move(record);
     return GA_OK;
 }
 
 ga_status Solver::set_sensitivity_method(int methods, long max_steps)
 {
-    const std::size_t stride = AdjointRecord::stride_for(n_, m_, r());
+    const std::size_t stride = AdjointRecord::stride_for(nq_, nv_, m_, r());
     if ((methods & GA_SENSITIVITY_ADJOINT) &&
         !fits_doubles(static_cast<std::size_t>(max_steps) + 1, stride))
         return diag.fail(GA_ERR_NOMEM, "an adjoint record of max_steps = %ld steps (%zu doubles "
@@ -86,7 +87,7 @@ ga_status Solver::set_sensitivity_method(int methods, long max_steps)
                          "keeps one segment", max_steps, stride);
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
     if (methods & GA_SENSITIVITY_ADJOINT)
-        record.allocate(n_, m_, r(), sens.np, max_steps);
+        record.allocate(nq_, nv_, m_, r(), sens.np, max_steps);
     adjoint_ = std::move(record);
     sens.forward = (methods & GA_SENSITIVITY_FORWARD) != 0;
     sens.adjoint = (methods & GA_SENSITIVITY_ADJOINT) != 0;
@@ -202,7 +203,7 @@ struct Solver::AdjointWork {
     Eigen::PartialPivLU<Mat> dense_lu;
     std::vector<Eigen::Triplet<double>> entries;
     int np = 0;
-    void allocate(int n, int m, int r, int p)
+    void allocate(int nq, int n, int m, int r, int p)  // (n: nv)
     {
         for (Vec *v : {&my, &mydot, &mw, &ry, &yp})
             v->setZero(r);
@@ -212,7 +213,7 @@ struct Solver::AdjointWork {
             v->setZero(m);
         cp.setZero(p);
         dJ.assign(p, 0.0);
-        x.allocate(n, m);
+        x.allocate(nq, n, m);
         x.allocate_first_order(r);
         np = p;
     }
@@ -269,7 +270,7 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     const AdjointRecord &r = adjoint_;
     const Params &p = params;
     const bool index2 = formulation == GA_INDEX2_STABILIZED;
-    const int n = n_, m = m_;
+    const int nq = nq_, n = nv_, m = m_;  // (n: the linear algebra's, nv)
     const double *e0 = r.entry(k), *e1 = r.entry(k + 1);
     const double h = e1[1], rho = e1[2];
     const auto kind = static_cast<AdjointRecord::Kind>(e1[3]);
@@ -279,7 +280,9 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     // the converged step and its exact iteration matrix (as sensitivity_step builds it)
     State &x = w.x;
     const double *src = e1 + 4;
-    for (Vec *v : {&x.q, &x.v, &x.qdd}) {
+    x.q = Eigen::Map<const Vec>(src, nq);
+    src += nq;
+    for (Vec *v : {&x.v, &x.qdd}) {
         *v = Eigen::Map<const Vec>(src, n);
         src += n;
     }
@@ -295,7 +298,7 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
         if (!st)
             st = first_order_matrix(t1, x, true);
     }
-    const Vec q_n = Eigen::Map<const Vec>(e0 + 4, n);
+    const Vec q_n = Eigen::Map<const Vec>(e0 + 4, nq);
     if (!st && index2 && m > 0)
         st = model.jacobian(e0[0], q_n, B_);
     if (st)
@@ -667,13 +670,13 @@ ga_status Solver::adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double 
         return diag.fail(GA_ERR_STATE, "the adjoint sweep with dropped redundant constraints is "
                          "not built");
     AdjointWork w;
-    w.allocate(n_, m_, this->r(), sens.np);
+    w.allocate(nq_, nv_, m_, this->r(), sens.np);
     const long N = r.steps;
     // Cost terms at a recorded state k: its value into `value`, weight times its gradient
     // into the adjoint variables (and into dJ/dp).
     const auto cost = [&](ga_cost_fn fn, long k, double weight, double &total) {
         const double *e = r.entry(k);
-        const double *q = e + 4, *v = q + n_, *qdd = v + n_, *lambda = qdd + n_;
+        const double *q = e + 4, *v = q + nq_, *qdd = v + nv_, *lambda = qdd + nv_;
         double value = 0.0;
         if (auto st = model.cost(fn, e[0], q, v, qdd, lambda, value, w.cq, w.cv, w.cqdd, w.cl,
                                  w.cp))

@@ -19,7 +19,7 @@ struct AdjointRecord {
     long capacity = 0;  // steps
     long steps = 0;     // recorded since ga_init
     long max_steps = 0; // of the full record (ga_set_sensitivity_method)
-    int n = 0, m = 0, r = 0;
+    int nq = 0, nv = 0, m = 0, r = 0;
     std::vector<double> data;  // capacity + 1 entries of stride(), or interval + 1
     // Checkpointing (ga_set_adjoint_checkpoints): `data` holds the entries of steps base ...
     // base + interval only; the solver's state after steps 0, interval, 2 interval, ... is
@@ -40,14 +40,14 @@ struct AdjointRecord {
     Kind pending_kind = Regular;
     double pending_rho = 1.0;
 
-    static std::size_t stride_for(int n, int m, int r)
+    static std::size_t stride_for(int nq, int nv, int m, int r)
     {
-        return 4 + 3 * static_cast<std::size_t>(n) + 2 * static_cast<std::size_t>(m) +
-               2 * static_cast<std::size_t>(r);
+        return 4 + static_cast<std::size_t>(nq) + 2 * static_cast<std::size_t>(nv) +
+               2 * static_cast<std::size_t>(m) + 2 * static_cast<std::size_t>(r);
     }
-    std::size_t stride() const { return stride_for(n, m, r); }
-    // entry k: [t, h of the step ending here, rho, kind, q, v, qdd (n each), lambda, eta (m),
-    // y, y' (r each)]
+    std::size_t stride() const { return stride_for(nq, nv, m, r); }
+    // entry k: [t, h of the step ending here, rho, kind, q (nq), v, qdd (nv each), lambda,
+    // eta (m), y, y' (r each)]
     double *entry(long k) { return data.data() + static_cast<std::size_t>(k - base) * stride(); }
     const double *entry(long k) const
     {
@@ -56,8 +56,9 @@ struct AdjointRecord {
     double *checkpoint(long c) { return checkpoints.data() + c * checkpoint_size; }
     double *log_entry(long k) { return log.data() + (k - 1) * kLog; }
     // Throw std::bad_alloc.
-    void allocate(int n_, int m_, int r_, int np, long capacity_);
-    void allocate_checkpointed(int n_, int m_, int r_, int np, long interval_, long count,
+    void allocate(int nq_, int nv_, int m_, int r_, int np, long capacity_);
+    void allocate_checkpointed(int nq_, int nv_, int m_, int r_, int np, long interval_,
+                               long count,
                                std::size_t state_size);
 };
 

@@ -291,7 +291,7 @@ GA_API ga_status ga_get_size(const ga_solver *s, int *n, int *m)
     return reading(s, "ga_get_size", "n or m is NULL", [&](const ga::Solver &c) {
         if (!n || !m)
             return GA_ERR_ARG;
-        *n = c.n();
+        *n = c.nv();  // (ga_create's n: nq = nv)
         *m = c.m();
         return GA_OK;
     });
@@ -453,7 +453,7 @@ ga_status declare_pattern(ga::Solver &c, int which, int nnz, const int *rows, co
         return c.diag.fail(GA_ERR_STATE, "patterns are declared before ga_init");
     if (nnz < 0 || (nnz > 0 && (!rows || !cols)))
         return c.diag.fail(GA_ERR_ARG, "pattern with nnz = %d needs rows and cols", nnz);
-    const int nr = which == GA_MATRIX_JACOBIAN ? c.m() : c.n(), nc = c.n();
+    const int nr = which == GA_MATRIX_JACOBIAN ? c.m() : c.nv(), nc = c.nv();
     if (which == GA_MATRIX_JACOBIAN && c.m() == 0)
         return c.diag.fail(GA_ERR_ARG, "m = 0: there is no constraint Jacobian");
     for (int k = 0; k < nnz; ++k)
@@ -479,7 +479,7 @@ GA_API ga_status ga_set_pattern_csc(ga_solver *s, int which, const int *colptr,
             return c.diag.fail(GA_ERR_ARG, "pattern in CSC form needs colptr");
         if (colptr[0] != 0)
             return c.diag.fail(GA_ERR_ARG, "colptr[0] = %d, not 0", colptr[0]);
-        const int nc = c.n();
+        const int nc = c.nv();
         for (int j = 0; j < nc; ++j)
             if (colptr[j + 1] < colptr[j])
                 return c.diag.fail(GA_ERR_ARG, "colptr decreases at column %d (%d -> %d)", j,
@@ -661,8 +661,8 @@ ga_status set_events(ga_solver *s, const char *name, int count, ga_event_fn fn,
             if (direction[k] < -1 || direction[k] > 1)
                 return c.diag.fail(GA_ERR_ARG, "%s: direction[%d] = %d is not -1, 0 or 1", name,
                                    k, direction[k]);
-        c.events().configure(count, fn, fn_y, direction, terminal, with_multipliers != 0, c.n(),
-                             c.m(), c.r());
+        c.events().configure(count, fn, fn_y, direction, terminal, with_multipliers != 0,
+                             c.nq(), c.nv(), c.m(), c.r());
         return GA_OK;
     });
 }
@@ -796,11 +796,11 @@ GA_API ga_status ga_set_coupling_pattern(ga_solver *s, int which, int nnz, const
         if (nnz < 0 || (nnz > 0 && (!rows || !cols)))
             return c.diag.fail(GA_ERR_ARG, "pattern with nnz = %d needs rows and cols", nnz);
         for (int k = 0; k < nnz; ++k)
-            if (rows[k] < 0 || rows[k] >= c.r() || cols[k] < 0 || cols[k] >= c.n())
+            if (rows[k] < 0 || rows[k] >= c.r() || cols[k] < 0 || cols[k] >= c.nv())
                 return c.diag.fail(GA_ERR_ARG, "pattern entry %d = (%d, %d) is outside the "
-                                   "%d x %d block", k, rows[k], cols[k], c.r(), c.n());
+                                   "%d x %d block", k, rows[k], cols[k], c.r(), c.nv());
         (which == GA_COUPLING_G_Q ? c.model.g_q_pattern : c.model.g_v_pattern)
-            .set_pattern(c.r(), c.n(), rows, cols, nnz);
+            .set_pattern(c.r(), c.nv(), rows, cols, nnz);
         c.invalidate_jacobian();
         return GA_OK;
     });
@@ -866,7 +866,7 @@ GA_API ga_status ga_set_sensitivity_start(ga_solver *s, int j, const double *dq0
                                "with np > 0");
         if (j < 0 || j >= c.sens.np)
             return c.diag.fail(GA_ERR_ARG, "parameter %d: there are %d (0-based)", j, c.sens.np);
-        for (int i = 0; i < c.n(); ++i)
+        for (int i = 0; i < c.nv(); ++i)
             if ((dq0 && !std::isfinite(dq0[i])) || (dv0 && !std::isfinite(dv0[i])))
                 return c.diag.fail(GA_ERR_ARG, "dq0 or dv0 entry %d is not finite", i);
         return c.set_sensitivity_start(j, dq0, dv0);

@@ -1,17 +1,18 @@
 // Checkpoint and restart (ga_get_state, ga_set_state). Layout 4, in doubles:
-//   header   [magic, 4, n, m, t, h_last, h_next, err_prev, grew, sliver_span,
+//   header   [magic, 4, n (= nv), m, t, h_last, h_next, err_prev, grew, sliver_span,
 //             matrix kept (0/1), its t, its h, t of its B, tangents (K + 2 C + 4 Z + 8 if
 //             they were central differences, as for sensitivities),
 //             theta_prev, refresh_steps_left, reuse_backoff, fd_tangents, c_count, c_dt]
-//   state    q, v, qdd (n each), lambda (m), a, a_prev, c, c_prev (n each)
-//   matrix   the iterate it was factorized at: q, v, qdd (n), lambda (m); q of its B (n)
+//   state    q (nq), v, qdd (nv each), lambda (m), a, a_prev, c, c_prev (nv each)
+//   matrix   the iterate it was factorized at: q (nq), v, qdd (nv), lambda (m); q of its B (nq)
 //   active   the constraints in use (m flags; all 1 unless GA_REDUNDANT_DROP dropped some)
-//   pivots   blocks of pivot_state_size(N) (backend.hpp) for S_ (N = n + m), S2_ (2n + 2m),
-//            P_ and O_ (n + m each)
+//   pivots   blocks of pivot_state_size(N) (backend.hpp) for S_ (N = nv + m), S2_
+//            (2 nv + 2 m), P_ and O_ (nv + m each)
 //   y        with r first-order states only: y, y', w, w_prev and the kept matrix's y, y'
 //            (r each)
-//   sens     with np sensitivity parameters only: d/dp_j of q, v, qdd, lambda, a (and with
-//            first-order states y, y', w) for each j
+//   sens     with np sensitivity parameters only: d/dp_j of q, v, qdd, lambda, a (nv each
+//            but lambda: d/dp of q is a tangent; and with first-order states y, y', w) for each j
+// (nq = nv = n while the space is R^n: the bytes of layout 4 as they were.)
 // Taking one only reads. Restoring rebuilds the kept matrix from the callbacks at the same
 // iterate and hands every sparse LU its pivots back, so the restored run repeats the run it
 // came from bit for bit (a kept matrix or pivots left out would make the next steps converge
@@ -39,17 +40,18 @@ struct Layout {
 };
 
 // Layout 4, or with layout3 the one before it (19 header entries, no c and c_prev).
-Layout layout(int n, int m, bool layout3 = false)
+Layout layout(int nq, int nv, int m, bool layout3 = false)
 {
-    const std::size_t N = static_cast<std::size_t>(n), M = static_cast<std::size_t>(m);
+    const std::size_t Q = static_cast<std::size_t>(nq), N = static_cast<std::size_t>(nv),
+                      M = static_cast<std::size_t>(m);
     Layout l;
-    l.matrix = layout3 ? kHeader3 + 5 * N + M : kHeader + 7 * N + M;
-    l.active = l.matrix + 4 * N + M;
+    l.matrix = layout3 ? kHeader3 + Q + 4 * N + M : kHeader + Q + 6 * N + M;
+    l.active = l.matrix + 2 * Q + 2 * N + M;
     l.pivots[0] = l.active + M;
-    l.pivots[1] = l.pivots[0] + pivot_state_size(n + m);
-    l.pivots[2] = l.pivots[1] + pivot_state_size(2 * n + 2 * m);
-    l.pivots[3] = l.pivots[2] + pivot_state_size(n + m);
-    l.end = l.pivots[3] + pivot_state_size(n + m);
+    l.pivots[1] = l.pivots[0] + pivot_state_size(nv + m);
+    l.pivots[2] = l.pivots[1] + pivot_state_size(2 * nv + 2 * m);
+    l.pivots[3] = l.pivots[2] + pivot_state_size(nv + m);
+    l.end = l.pivots[3] + pivot_state_size(nv + m);
     return l;
 }
 }  // namespace
@@ -58,20 +60,20 @@ std::size_t Solver::state_size() const { return state_size_in(false); }
 
 std::size_t Solver::state_size_in(bool layout3) const
 {
-    return layout(n_, m_, layout3).end + 6 * static_cast<std::size_t>(r()) +
+    return layout(nq_, nv_, m_, layout3).end + 6 * static_cast<std::size_t>(r()) +
            static_cast<std::size_t>(sens.np) *
-               (4 * static_cast<std::size_t>(n_) + m_ + 3 * static_cast<std::size_t>(r()));
+               (4 * static_cast<std::size_t>(nv_) + m_ + 3 * static_cast<std::size_t>(r()));
 }
 
 void Solver::get_state(double *buf) const
 {
-    const Layout l = layout(n_, m_);
+    const Layout l = layout(nq_, nv_, m_);
     const State &s = accepted_;
     const MatrixRecipe &r = recipe_;
     std::fill(buf, buf + l.end, 0.0);
     const double header[kHeader] = {kStateMagic,
                                     kStateVersion,
-                                    static_cast<double>(n_),
+                                    static_cast<double>(nv_),
                                     static_cast<double>(m_),
                                     s.t,
                                     s.h_last,
@@ -133,9 +135,10 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
 {
     const bool layout2 = len >= 2 && buf[0] == kStateMagic && buf[1] == 2.0;
     const bool layout3 = len >= 2 && buf[0] == kStateMagic && buf[1] == 3.0;
-    const Layout l = layout(n_, m_, layout3);
+    const Layout l = layout(nq_, nv_, m_, layout3);
     const std::size_t expected =
-        layout2 ? kHeader2 + 5 * static_cast<std::size_t>(n_) + static_cast<std::size_t>(m_)
+        layout2 ? kHeader2 + static_cast<std::size_t>(nq_) + 4 * static_cast<std::size_t>(nv_) +
+                      static_cast<std::size_t>(m_)
                 : state_size_in(layout3);
     if (len != expected)
         return diag.fail(GA_ERR_ARG, "checkpoint has %zu doubles, this solver needs %zu", len,
@@ -146,9 +149,9 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
     if (buf[0] != kStateMagic || (buf[1] != kStateVersion && !layout2 && !layout3))
         return diag.fail(GA_ERR_ARG, "not a galpha checkpoint (magic %g, layout version %g)",
                          buf[0], buf[1]);
-    if (buf[2] != n_ || buf[3] != m_)
+    if (buf[2] != nv_ || buf[3] != m_)
         return diag.fail(GA_ERR_ARG, "checkpoint is for n = %g, m = %g; this solver has n = %d, "
-                         "m = %d", buf[2], buf[3], n_, m_);
+                         "m = %d", buf[2], buf[3], nv_, m_);
     for (std::size_t k = 4; k < len; ++k)
         if (!std::isfinite(buf[k]))
             return diag.fail(GA_ERR_ARG, "checkpoint entry %zu is not finite", k);
@@ -219,7 +222,7 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
     }
     if (redundancy == GA_REDUNDANT_DROP && m_ > 0) {
         if (layout2) {
-            const Vec q = Eigen::Map<const Vec>(buf + kHeader2, n_);
+            const Vec q = Eigen::Map<const Vec>(buf + kHeader2, nq_);
             const std::vector<unsigned char> active_before = active_;
             if (auto st = select_active_constraints(buf[4], q)) {
                 restore_active(active_before);

@@ -83,7 +83,7 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
         // rad/s) then took 13 % more steps with its accelerations' errors spread 6 times wider
         // over the tolerances (docs/design-notes.md).
         double moved = 0.0;
-        for (int i = 0; i < n_ && jacobian_valid_; ++i)
+        for (int i = 0; i < nv_ && jacobian_valid_; ++i)
             moved = std::max(moved, model.space.distance(x.q, recipe_.q, i) /
                                         (model.space.magnitude(x.q, i) + 1.0));
         if (jacobian_valid_ && moved <= kFactorizedNearby) {
@@ -209,7 +209,7 @@ double Solver::weighted_error_norm(const State &s, const State &x, const Vec &eq
     const double rtol = control.rtol, atol = control.atol;
     const double scale = control.calibration();
     double sum = 0.0;
-    for (int i = 0; i < n_; ++i) {
+    for (int i = 0; i < nv_; ++i) {
         const double wq =
             scale * (atol + rtol * std::max(model.space.magnitude(s.q, i),
                                             model.space.magnitude(x.q, i))) +
@@ -219,8 +219,8 @@ double Solver::weighted_error_norm(const State &s, const State &x, const Vec &eq
         sum += (eq[i] / wq) * (eq[i] / wq) + (ev[i] / wv) * (ev[i] / wv);
     }
     if (r() > 0)
-        return std::sqrt((sum + first_order_error_sum(h, scale)) / (2.0 * n_ + r()));
-    return std::sqrt(sum / (2.0 * n_));
+        return std::sqrt((sum + first_order_error_sum(h, scale)) / (2.0 * nv_ + r()));
+    return std::sqrt(sum / (2.0 * nv_));
 }
 
 ga_status Solver::adaptive_step(double t_stop)
@@ -253,14 +253,14 @@ ga_status Solver::adaptive_step(double t_stop)
         // against its calibrated atol + rtol |q_i|), from which the controller proposes.
         const double scale = control.calibration();
         double acc = 0.0, vel = 0.0;  // |qdd|_w^2, |v|_w^2
-        for (int i = 0; i < n_; ++i) {
+        for (int i = 0; i < nv_; ++i) {
             const double w =
                 scale * (control.atol + control.rtol * model.space.magnitude(accepted_.q, i));
             acc += (accepted_.qdd[i] / w) * (accepted_.qdd[i] / w);
             vel += (accepted_.v[i] / w) * (accepted_.v[i] / w);
         }
-        acc = std::sqrt(acc / n_);
-        vel = std::sqrt(vel / n_);
+        acc = std::sqrt(acc / nv_);
+        vel = std::sqrt(vel / nv_);
         h = control.first_step(acc, vel, remaining);
     }
     const double h_min = control.minimum_step(t);

@@ -85,7 +85,7 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
                                     const double *qdd0, const double *lambda0, const double *y0,
                                     double tol, double *worst_out)
 {
-    const int n = n_, m = m_, R = r();
+    const int n = nv_, m = m_, R = r();
     Vec q = Eigen::Map<const Vec>(q0, n), v = Eigen::Map<const Vec>(v0, n);
     Vec qdd = qdd0 ? Vec(Eigen::Map<const Vec>(qdd0, n)) : Vec::Zero(n);
     // (ones: the multipliers' part of K_t is checked too)

@@ -80,13 +80,14 @@ int EventLocator::locate(double t0, const double *g0, double t1, const double *g
 }
 
 void EventSet::configure(int count, ga_event_fn fn, ga_event_y_fn fn_y, const int *direction,
-                         const int *terminal, bool with_lambda, int n, int m, int r)
+                         const int *terminal, bool with_lambda, int nq, int nv, int m,
+                         int r)
 {
     // everything is allocated before anything changes: a failure leaves the old set
     std::vector<int> dir(count), term(count), fired(count);
     std::vector<double> lo(count), hi(count), slo(count), shi(count), past(count),
         start(count);
-    std::vector<double> qs(count ? n : 0), vs(count ? n : 0), ls(count && with_lambda ? m : 0);
+    std::vector<double> qs(count ? nq : 0), vs(count ? nv : 0), ls(count && with_lambda ? m : 0);
     std::vector<double> ys(count && fn_y ? r : 0);
     // a whole root fits into an empty log, however many functions cross at it
     std::vector<Entry> log(count ? std::max(count, GA_EVENT_LOG) : 0);

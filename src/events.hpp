@@ -64,7 +64,7 @@ public:
     // Allocates everything the search needs (count 0: no events); throws std::bad_alloc.
     // fn_y instead of fn: the functions see the first-order states (r of them) too.
     void configure(int count, ga_event_fn fn, ga_event_y_fn fn_y, const int *direction,
-                   const int *terminal, bool with_lambda, int n, int m, int r);
+                   const int *terminal, bool with_lambda, int nq, int nv, int m, int r);
     int count() const { return static_cast<int>(direction_.size()); }
     bool active() const { return count() > 0; }
     ga_event_fn fn() const { return fn_; }

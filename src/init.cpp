@@ -94,8 +94,8 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
     x.t = t0;
     x.h_last = 0.0;
     x.sliver_span = 0.0;
-    x.q = Eigen::Map<const Vec>(q0, n_);
-    x.v = Eigen::Map<const Vec>(v0, n_);
+    x.q = Eigen::Map<const Vec>(q0, nq_);
+    x.v = Eigen::Map<const Vec>(v0, nv_);
     if (!all_finite(x.q) || !all_finite(x.v))
         return diag.fail(GA_ERR_ARG, "q0 or v0 contains NaN or Inf");
 
@@ -189,7 +189,7 @@ ga_status Solver::acceleration_level(double t, const Vec &q, const Vec &v, Saddl
         const std::vector<int> &rows = w.M.row_index();
         for (int k = 0; k < w.M.nnz(); ++k)  // (repeated entries add up)
             qdd[rows[k]] += w.M.data()[k];
-        for (int i = 0; i < n_; ++i) {
+        for (int i = 0; i < nv_; ++i) {
             if (!(qdd[i] != 0.0))
                 return diag.fail(GA_ERR_SINGULAR,
                                  "the mass matrix M (diagonal) is singular at t = %.17g: "
@@ -230,12 +230,12 @@ ga_status Solver::select_active_constraints(double t, const Vec &q)
 {
     if (auto st = model.jacobian(t, q, J_))
         return st;
-    if (independent_in_order(J_, n_, m_, active_.data()) < 0)
+    if (independent_in_order(J_, nv_, m_, active_.data()) < 0)
         return diag.fail(GA_ERR_ARG,
                          "dropping redundant constraints of a dense Phi_q takes a dense "
                          "Gram-Schmidt, and n m = %.0f is too large for it (declare the "
                          "pattern of Phi_q)",
-                         static_cast<double>(n_) * m_);
+                         static_cast<double>(nv_) * m_);
     invalidate_jacobian();  // the matrices change with the set of active constraints
     return GA_OK;
 }
@@ -260,7 +260,7 @@ void Solver::explain_singular_saddle_point()
             return;
         }
     std::vector<unsigned char> independent(m_);
-    const int rank = m_ > 0 ? independent_in_order(J_, n_, m_, independent.data()) : -1;
+    const int rank = m_ > 0 ? independent_in_order(J_, nv_, m_, independent.data()) : -1;
     if (rank < 0) {
         diag.append(": redundant constraints, or M singular on the null space of Phi_q");
         return;

@@ -101,20 +101,20 @@ void ColumnGroups::build(const ModelMatrix &A)
 }
 
 Model::Model(int n, int m, Counters &counters, Diagnostics &diag)
-    : space(n), n_(n), m_(m), counters_(counters), diag_(diag)
+    : space(n), nv_(n), m_(m), counters_(counters), diag_(diag)
 {
 }
 
 void Model::allocate_workspace(const ModelMatrix &M, const ModelMatrix &J, const ModelMatrix &K,
                                const ModelMatrix &C)
 {
-    q_pert_.setZero(n_);
-    v_pert_.setZero(n_);
-    f_pert_.setZero(n_);
-    r_pert_.setZero(n_);
-    r_minus_.setZero(n_);
-    f_minus_.setZero(n_);
-    step_.setZero(n_);
+    q_pert_.setZero(space.nq());
+    v_pert_.setZero(nv_);
+    f_pert_.setZero(nv_);
+    r_pert_.setZero(nv_);
+    r_minus_.setZero(nv_);
+    f_minus_.setZero(nv_);
+    step_.setZero(nv_);
     phi_plus_.setZero(m_);
     phi_minus_.setZero(m_);
     g_plus_.setZero(m_);
@@ -195,7 +195,7 @@ ga_status Model::force(double t, const Vec &q, const Vec &v, Vec &f, Check check
                 user([&] { return cb.force_y(t, q.data(), v.data(), y, f.data(), cb.user); }),
                 "force", t))
             return st;
-        return check == Check::Now ? check_finite(f.data(), n_, 0, "force f", t) : GA_OK;
+        return check == Check::Now ? check_finite(f.data(), nv_, 0, "force f", t) : GA_OK;
     }
     if (!cb.force) {  // no applied forces: nothing to evaluate, nothing to count
         f.setZero();
@@ -205,7 +205,7 @@ ga_status Model::force(double t, const Vec &q, const Vec &v, Vec &f, Check check
     if (auto st = callback_status(user([&] { return cb.force(t, q.data(), v.data(), f.data(), cb.user); }), "force",
                                   t))
         return st;
-    return check == Check::Now ? check_finite(f.data(), n_, 0, "force f", t) : GA_OK;
+    return check == Check::Now ? check_finite(f.data(), nv_, 0, "force f", t) : GA_OK;
 }
 
 ga_status Model::force_p(double t, const Vec &q, const Vec &v, int j, Vec &out)
@@ -215,7 +215,7 @@ ga_status Model::force_p(double t, const Vec &q, const Vec &v, int j, Vec &out)
             user([&] { return cb.force_p(t, q.data(), v.data(), j, out.data(), cb.user); }),
             "force_p", t))
         return st;
-    return check_finite(out.data(), n_, 0, "df/dp", t);
+    return check_finite(out.data(), nv_, 0, "df/dp", t);
 }
 
 ga_status Model::mass_p(double t, const Vec &q, int j, const Vec &a, Vec &out)
@@ -225,7 +225,7 @@ ga_status Model::mass_p(double t, const Vec &q, int j, const Vec &a, Vec &out)
             user([&] { return cb.mass_p(t, q.data(), j, a.data(), out.data(), cb.user); }),
             "mass_p", t))
         return st;
-    return check_finite(out.data(), n_, 0, "(dM/dp) a", t);
+    return check_finite(out.data(), nv_, 0, "(dM/dp) a", t);
 }
 
 ga_status Model::constraint_p(double t, const Vec &q, int j, Vec &phi_p, ModelMatrix &J_p,
@@ -297,7 +297,7 @@ ga_status Model::jacobian(double t, const Vec &q, ModelMatrix &J, Check check)
 ga_status Model::check_deferred(double t, const Vec &f, const ModelMatrix &J)
 {
     if (has_force())
-        if (auto st = check_finite(f.data(), n_, 0, "force f", t))
+        if (auto st = check_finite(f.data(), nv_, 0, "force f", t))
             return st;
     if (m_ == 0 || J.zero())
         return GA_OK;
@@ -375,7 +375,7 @@ ga_status Model::stiffness(double t, const Vec &q, const Vec &v, const Vec &qdd,
     q_pert_ = q;
     if (K.dense()) {
         auto Kd = K.as_dense();
-        for (int j = 0; j < n_; ++j) {
+        for (int j = 0; j < nv_; ++j) {
             const double e = central ? central_increment(q[j]) : fd_increment(q[j]);
             space.shift_coordinate(q_pert_, q, j, e);
             if (auto st = perturbed_residual(t, q_pert_, v, qdd, lambda, M, r_pert_))
@@ -440,7 +440,7 @@ ga_status Model::damping(double t, const Vec &q, const Vec &v, const Vec &f, Mod
     v_pert_ = v;
     if (C.dense()) {
         auto Cd = C.as_dense();
-        for (int j = 0; j < n_; ++j) {
+        for (int j = 0; j < nv_; ++j) {
             const double e = central ? central_increment(v[j]) : fd_increment(v[j]);
             v_pert_[j] = v[j] + e;
             if (auto st = force(t, q, v_pert_, f_pert_))
@@ -645,7 +645,7 @@ ga_status Model::coupling_block(double t, const Vec &q, const Vec &v, const Vec 
     };
     const double span = central ? 2.0 : 1.0;
     if (pattern.dense()) {
-        for (int j = 0; j < n_; ++j) {
+        for (int j = 0; j < nv_; ++j) {
             const double e = central ? central_increment(x[j]) : fd_increment(x[j]);
             shift(j, e);
             ga_status st = evaluate(rate_pert_);

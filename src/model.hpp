@@ -37,15 +37,16 @@ struct Callbacks {
     void *user = nullptr;
 };
 
-// The coupling blocks of first-order states, dense: g_q, g_v (r x n), g_y (r x r), f_y (n x r).
+// The coupling blocks of first-order states, dense: g_q, g_v (r x nv), g_y (r x r), f_y
+// (nv x r).
 struct CouplingBlocks {
     Mat g_q, g_v, g_y, f_y;
-    void allocate(int n, int r)
+    void allocate(int nv, int r)
     {
-        g_q.setZero(r, n);
-        g_v.setZero(r, n);
+        g_q.setZero(r, nv);
+        g_v.setZero(r, nv);
         g_y.setZero(r, r);
-        f_y.setZero(n, r);
+        f_y.setZero(nv, r);
     }
 };
 
@@ -92,8 +93,8 @@ public:
     void set_first_order_count(int r)
     {
         r_ = r;
-        g_q_pattern.set_dense(r, n_);
-        g_v_pattern.set_dense(r, n_);
+        g_q_pattern.set_dense(r, nv_);
+        g_v_pattern.set_dense(r, nv_);
     }
     // Where g_q, g_v may be nonzero (dense: anywhere): their differences perturb the columns
     // of a group together (ColumnGroups, built at setup).
@@ -212,7 +213,7 @@ private:
     ga_status perturbed_residual(double t, const Vec &qp, const Vec &v, const Vec &qdd,
                                  const Vec &lambda, const ModelMatrix &M, Vec &r);
 
-    int n_, m_;
+    int nv_, m_;  // v's coordinates (q's: space.nq())
     Counters &counters_;
     Diagnostics &diag_;
     // finite-difference scratch

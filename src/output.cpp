@@ -20,15 +20,15 @@ void Solver::setup_output()
         return;
     auto backend = sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Auto);
     backend->analysis_from(S_.backend());  // the same pattern: its ordering, not a second one
-    O_.setup(std::move(backend), n_, m_, M_, J_, K_, C_, active_ptr());
+    O_.setup(std::move(backend), nv_, m_, M_, J_, K_, C_, active_ptr());
     out_M_.copy_layout(M_);
     out_J_.copy_layout(J_);
-    out_f_.setZero(n_);
+    out_f_.setZero(nv_);
     out_c_.setZero(m_);
-    out_r_.setZero(n_);
-    out_q_.setZero(n_);
-    out_v_.setZero(n_);
-    out_qdd_.setZero(n_);
+    out_r_.setZero(nv_);
+    out_q_.setZero(nq_);
+    out_v_.setZero(nv_);
+    out_qdd_.setZero(nv_);
     out_lambda_.setZero(m_);
     O_.reserve_factors();
 }
@@ -58,7 +58,7 @@ ga_status Solver::output_state(double *qdd, double *lambda)
     const State &x = accepted_;
     if (output != GA_OUTPUT_CONSISTENT) {
         if (qdd)
-            Eigen::Map<Vec>(qdd, n_) = x.qdd;
+            Eigen::Map<Vec>(qdd, nv_) = x.qdd;
         if (lambda && m_ > 0)
             Eigen::Map<Vec>(lambda, m_) = x.lambda;
         return GA_OK;
@@ -70,7 +70,7 @@ ga_status Solver::output_state(double *qdd, double *lambda)
         output_for_ = state_id_;
     }
     if (qdd)
-        Eigen::Map<Vec>(qdd, n_) = out_qdd_;
+        Eigen::Map<Vec>(qdd, nv_) = out_qdd_;
     if (lambda && m_ > 0)
         Eigen::Map<Vec>(lambda, m_) = out_lambda_;
     return GA_OK;
@@ -108,9 +108,9 @@ ga_status Solver::interpolate(double t, double *q, double *v, double *qdd, doubl
     if (consistent || v)
         out_v_ = h00 * a.v + (h10 * h) * a.qdd + h01 * b.v + (h11 * h) * b.qdd;
     if (q)
-        Eigen::Map<Vec>(q, n_) = out_q_;
+        Eigen::Map<Vec>(q, nq_) = out_q_;
     if (v)
-        Eigen::Map<Vec>(v, n_) = out_v_;
+        Eigen::Map<Vec>(v, nv_) = out_v_;
     if (consistent) {
         if (r() > 0) {  // the forces at t see y there
             if (auto st = interpolate_y(t, out_y_.data(), nullptr))
@@ -121,14 +121,14 @@ ga_status Solver::interpolate(double t, double *q, double *v, double *qdd, doubl
             return st;
         output_for_ = -1;  // out_qdd_, out_lambda_ now hold values at t
         if (qdd)
-            Eigen::Map<Vec>(qdd, n_) = out_qdd_;
+            Eigen::Map<Vec>(qdd, nv_) = out_qdd_;
         if (lambda && m_ > 0)
             Eigen::Map<Vec>(lambda, m_) = out_lambda_;
         return GA_OK;
     }
     // the step's own values, linear over the step
     if (qdd)
-        Eigen::Map<Vec>(qdd, n_) = (1.0 - th) * a.qdd + th * b.qdd;
+        Eigen::Map<Vec>(qdd, nv_) = (1.0 - th) * a.qdd + th * b.qdd;
     if (lambda && m_ > 0)
         Eigen::Map<Vec>(lambda, m_) = (1.0 - th) * a.lambda + th * b.lambda;
     return GA_OK;

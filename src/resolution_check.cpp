@@ -35,7 +35,7 @@ ga_status Solver::check_velocity_constraint(double h, double tol)
     // the speeds of its own coordinates only, a link that starts to fall from the horizontal
     // measured an O(h^2) residual against the second-order motion along the link: 0.22.)
     double top = 0.0, q_max = 0.0;
-    for (int j = 0; j < n_; ++j) {
+    for (int j = 0; j < nv_; ++j) {
         top = std::max(top, std::fabs(x.v[j]) + model.space.distance(x.q, s.q, j) / h);
         q_max = std::max(q_max, model.space.magnitude(x.q, j));
     }

@@ -18,7 +18,7 @@ namespace {
 const double kEps = std::numeric_limits<double>::epsilon();
 }
 
-void Sensitivities::allocate(int n, int m, int r)
+void Sensitivities::allocate(int nq, int n, int m, int r)  // (n: nv)
 {
     for (auto *set : {&accepted, &trial, &start}) {
         set->resize(np);
@@ -28,7 +28,9 @@ void Sensitivities::allocate(int n, int m, int r)
     wide.allocate(n, m, r);
     for (Vec *x : {&ry, &dy, &gy, &w0, &rate_plus, &rate_minus})
         x->setZero(r);
-    for (Vec *x : {&rq, &d, &w, &f_plus, &f_minus, &bt, &a0, &xq, &xv, &cq, &cbt, &cq2, &cbt2})
+    xq.setZero(nq);  // points: the rest are tangents
+    q_pert.setZero(nq);
+    for (Vec *x : {&rq, &d, &w, &f_plus, &f_minus, &bt, &a0, &xv, &cq, &cbt, &cq2, &cbt2})
         x->setZero(n);
     seed_q.assign(np, Vec::Zero(n));
     seed_v.assign(np, Vec::Zero(n));
@@ -70,10 +72,10 @@ ga_status Solver::set_sensitivity(int np, double *p, const double *p_scale, int 
     for (int j = 0; j < np; ++j)
         s.scale[j] = p_scale ? p_scale[j] : (p[j] != 0.0 ? std::fabs(p[j]) : 1.0);
     if (np > 0) {
-        s.allocate(n_, m_, r());
+        s.allocate(nq_, nv_, m_, r());  // (d/dp of q is a tangent: nv)
         if (workspace_ready_)
             s.allocate_matrices(M_, J_);
-        sens_scratch_.allocate(n_, m_);
+        sens_scratch_.allocate(nq_, nv_, m_);
         sens_scratch_.allocate_first_order(r());
     }
     sens = std::move(s);
@@ -83,8 +85,8 @@ ga_status Solver::set_sensitivity(int np, double *p, const double *p_scale, int 
 
 ga_status Solver::set_sensitivity_start(int j, const double *dq0, const double *dv0)
 {
-    Vec q = dq0 ? Vec(Eigen::Map<const Vec>(dq0, n_)) : Vec::Zero(n_);
-    Vec v = dv0 ? Vec(Eigen::Map<const Vec>(dv0, n_)) : Vec::Zero(n_);
+    Vec q = dq0 ? Vec(Eigen::Map<const Vec>(dq0, nv_)) : Vec::Zero(nv_);
+    Vec v = dv0 ? Vec(Eigen::Map<const Vec>(dv0, nv_)) : Vec::Zero(nv_);
     sens.seed_q[j].swap(q);  // (no allocation after the two above)
     sens.seed_v[j].swap(v);
     return GA_OK;
@@ -529,8 +531,8 @@ ga_status Solver::correction_derivative(double t, const Vec &q, const Vec &eta, 
         return GA_OK;
     const double e = std::cbrt(kEps) * std::max(model.space.max_magnitude(q), 1.0) / s_max;
     for (int side = 0; side < 2; ++side) {
-        model.space.shifted(q, side == 0 ? e : -e, s, z.d);
-        if (auto st = model.jacobian(t, z.d, z.J_pert))
+        model.space.shifted(q, side == 0 ? e : -e, s, z.q_pert);
+        if (auto st = model.jacobian(t, z.q_pert, z.J_pert))
             return st;
         z.J_pert.multiply_transpose_add(side == 0 ? -0.5 / e : 0.5 / e, eta, out);
     }

@@ -17,8 +17,9 @@ namespace ga {
 struct StateDerivative {
     Vec q, v, qdd, lambda, a;
     Vec y, ydot, w;
-    void allocate(int n, int m, int r = 0)
+    void allocate(int nv, int m, int r = 0)  // (d/dp of q is a tangent: nv)
     {
+        const int n = nv;
         q.setZero(n);
         v.setZero(n);
         qdd.setZero(n);
@@ -56,6 +57,7 @@ struct Sensitivities {
 
     // scratch of one step
     Vec rq, rl, rv, d, w, dl, e, f_plus, f_minus, bt, a0, xq, xv;
+    Vec q_pert;  // a point of q along a tangent (correction_derivative)
     Vec ry, dy, gy, w0, rate_plus, rate_minus;  // first-order states (r)
     // the constraints' parameter terms (GA_DEPENDS_CONSTRAINT): in r^q, Phi, the velocity
     // constraint and the index-2 position correction; phi is scratch
@@ -66,7 +68,7 @@ struct Sensitivities {
     bool active() const { return np > 0; }
     // Sizes the vectors, and the matrices in the layouts of M and Phi_q (at setup, when the
     // patterns are known); throw std::bad_alloc.
-    void allocate(int n, int m, int r);
+    void allocate(int nq, int nv, int m, int r);
     void allocate_matrices(const ModelMatrix &M, const ModelMatrix &J);
     // The perturbation of p_j for central differences, and the wider one of extrapolated
     // differences, (4 D(e/2) - D(e)) / 3 with error O(eps^(4/5)).

@@ -89,16 +89,16 @@ void apply_update(const ConfigurationSpace &space, const Vec &dq, const Vec &dw,
 }
 }  // namespace
 
-void State::allocate(int n, int m)
+void State::allocate(int nq, int nv, int m)
 {
-    q.setZero(n);
-    v.setZero(n);
-    qdd.setZero(n);
+    q.setZero(nq);
+    v.setZero(nv);
+    qdd.setZero(nv);
     lambda.setZero(m);
-    a.setZero(n);
-    a_prev.setZero(n);
-    c.setZero(n);
-    c_prev.setZero(n);
+    a.setZero(nv);
+    a_prev.setZero(nv);
+    c.setZero(nv);
+    c_prev.setZero(nv);
     c_dt = 0.0;
     c_count = 0;
 }
@@ -134,22 +134,24 @@ void State::swap(State &other)
 
 Solver::Solver(int n, int m)
     : params(params_from_rho_inf(0.9)), params1(first_order_params_from_rho_inf(0.9)),
-      model(n, m, counters, diag), n_(n), m_(m)
+      model(n, m, counters, diag), nq_(n), nv_(n), m_(m)  // (ga_create: one block R^n)
 {
-    accepted_.allocate(n, m);
-    trial_.allocate(n, m);
-    previous_.allocate(n, m);
-    a_n_.setZero(n);
-    v_n_.setZero(n);
-    qdd_n_.setZero(n);
+    accepted_.allocate(nq_, nv_, m);
+    trial_.allocate(nq_, nv_, m);
+    previous_.allocate(nq_, nv_, m);
+    a_n_.setZero(nv_);
+    v_n_.setZero(nv_);
+    qdd_n_.setZero(nv_);
     lambda_n_.setZero(m);
-    for (Vec *x : {&recipe_.q, &recipe_.v, &recipe_.qdd, &recipe_.q_b})
-        x->setZero(n);
+    for (Vec *x : {&recipe_.q, &recipe_.q_b})
+        x->setZero(nq_);
+    for (Vec *x : {&recipe_.v, &recipe_.qdd})
+        x->setZero(nv_);
     recipe_.lambda.setZero(m);
-    M_.set_dense(n, n);
-    J_.set_dense(m, n);
-    K_.set_dense(n, n);
-    C_.set_dense(n, n);
+    M_.set_dense(nv_, nv_);
+    J_.set_dense(m, nv_);
+    K_.set_dense(nv_, nv_);
+    C_.set_dense(nv_, nv_);
 }
 
 ModelMatrix &Solver::matrix(ga_matrix which)
@@ -200,7 +202,7 @@ ga_status Solver::setup_workspace()
                              "pattern declares a zero matrix)");
         sparse = true;
         break;
-    case GA_LINEAR_AUTO: sparse = sparse_possible && n_ + m_ >= kSparseMinSize; break;
+    case GA_LINEAR_AUTO: sparse = sparse_possible && nv_ + m_ >= kSparseMinSize; break;
     default: sparse = false;
     }
     std::unique_ptr<LinearBackend> backend;
@@ -212,7 +214,7 @@ ga_status Solver::setup_workspace()
     if (!backend) {
         // The dense iteration matrix has (n + m)^2 entries; refuse sizes whose byte count
         // does not fit in the address space instead of letting the multiplication overflow.
-        const double N = static_cast<double>(n_) + static_cast<double>(m_);
+        const double N = static_cast<double>(nv_) + static_cast<double>(m_);
         if (N * N * sizeof(double) >
             static_cast<double>(std::numeric_limits<std::ptrdiff_t>::max()))
             throw std::bad_alloc();
@@ -228,18 +230,18 @@ ga_status Solver::setup_workspace()
         C_.allocate();
     B_.copy_layout(J_);
     Z_.copy_layout(J_);
-    f_.setZero(n_);
+    f_.setZero(nv_);
     phi_.setZero(m_);
     phi_v_.setZero(m_);
-    rq_.setZero(n_);
-    dq_.setZero(n_);
-    dw_.setZero(n_);
+    rq_.setZero(nv_);
+    dq_.setZero(nv_);
+    dw_.setZero(nv_);
     dlambda_.setZero(m_);
     deta_.setZero(m_);
     c_.setZero(m_);
-    qdd_tmp_.setZero(n_);
-    guard_q_.setZero(n_);
-    guard_v_.setZero(n_);
+    qdd_tmp_.setZero(nv_);
+    guard_q_.setZero(nv_);
+    guard_v_.setZero(nv_);
     check_residual_.setZero(m_);
     check_scale_.setZero(m_);
     check_phi_t_.setZero(m_);
@@ -249,16 +251,16 @@ ga_status Solver::setup_workspace()
         sens.allocate_matrices(M_, J_);
     if (r() > 0) {
         const int r1 = r();
-        blocks_.allocate(n_, r1);
+        blocks_.allocate(nv_, r1);
         for (Mat *Z : {&Zq_, &Zw_})
-            Z->setZero(n_, r1);
+            Z->setZero(nv_, r1);
         for (Mat *Z : {&Zl_, &Ze_})
             Z->setZero(m_, r1);
         C1_.setZero(r1, r1);
-        Cg_.setZero(r1, n_);
+        Cg_.setZero(r1, nv_);
         C1_lu_ = Eigen::PartialPivLU<Mat>(r1);
         for (Vec *x : {&z_rhs_, &z_d_, &z_w_})
-            x->setZero(n_);
+            x->setZero(nv_);
         for (Vec *x : {&z_zero_, &z_l_, &z_e_})
             x->setZero(m_);
         for (Vec *x : {&rate_, &ry_, &gx_, &dy_, &w_n_, &ydot_n_, &y_tmp_, &z_y_})
@@ -269,7 +271,7 @@ ga_status Solver::setup_workspace()
     sparse_backend_ = sparse && backend;
     if (redundancy == GA_REDUNDANT_DROP)
         active_.assign(m_, 1);
-    S_.setup(std::move(backend), n_, m_, M_, J_, K_, C_, active_ptr());
+    S_.setup(std::move(backend), nv_, m_, M_, J_, K_, C_, active_ptr());
     workspace_ready_ = true;
     return GA_OK;
 }
@@ -292,10 +294,10 @@ void Solver::set_aside_matrix(KeptMatrix &kept)
     auto backend = sparse_backend_ ? make_sparse_backend()
                                    : make_dense_backend(dense_kind(linear_solver));
     backend->analysis_from(S_.backend());  // the same pattern: its ordering
-    kept.S.setup(std::move(backend), n_, m_, M_, J_, K_, C_, active_ptr());
+    kept.S.setup(std::move(backend), nv_, m_, M_, J_, K_, C_, active_ptr());
     kept.S.reserve_factors();
     if (S2_.ready()) {
-        kept.S2.setup(n_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_,
+        kept.S2.setup(nv_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_,
                       active_ptr());
         kept.S2.reserve_factors();
     }
@@ -319,7 +321,7 @@ void Solver::take_back_matrix(KeptMatrix &kept)
 void Solver::setup_index2()
 {
     if (!S2_.ready()) {
-        S2_.setup(n_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_, active_ptr());
+        S2_.setup(nv_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_, active_ptr());
         S2_.reserve_factors();
     }
     if (initialized_)
@@ -346,7 +348,7 @@ void Solver::setup_projection()
         auto backend =
             sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Auto);
         backend->analysis_from(S_.backend());  // the same pattern: its ordering
-        P_.setup(std::move(backend), n_, m_, M_, J_, K_, C_, active_ptr());
+        P_.setup(std::move(backend), nv_, m_, M_, J_, K_, C_, active_ptr());
         P_.reserve_factors();
     }
 }
@@ -573,7 +575,7 @@ ga_status Solver::regular_step(const StepPlan &plan)
     // Algorithm 1, last line: a_{n+1} from eq. (3) with the converged qdd_{n+1}; a_n kept for
     // the error estimate of the next step (one pass for both)
     const Vec &a_n = *a_start_, &qdd_n = *qdd_start_;
-    for (Eigen::Index i = 0; i < n_; ++i) {
+    for (Eigen::Index i = 0; i < nv_; ++i) {
         x.a[i] = (p.alpha_f * qdd_n[i] - p.alpha_m * a_n[i] + (1.0 - p.alpha_f) * x.qdd[i]) /
                  (1.0 - p.alpha_m);
         x.a_prev[i] = a_n[i];
@@ -812,8 +814,8 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
     // qdd(t_n + h) = qdd_n + (h / h_last) (a_n - qdd_n) / delta_alpha + O(h^2).
     const double slope = start == Extrapolate ? h / (s.h_last * delta_alpha) : 0.0;
     bool finite = true;
-    for (Eigen::Index i = 0; i < n_; i += kBlock) {  // blocks in L1: one trip to memory
-        const Eigen::Index len = std::min(kBlock, n_ - i);
+    for (Eigen::Index i = 0; i < nv_; i += kBlock) {  // blocks in L1: one trip to memory
+        const Eigen::Index len = std::min(kBlock, nv_ - i);
         const auto qdd_n = qdd_start_->segment(i, len), an = a_n.segment(i, len);
         auto qdd = x.qdd.segment(i, len), a = x.a.segment(i, len), q = x.q.segment(i, len),
              v = x.v.segment(i, len);

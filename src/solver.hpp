@@ -38,7 +38,7 @@ struct State {
     // is of qdd) and w of the state before; empty when r = 0.
     Vec y, ydot, w, w_prev;
 
-    void allocate(int n, int m);
+    void allocate(int nq, int nv, int m);  // q: nq; v, qdd, a, a_prev, c, c_prev: nv
     void allocate_first_order(int r);
     void swap(State &other);  // pointer swaps only: no allocation, no copy
 };
@@ -74,7 +74,8 @@ class Solver {
 public:
     Solver(int n, int m);
 
-    int n() const { return n_; }
+    int nq() const { return nq_; }  // q's coordinates
+    int nv() const { return nv_; }  // v's, and those of every increment of q
     int m() const { return m_; }
 
     // Options (validated by the C API before they get here).
@@ -374,7 +375,7 @@ private:
     ga_status select_active_constraints(double t, const Vec &q);
     const unsigned char *active_ptr() const { return active_.empty() ? nullptr : active_.data(); }
 
-    int n_, m_;
+    int nq_, nv_, m_;  // equal while the space is R^n (configuration_space.hpp)
     std::vector<unsigned char> active_;  // GA_REDUNDANT_DROP: constraints in use
     bool initialized_ = false;
     bool workspace_ready_ = false;
