@@ -686,7 +686,7 @@ GA_API ga_status ga_set_step_hook(ga_solver *s, ga_step_hook_fn fn, void *user,
                                   int with_multipliers)
 {
     return guarded(s, [&](ga::Solver &c) {
-        ga::Solver::StepHook hook;
+        ga::StepHook hook;
         if (fn) {
             hook.fn = fn;
             hook.user = user;

@@ -328,30 +328,4 @@ ga_status Solver::adaptive_step(double t_stop)
     }
 }
 
-ga_status Solver::advance(double t_out)
-{
-    if (t_out < accepted_.t)
-        return diag.fail(GA_ERR_ARG, "t_out = %.17g is before t = %.17g", t_out, accepted_.t);
-    if (!events_.active()) {
-        while (accepted_.t < t_out)
-            if (auto st = hooked(true, t_out, &Solver::adaptive_step))
-                return st;
-        return GA_OK;
-    }
-    events_.clear_log();
-    events_.save();
-    if (auto st = resume_events()) {
-        if (st < 0)
-            events_.restore();
-        return st;
-    }
-    // each step is undone alone: those accepted before a failure stay, with their events
-    while (accepted_.t < t_out) {
-        events_.save();
-        if (auto st = hooked(true, t_out, &Solver::adaptive_step_with_events))
-            return st;
-    }
-    return GA_OK;
-}
-
 }  // namespace ga

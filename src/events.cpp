@@ -1,6 +1,6 @@
 #include "events.hpp"
 
-#include "solver.hpp"
+#include "model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -148,36 +148,36 @@ void EventSet::restore()
 
 // g at t: at the end of the last step from the accepted state, inside it from the dense
 // output, with lambda (if asked for) as ga_get_lambda and ga_interpolate give it.
-ga_status Solver::event_values(double t, double *g)
+ga_status EventSet::values(StepOutput &out, double t, double *g)
 {
-    EventSet &e = events_;
+    EventSet &e = *this;
     double *lambda = e.with_lambda() ? e.lambda.data() : nullptr;
-    const double *q = accepted_.q.data(), *v = accepted_.v.data(), *y = accepted_.y.data();
-    if (t == accepted_.t) {
+    const double *q = out.positions(), *v = out.velocities(), *y = out.first_order_states();
+    if (t == out.time()) {
         if (lambda)
-            if (auto st = output_state(nullptr, lambda))
+            if (auto st = out.multipliers(lambda))
                 return st;
     } else {
-        if (auto st = interpolate(t, e.q.data(), e.v.data(), nullptr, lambda))
+        if (auto st = out.interpolate_at(t, e.q.data(), e.v.data(), lambda))
             return st;
         q = e.q.data();
         v = e.v.data();
         if (e.fn_y()) {
-            if (auto st = interpolate_y(t, e.y.data(), nullptr))
+            if (auto st = out.interpolate_y_at(t, e.y.data()))
                 return st;
             y = e.y.data();
         }
     }
-    return model.event_functions(e.fn(), e.fn_y(), t, q, v, y, lambda, g, e.count());
+    return out.callbacks().event_functions(e.fn(), e.fn_y(), t, q, v, y, lambda, g, e.count());
 }
 
 // A function exactly zero at the start of the search (at ga_init, a restart, or where a
 // search stopped) cannot say from that value where it goes: g = t (0.05 - t) from t0 = 0 fell
 // through zero at 0.05 unseen in a step of 0.1. Its value just past the start says it (as
 // IDA looks past t0): 1e-6 of the interval, or 100 ulps of t where that is more.
-ga_status Solver::event_start_values(const double **start)
+ga_status EventSet::start_values(StepOutput &out, const double **start)
 {
-    EventSet &e = events_;
+    EventSet &e = *this;
     *start = e.g_lo.data();
     bool zero = false;
     for (int k = 0; k < e.count(); ++k)
@@ -187,7 +187,7 @@ ga_status Solver::event_start_values(const double **start)
                                                   (std::fabs(e.t_lo) + span));
     if (!zero || !(past < span))
         return GA_OK;
-    if (auto st = event_values(e.t_lo + past, e.g_past.data()))
+    if (auto st = values(out, e.t_lo + past, e.g_past.data()))
         return st;
     for (int k = 0; k < e.count(); ++k)
         e.g_start[k] = e.g_lo[k] == 0.0 ? e.g_past[k] : e.g_lo[k];
@@ -199,21 +199,26 @@ ga_status Solver::event_start_values(const double **start)
 // at a terminal event or a full log, the search left just after the root (or, if the next
 // root's entries do not fit, before it) for the next call. A failure leaves t_lo and g_lo as
 // they were (the caller's EventSet::restore puts back the log).
-ga_status Solver::search_events()
+ga_status EventSet::search(StepOutput &out)
 {
-    EventSet &e = events_;
-    const auto evaluate = [](double t, double *g, void *self) {
-        return static_cast<int>(static_cast<Solver *>(self)->event_values(t, g));
+    EventSet &e = *this;
+    struct Context {
+        EventSet *set;
+        StepOutput *out;
+    } context{this, &out};
+    const auto evaluate = [](double t, double *g, void *c) {
+        const Context &x = *static_cast<Context *>(c);
+        return static_cast<int>(x.set->values(*x.out, t, g));
     };
     double t_cur = e.t_lo;
     const double *g_cur = nullptr;
-    if (auto st0 = event_start_values(&g_cur))
+    if (auto st0 = start_values(out, &g_cur))
         return st0;
     ga_status st = GA_OK;
     while (t_cur < e.t_hi && e.any_crossing(g_cur, e.g_hi.data())) {
         double t_root = 0.0;
         const int found = e.locator.locate(t_cur, g_cur, e.t_hi, e.g_hi.data(), e.direction(),
-                                           evaluate, this, &t_root, e.fired.data());
+                                           evaluate, &context, &t_root, e.fired.data());
         if (found < 0)
             return static_cast<ga_status>(found);
         if (found == 0)
@@ -251,117 +256,40 @@ ga_status Solver::search_events()
 
 // At the start of a stepping call: g at the current state if the search starts afresh, else
 // the rest of the last step, which a call that stopped at an event left.
-ga_status Solver::resume_events()
+ga_status EventSet::resume(StepOutput &out)
 {
-    EventSet &e = events_;
+    EventSet &e = *this;
     if (e.started)
-        return e.t_lo < e.t_hi ? search_events() : GA_OK;
-    if (auto st = event_values(accepted_.t, e.g_lo.data()))
+        return e.t_lo < e.t_hi ? search(out) : GA_OK;
+    if (auto st = values(out, out.time(), e.g_lo.data()))
         return st;
-    e.t_lo = e.t_hi = accepted_.t;
+    e.t_lo = e.t_hi = out.time();
     e.started = true;
     return GA_OK;
 }
 
 // After a step was accepted: g at its end, and the search over it (at most steps, nothing
 // crosses: then no more than that check).
-ga_status Solver::events_after_step()
+ga_status EventSet::after_step(StepOutput &out)
 {
-    EventSet &e = events_;
+    EventSet &e = *this;
     const ga_status st =
-        e.with_lambda() ? event_values(accepted_.t, e.g_hi.data())
-                        : model.event_functions(e.fn(), e.fn_y(), accepted_.t, accepted_.q.data(),
-                                                accepted_.v.data(), accepted_.y.data(), nullptr,
-                                                e.g_hi.data(), e.count());
+        e.with_lambda()
+            ? values(out, out.time(), e.g_hi.data())
+            : out.callbacks().event_functions(e.fn(), e.fn_y(), out.time(), out.positions(),
+                                              out.velocities(), out.first_order_states(),
+                                              nullptr, e.g_hi.data(), e.count());
     if (st)
         return st;
-    e.t_hi = accepted_.t;
+    e.t_hi = out.time();
     const double *start = nullptr;
-    if (auto st2 = event_start_values(&start))
+    if (auto st2 = start_values(out, &start))
         return st2;
     if (e.any_crossing(start, e.g_hi.data()))
-        return search_events();
+        return search(out);
     e.t_lo = e.t_hi;
     e.g_lo.swap(e.g_hi);
     return GA_OK;
-}
-
-// The caller saved the search (events_.save()) where a failure must put it back.
-ga_status Solver::step_with_events(bool adaptive, double h_or_t_stop)
-{
-    const StepUndo undo{previous_valid_, start_pending_, adaptive};
-    if (adaptive)
-        undo_control_ = control;
-    if (auto st = adaptive ? adaptive_step(h_or_t_stop) : take_step(h_or_t_stop)) {
-        events_.restore();
-        return st;
-    }
-    const ga_status st = events_after_step();
-    if (st < 0) {
-        undo_step(undo);
-        events_.restore();
-    }
-    return st;
-}
-
-// ga_step and ga_step_adaptive with events: first the search from the current state or over
-// the rest of the step a call stopped in, then one step and the search over it.
-ga_status Solver::watched_step(bool adaptive, double h_or_t_stop)
-{
-    EventSet &e = events_;
-    e.clear_log();
-    e.save();
-    if (!e.started || e.t_lo < e.t_hi) {
-        if (auto st = resume_events()) {
-            if (st < 0)
-                e.restore();
-            return st;
-        }
-    }
-    return step_with_events(adaptive, h_or_t_stop);
-}
-
-// ga_step with events. The common case -- the search stands at the end of the last step and
-// the functions need no multipliers -- goes without save points: a failure puts back what
-// it changed (the step, t_hi, the log) from what it knows.
-ga_status Solver::one_step(double h)
-{
-    EventSet &e = events_;
-    if (!e.active())
-        return take_step(h);
-    if (!e.started || e.t_lo < e.t_hi || e.with_lambda())
-        return watched_step(false, h);
-    e.clear_log();
-    const StepUndo undo{previous_valid_, start_pending_, false};
-    if (auto st = take_step(h))
-        return st;
-    ga_status st = model.event_functions(e.fn(), e.fn_y(), accepted_.t, accepted_.q.data(),
-                                         accepted_.v.data(), accepted_.y.data(), nullptr,
-                                         e.g_hi.data(), e.count());
-    const double *start = nullptr;
-    if (st == GA_OK) {
-        e.t_hi = accepted_.t;
-        st = event_start_values(&start);
-    }
-    if (st == GA_OK) {
-        if (!e.any_crossing(start, e.g_hi.data())) {
-            e.t_lo = e.t_hi;
-            e.g_lo.swap(e.g_hi);
-            return GA_OK;
-        }
-        st = search_events();
-        if (st >= GA_OK)
-            return st;
-    }
-    undo_step(undo);
-    e.t_hi = e.t_lo;  // search_events leaves t_lo and g_lo alone when it fails
-    e.clear_log();
-    return st;
-}
-
-ga_status Solver::one_adaptive_step(double t_stop)
-{
-    return events_.active() ? watched_step(true, t_stop) : adaptive_step(t_stop);
 }
 
 }  // namespace ga

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "galpha.h"
+#include "step_output.hpp"
 
 namespace ga {
 
@@ -87,6 +88,15 @@ public:
     void save();
     void restore();
 
+    // The search, on what the step offers (step_output.hpp); each returns GA_EVENT when a
+    // terminal function fired or the log filled, a failure leaving t_lo and g_lo as they were
+    // (restore() puts back the rest).
+    // At the start of a stepping call: g at the state if the search starts afresh, else the
+    // rest of the step a call stopped in.
+    ga_status resume(StepOutput &out);
+    // After a step was committed: g at its end, and the search over it.
+    ga_status after_step(StepOutput &out);
+
     int capacity() const { return static_cast<int>(log_.size()); }
     bool log_full() const { return log_count_ == capacity(); }
     // Some function crosses zero, in the direction it watches, between the values a and b.
@@ -110,6 +120,10 @@ public:
     std::vector<int> fired;
 
 private:
+    ga_status values(StepOutput &out, double t, double *g);
+    ga_status start_values(StepOutput &out, const double **start);
+    ga_status search(StepOutput &out);
+
     ga_event_fn fn_ = nullptr;
     ga_event_y_fn fn_y_ = nullptr;
     bool with_lambda_ = false;

@@ -15,6 +15,8 @@
 #include "newton.hpp"
 #include "params.hpp"
 #include "step_controller.hpp"
+#include "step_hook.hpp"
+#include "step_output.hpp"
 #include "adjoint.hpp"
 #include "sensitivity.hpp"
 #include "step_plan.hpp"
@@ -70,7 +72,7 @@ private:
     T value_;
 };
 
-class Solver {
+class Solver : private StepOutput {
 public:
     Solver(int n, int m);
 
@@ -130,9 +132,9 @@ public:
     const State &state() const { return accepted_; }
 
     ga_status init(double t0, const double *q0, const double *v0);  // init.cpp
-    // One step of size h; with events (events.cpp) GA_EVENT when a terminal one fired in it.
+    // One step of size h (transaction.cpp); with events GA_EVENT when a terminal one fired.
     ga_status step(double h);
-    // Adaptive mode (control.cpp): one controlled step, not beyond t_stop (landing on it
+    // Adaptive mode (transaction.cpp): one controlled step, not beyond t_stop (landing on it
     // exactly if it is reached); or steps until t_out exactly.
     ga_status step_adaptive(double t_stop);
     ga_status advance(double t_out);
@@ -158,14 +160,7 @@ public:
     ga_status set_adjoint_checkpoints(long interval, long count);
 
     // The step hook (ga_set_step_hook), called by step, step_adaptive and advance.
-    struct StepHook {
-        ga_step_hook_fn fn = nullptr;
-        void *user = nullptr;
-        const ga_solver *handle = nullptr;
-        std::atomic<bool> *running = nullptr;  // the handle's flag: reads allowed from the hook
-        bool with_lambda = false;
-    };
-    void set_step_hook(const StepHook &hook);  // step_hook.cpp; throws std::bad_alloc
+    void set_step_hook(const StepHook &hook);  // transaction.cpp; throws std::bad_alloc
 
     // Events (events.cpp): the functions watched, where their search stands, the last log.
     EventSet &events() { return events_; }
@@ -264,15 +259,7 @@ private:
     };
     StepController undo_control_;  // the controller before the step (adaptive steps)
     void undo_step(const StepUndo &u);
-    // events.cpp
-    ga_status event_values(double t, double *g);
-    ga_status search_events();
-    // g at the start of the search over (t_lo, t_hi], functions exactly zero there replaced
-    // by their values just past it (into *start: g_lo itself when none is)
-    ga_status event_start_values(const double **start);
-    ga_status resume_events();
-    ga_status events_after_step();
-    // A step (take_step(h), or adaptive_step(t_stop) if adaptive) with the event search
+    // transaction.cpp: a step (take_step(h), or adaptive_step(t_stop) if adaptive) with the event search
     // after it; a failure of either leaves the solver as it was and the search as the
     // caller saved it.
     ga_status step_with_events(bool adaptive, double h_or_t_stop);
@@ -281,12 +268,20 @@ private:
     // ga_step's and ga_step_adaptive's step with events, before the step hook
     ga_status one_step(double h);
     ga_status one_adaptive_step(double t_stop);
-    // step_hook.cpp: (this->*step)(arg), then the step hook if a step was accepted; a failure
-    // of the hook's multipliers or a throwing hook undoes that step.
+    // (this->*step)(arg), then the step hook if a step was accepted; a failure of the hook's
+    // multipliers or a throwing hook undoes that step.
     ga_status hooked(bool adaptive, double arg, ga_status (Solver::*step)(double));
     ga_status hooked_step(bool adaptive, double arg, ga_status (Solver::*step)(double));
     StepHook hook_;
-    Vec hook_lambda_;  // the multipliers the hook sees, its own: reads from the hook reuse out_
+    // What the services after a commit see (step_output.hpp, transaction.cpp)
+    double time() const override;
+    const double *positions() const override;
+    const double *velocities() const override;
+    const double *first_order_states() const override;
+    ga_status multipliers(double *lambda) override;
+    ga_status interpolate_at(double t, double *q, double *v, double *lambda) override;
+    ga_status interpolate_y_at(double t, double *y) override;
+    Model &callbacks() override;
     ga_status residual(double t, const State &x);
     // first_order.cpp: the parts of a step that concern first-order states.
     void first_order_start(const State &from, double h);
