@@ -260,19 +260,9 @@ double Solver::first_order_error_sum(double h, double scale)
 ga_status Solver::interpolate_y(double t, double *y, double *ydot)
 {
     double th = 0.0, h = 0.0;
-    if (auto st = dense_output_place(t, th, h))
+    if (auto st = dense_.place(t, th, h, diag))
         return st;
-    const State &a = previous_, &b = accepted_;
-    for (int k = 0; k < r(); ++k) {
-        const double y0 = a.y[k], y1 = b.y[k], d0 = h * a.ydot[k], d1 = h * b.ydot[k];
-        if (y)
-            y[k] = ((2 * th - 3) * th * th + 1) * y0 + ((th - 2) * th + 1) * th * d0 +
-                   (3 - 2 * th) * th * th * y1 + (th - 1) * th * th * d1;
-        if (ydot)
-            ydot[k] = ((6 * th - 6) * th * (y0 - y1) + ((3 * th - 4) * th + 1) * d0 +
-                       (3 * th - 2) * th * d1) /
-                      h;
-    }
+    dense_.first_order_states(th, h, y, ydot);
     return GA_OK;
 }
 

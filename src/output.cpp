@@ -76,37 +76,18 @@ ga_status Solver::output_state(double *qdd, double *lambda)
     return GA_OK;
 }
 
-// Where t lies in the last step: its fraction th of the step h (for ga_interpolate and
-// ga_interpolate_y), or why there is no such place.
-ga_status Solver::dense_output_place(double t, double &th, double &h)
-{
-    if (!previous_valid_)
-        return diag.fail(GA_ERR_STATE, "dense output: no step since ga_init or ga_set_state");
-    const State &a = previous_, &b = accepted_;
-    h = b.t - a.t;
-    const double slack = 1e-12 * std::max(std::fabs(b.t), 1.0);
-    if (!(t >= a.t - slack && t <= b.t + slack))
-        return diag.fail(GA_ERR_ARG, "dense output: t = %.17g is outside the last step [%.17g, "
-                         "%.17g]", t, a.t, b.t);
-    th = std::clamp((t - a.t) / h, 0.0, 1.0);
-    return GA_OK;
-}
-
-// Cubic Hermite interpolation of q (from q, v at both ends) and of v (from v, qdd) over the
-// last step: third-order local accuracy.
+// Dense output (dense_output.hpp), with GA_OUTPUT_CONSISTENT's accelerations and multipliers
+// solved at the interpolated (q, v).
 ga_status Solver::interpolate(double t, double *q, double *v, double *qdd, double *lambda)
 {
     double th = 0.0, h = 0.0;
-    if (auto st = dense_output_place(t, th, h))
+    if (auto st = dense_.place(t, th, h, diag))
         return st;
-    const State &a = previous_, &b = accepted_;
-    const double h00 = (2 * th - 3) * th * th + 1, h10 = ((th - 2) * th + 1) * th;
-    const double h01 = (3 - 2 * th) * th * th, h11 = (th - 1) * th * th;
     const bool consistent = output == GA_OUTPUT_CONSISTENT && (qdd || (lambda && m_ > 0));
     if (consistent || q)
-        model.space.hermite(a.q, a.v, b.q, b.v, h, h00, h10, h01, h11, out_q_);
+        dense_.positions(th, h, out_q_);
     if (consistent || v)
-        out_v_ = h00 * a.v + (h10 * h) * a.qdd + h01 * b.v + (h11 * h) * b.qdd;
+        dense_.velocities(th, h, out_v_);
     if (q)
         Eigen::Map<Vec>(q, nq_) = out_q_;
     if (v)
@@ -128,9 +109,9 @@ ga_status Solver::interpolate(double t, double *q, double *v, double *qdd, doubl
     }
     // the step's own values, linear over the step
     if (qdd)
-        Eigen::Map<Vec>(qdd, nv_) = (1.0 - th) * a.qdd + th * b.qdd;
+        dense_.accelerations(th, qdd);
     if (lambda && m_ > 0)
-        Eigen::Map<Vec>(lambda, m_) = (1.0 - th) * a.lambda + th * b.lambda;
+        dense_.multipliers(th, lambda);
     return GA_OK;
 }
 

@@ -1,6 +1,7 @@
 // ga::Solver: the state (t, q, v, qdd, lambda, a), the options, one step of Algorithm 1 (or of
 // its stabilized index-2 variant) with commit/rollback and the reuse of the iteration matrix.
-// The consistent start lives in init.cpp, step-size control and dense output in control.cpp.
+// The consistent start lives in init.cpp, the adaptive loop and its error estimate in
+// control.cpp, dense output in dense_output.hpp and output.cpp, the calls in transaction.cpp.
 #pragma once
 
 #include <atomic>
@@ -20,30 +21,10 @@
 #include "adjoint.hpp"
 #include "sensitivity.hpp"
 #include "step_plan.hpp"
+#include "dense_output.hpp"
+#include "state.hpp"
 
 namespace ga {
-
-struct State {
-    double t = 0.0;
-    double h_last = 0.0;  // size of the step that produced this state (0 at the start)
-    // Time covered by Taylor steps (sliver_step) since the last step of Algorithm 1: once it
-    // passes h_last / kShortStepRatio, short steps are Algorithm 1 steps again.
-    double sliver_span = 0.0;
-    Vec q, v, qdd, lambda, a;
-    Vec a_prev;           // a of the state before (variable-step error estimate)
-    // Index-3 adaptive steps (control.cpp): qdd consistent with (q, v) here (c) and at the
-    // state before (c_prev), c_dt apart; c_count of them known (0-2; 0 after a fixed step).
-    Vec c, c_prev;
-    double c_dt = 0.0;
-    int c_count = 0;
-    // First-order states (docs/algorithms.md sec. 11): y, y' = g, the auxiliary w of y' (as a
-    // is of qdd) and w of the state before; empty when r = 0.
-    Vec y, ydot, w, w_prev;
-
-    void allocate(int nq, int nv, int m);  // q: nq; v, qdd, a, a_prev, c, c_prev: nv
-    void allocate_first_order(int r);
-    void swap(State &other);  // pointer swaps only: no allocation, no copy
-};
 
 // The matrix and scratch of an acceleration-level solve (init.cpp): the step's own at the
 // consistent start, separate ones for consistent output, so that reading the output never
@@ -75,6 +56,8 @@ private:
 class Solver : private StepOutput {
 public:
     Solver(int n, int m);
+    Solver(const Solver &) = delete;  // (dense_ refers to its own states)
+    Solver &operator=(const Solver &) = delete;
 
     int nq() const { return nq_; }  // q's coordinates
     int nv() const { return nv_; }  // v's, and those of every increment of q
@@ -143,8 +126,6 @@ public:
     // They evaluate callbacks in GA_OUTPUT_CONSISTENT, and do not touch what steps reuse.
     ga_status output_state(double *qdd, double *lambda);
     ga_status interpolate(double t, double *q, double *v, double *qdd, double *lambda);
-    // where t lies in the last step (fraction th of its size h), or the failure to report
-    ga_status dense_output_place(double t, double &th, double &h);
     // Allocates the workspace of consistent output if the solver's workspace exists and it
     // does not yet; throws std::bad_alloc.
     void setup_output();
@@ -381,6 +362,7 @@ private:
     State trial_;     // the step being computed
     State previous_;  // the accepted step before (dense output)
     bool previous_valid_ = false;
+    DenseOutput dense_{previous_, accepted_, previous_valid_, model.space};  // the last step
     bool start_pending_ = false;  // first step after ga_init (or a restart): corrected start
 
     // The start of the step being computed: a_n rescaled to h (docs/algorithms.md 1.2) and, in the
