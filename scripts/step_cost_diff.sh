@@ -3,7 +3,8 @@
 # the solver (issue 35) must keep the step's cost, and wall times here scatter by 20-50 %.
 #   scripts/step_cost_diff.sh BASE_BUILD_DIR NEW_BUILD_DIR [out.csv]
 # Each build dir needs bench/step_cost (cmake --build DIR --target step_cost). Scenes: the
-# slider-crank, Andrews (7 and 31 coordinates, the latter sparse too) and the 1000-link chain.
+# slider-crank, Andrews (7 and 31 coordinates, the latter sparse too) and the 1000-link chain
+# (index 3, and index 2).
 set -euo pipefail
 base=$1 new=$2 out=${3:-/dev/stdout}
 collected() {  # instructions inside ga_step for step_cost's arguments
@@ -24,4 +25,9 @@ collected() {  # instructions inside ga_step for step_cost's arguments
     a=$(collected "$base/bench/step_cost" chain_steps 1000 10)
     b=$(collected "$new/bench/step_cost" chain_steps 1000 10)
     awk -v a="$a" -v b="$b" 'BEGIN { printf "chain1000,10,%.0f,%.0f,%.4f\n", a / 10, b / 10, b / a }'
+    # index 2: step_cost's timing mode (200 runs of 20 steps at 1000 links, a fixed count)
+    a=$(collected "$base/bench/step_cost" chain 1000 20 1e-10 1)
+    b=$(collected "$new/bench/step_cost" chain 1000 20 1e-10 1)
+    awk -v a="$a" -v b="$b" \
+        'BEGIN { printf "chain1000_index2,4000,%.0f,%.0f,%.4f\n", a / 4000, b / 4000, b / a }'
 } > "$out"

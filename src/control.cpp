@@ -297,7 +297,7 @@ ga_status Solver::adaptive_step(double t_stop)
         if (st == GA_OK) {
             control.err_last = err;
             if (err <= 1.0) {
-                if (auto st2 = sensitivity_step(h)) {  // of the accepted step only
+                if (auto st2 = on_converged(h)) {  // of the accepted step only
                     count(counters, GA_COUNT_FAILED_STEPS);
                     invalidate_jacobian();
                     return st2;
@@ -311,8 +311,7 @@ ga_status Solver::adaptive_step(double t_stop)
             }
             count(counters, GA_COUNT_REJECTED_STEPS);
             last_failure[0] = '\0';
-            if (sens.adjoint)  // (a replay from a checkpoint cannot know the matrix it left)
-                invalidate_jacobian();
+            on_rejection();
             h = StepController::after_rejection(h, err);
         } else if (recoverable(st)) {
             count(counters, GA_COUNT_FAILED_STEPS);

@@ -247,8 +247,7 @@ ga_status Solver::setup_workspace()
     check_phi_t_.setZero(m_);
     lambda_tmp_.setZero(m_);
     eta_total_.setZero(m_);
-    if (sens.active())
-        sens.allocate_matrices(M_, J_);
+    on_setup();
     if (r() > 0) {
         const int r1 = r();
         blocks_.allocate(nv_, r1);
@@ -390,7 +389,7 @@ ga_status Solver::take_step(double h)
     } failed{counters};
     ga_status st = attempt_step(h, newton_tolerance(false), true);
     if (!st)
-        st = sensitivity_step(h);
+        st = on_converged(h);
     if (st != GA_OK) {
         // Whatever went wrong, the next attempt starts from a fresh iteration matrix.
         invalidate_jacobian();
@@ -414,8 +413,7 @@ void Solver::undo_step(const StepUndo &u)
 {
     previous_.swap(trial_);  // commit's swaps, backwards
     accepted_.swap(trial_);
-    if (sens.active())
-        sensitivity_on_undo();
+    on_undo();
     previous_valid_ = u.previous_valid;
     start_pending_ = u.start_pending;
     if (u.adaptive)
@@ -433,8 +431,7 @@ void Solver::commit(bool land_on, double t_land)
     previous_.swap(trial_);    // ... and the old one the start of the interval for dense output
     if (land_on)
         accepted_.t = t_land;  // exactly, not t_n + h rounded
-    if (sens.active())  // (before the counters: the adjoint's checkpoints hold them)
-        sensitivity_on_commit();
+    on_commit();  // (before the counters: the adjoint's checkpoints hold them)
     previous_valid_ = true;
     start_pending_ = false;
     ++state_id_;
@@ -478,9 +475,8 @@ ga_status Solver::attempt_step(double h, double tol, bool sliver_allowed)
     std::copy_n(reuse_state, kReuseStateSize, report.reuse_before);
     if (pivots_forgotten_)  // after a layout-2 checkpoint: pivots as a new solver picks them
         forget_pivots();
-    if (sens.active())
-        if (auto st = sensitivity_before_attempt(plan))
-            return st;
+    if (auto st = before_attempt(plan))
+        return st;
     return plan.kind == StepPlan::Sliver ? sliver_step(accepted_, h) : regular_step(plan);
 }
 
@@ -846,8 +842,8 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
                          "predicted Newton iterate is not finite in the step from t = %.17g "
                          "with h = %g",
                          s.t, h);
-    if (index2 && sens.active())
-        eta_total_.setZero();  // the predictor's eta_bar
+    if (index2)
+        eta_total_.setZero();  // the predictor's eta_bar (the step's report: sensitivities read it)
     if (index2 && m_ > 0) {
         // B = Phi_q(q_n): the direction of the position correction -h B^T eta (sec. 2.1)
         if (auto st = model.jacobian(s.t, s.q, B_))
@@ -916,8 +912,7 @@ ga_status Solver::newton(double h, double tol, bool refresh, bool &converged, bo
             // dw_: the Newmark part of the update, dq + B^T deta
             S2_.solve(rq_, phi_, phi_v_, p, h, B_, dq_, dw_, dlambda_, deta_);
             dw = &dw_;
-            if (sens.active())
-                eta_total_ += deta_;
+            eta_total_ += deta_;
         } else {
             S_.solve(rq_, phi_, dq_, dlambda_, row_scale);
         }

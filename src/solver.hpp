@@ -240,6 +240,13 @@ private:
     };
     StepController undo_control_;  // the controller before the step (adaptive steps)
     void undo_step(const StepUndo &u);
+    // The doors of a step where the services that need its matrices attach (transaction.cpp)
+    void on_setup();
+    ga_status before_attempt(const StepPlan &plan);
+    ga_status on_converged(double h);
+    void on_rejection();
+    void on_commit();
+    void on_undo();
     // transaction.cpp: a step (take_step(h), or adaptive_step(t_stop) if adaptive) with the event search
     // after it; a failure of either leaves the solver as it was and the search as the
     // caller saved it.

@@ -25,6 +25,42 @@ ga_status Solver::interpolate_at(double t, double *q, double *v, double *lambda)
 ga_status Solver::interpolate_y_at(double t, double *y) { return interpolate_y(t, y, nullptr); }
 Model &Solver::callbacks() { return model; }
 
+// ---- the doors of a step (the kernel, solver.cpp and control.cpp, calls them) ----
+// At setup, once the matrices' layouts are known: the sensitivities' matrices like them.
+void Solver::on_setup()
+{
+    if (sens.active())
+        sens.allocate_matrices(M_, J_);
+}
+// Before an attempt: the forward sensitivities start by differences before Taylor slivers
+// and fresh starts.
+ga_status Solver::before_attempt(const StepPlan &plan)
+{
+    return sens.active() ? sensitivity_before_attempt(plan) : GA_OK;
+}
+// The attempt converged (and passed the error test): the sensitivities' linear step, whose
+// failure fails the step.
+ga_status Solver::on_converged(double h) { return sensitivity_step(h); }
+// An attempt's error was rejected: the adjoint's replays from a checkpoint cannot know the
+// matrix the rejected attempt left, so the run drops it too.
+void Solver::on_rejection()
+{
+    if (sens.adjoint)
+        invalidate_jacobian();
+}
+// The commit (after the states' swap): the sensitivities swap theirs, the record logs the step.
+void Solver::on_commit()
+{
+    if (sens.active())
+        sensitivity_on_commit();
+}
+// undo_step (after its swaps): each puts back its own.
+void Solver::on_undo()
+{
+    if (sens.active())
+        sensitivity_on_undo();
+}
+
 // ---- the calls ----
 ga_status Solver::step(double h)
 {
