@@ -111,9 +111,8 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
 
     if (r() > 0)
         model.y_now = &x.y;  // start() callers put y0 into trial_.y
-    if (sens.active())  // first: differences leave the matrices at a perturbed p
-        if (auto st = sensitivity_start(x))
-            return st;
+    if (auto st = on_start(x))  // first: differences leave the matrices at a perturbed p
+        return st;
     if (auto st = consistent_accelerations(t0, x.q, x.v, x.qdd, x.lambda)) {
         diag.append(" (consistent initial accelerations at t0 = %.17g)", t0);
         return st;
@@ -132,13 +131,10 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
     x.c_count = 1;
 
     accepted_.swap(trial_);
-    sens.accepted.swap(sens.trial);
-    if (sens.adjoint)
-        record_start();
+    on_started();
     ++state_id_;
     initialized_ = true;
     previous_valid_ = false;
-    events_.restart();
     start_pending_ = true;  // corrected starting values need the h of the first step
     control.reset();  // no accepted step: no proposal, no base for a prediction
     if (formulation == GA_INDEX2_STABILIZED)

@@ -241,6 +241,8 @@ private:
     StepController undo_control_;  // the controller before the step (adaptive steps)
     void undo_step(const StepUndo &u);
     // The doors of a step where the services that need its matrices attach (transaction.cpp)
+    ga_status on_start(const State &x);
+    void on_started();
     void on_setup();
     ga_status before_attempt(const StepPlan &plan);
     ga_status on_converged(double h);

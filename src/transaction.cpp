@@ -26,6 +26,17 @@ ga_status Solver::interpolate_y_at(double t, double *y) { return interpolate_y(t
 Model &Solver::callbacks() { return model; }
 
 // ---- the doors of a step (the kernel, solver.cpp and control.cpp, calls them) ----
+// A start (ga_init): the sensitivities' initial derivatives, before the consistent
+// accelerations; and once it is the accepted state, the sensitivities take theirs, the record
+// its first entry, the event search starts afresh.
+ga_status Solver::on_start(const State &x) { return sens.active() ? sensitivity_start(x) : GA_OK; }
+void Solver::on_started()
+{
+    sens.accepted.swap(sens.trial);
+    if (sens.adjoint)
+        record_start();
+    events_.restart();
+}
 // At setup, once the matrices' layouts are known: the sensitivities' matrices like them.
 void Solver::on_setup()
 {
