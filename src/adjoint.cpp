@@ -102,6 +102,31 @@ void put(const Vec &x, double *&out)
 }
 }  // namespace
 
+// A step converged (before its commit): room for it, and how it began (record_step logs it).
+ga_status Solver::record_on_converged(double h)
+{
+    const State &s = accepted_;
+    AdjointRecord &r = adjoint_;
+    if (r.steps >= r.capacity && r.interval > 0)
+        return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (%ld steps: interval "
+                         "= %ld times %ld checkpoints, ga_set_adjoint_checkpoints)",
+                         r.capacity, r.interval, r.capacity / r.interval);
+    if (r.steps >= r.capacity)
+        return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (max_steps = %ld: "
+                         "ga_set_sensitivity_method)", r.capacity);
+    r.pending_rho = 1.0;
+    if (sens.step_done || (sens.start_given && !start_pending_)) {
+        r.pending_kind = AdjointRecord::Unsupported;
+    } else if (sens.start_given) {
+        r.pending_kind = AdjointRecord::First;
+    } else {
+        r.pending_kind = AdjointRecord::Regular;
+        if (a_start_ != &s.a)
+            r.pending_rho = h / s.h_last;
+    }
+    return GA_OK;
+}
+
 void Solver::record_start()
 {
     AdjointRecord &r = adjoint_;
@@ -572,6 +597,8 @@ ga_status Solver::replay_segment(long s)
         fd_tangents_ = l[10] != 0.0;
         const Restore<bool> keep_mode(adaptive_attempt_);
         adaptive_attempt_ = l[5] >= 2.0;  // (a fresh start: its first-order states' start)
+        // the kernel and the forward sensitivities' linear step, not the doors: a replay
+        // records nothing (its entries are written below)
         ga_status st = attempt_step(h, l[4], std::fmod(l[5], 2.0) != 0.0);
         if (!st)
             st = sensitivity_step(h);
@@ -624,7 +651,6 @@ ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, doub
     KeptMatrix kept;
     set_aside_matrix(kept);
     const auto restore = [&] {
-        replaying_ = false;
         take_back_matrix(kept);
         const ga_status back = set_state(here.data(), here.size(), true, true);
         previous_ = previous;
@@ -638,7 +664,6 @@ ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, doub
         r.base = base;
         return back;
     };
-    replaying_ = true;
     ga_status st = GA_OK;
     try {
         st = adjoint_sweep(running, terminal, J, dJ);

@@ -561,31 +561,9 @@ ga_status Solver::exact_tangents(double t, const State &x, bool &K, bool &C, boo
 // After a step converged (trial_ holds it), the derivatives of its state.
 ga_status Solver::sensitivity_step(double h)
 {
-    if (!sens.active())
+    if (!sens.active() || !sens.forward || sens.step_done)
         return GA_OK;
     const State &s = accepted_;
-    if (sens.adjoint && !replaying_) {  // how the step began, for the record (adjoint.cpp)
-        AdjointRecord &r = adjoint_;
-        if (r.steps >= r.capacity && r.interval > 0)
-            return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (%ld steps: interval "
-                             "= %ld times %ld checkpoints, ga_set_adjoint_checkpoints)",
-                             r.capacity, r.interval, r.capacity / r.interval);
-        if (r.steps >= r.capacity)
-            return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (max_steps = %ld: "
-                             "ga_set_sensitivity_method)", r.capacity);
-        r.pending_rho = 1.0;
-        if (sens.step_done || (sens.start_given && !start_pending_)) {
-            r.pending_kind = AdjointRecord::Unsupported;
-        } else if (sens.start_given) {
-            r.pending_kind = AdjointRecord::First;
-        } else {
-            r.pending_kind = AdjointRecord::Regular;
-            if (a_start_ != &s.a)
-                r.pending_rho = h / s.h_last;
-        }
-    }
-    if (!sens.forward || sens.step_done)
-        return GA_OK;
     const State &x = trial_;
     const Params &p = params;
     const NewtonCoefficients c = newton_coefficients(p, h);

@@ -316,12 +316,12 @@ private:
     State sens_scratch_;  // the accepted state while a perturbed one takes its place
     AdjointRecord adjoint_;
     void record_start();   // adjoint.cpp: x_0 and the start's derivatives, at ga_init
+    ga_status record_on_converged(double h);  // adjoint.cpp: room, and how the step began
     void record_step();    // the accepted step, at commit
     struct AdjointWork;
     ga_status adjoint_step(long k, AdjointWork &w);
     ga_status adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ);
     ga_status replay_segment(long s);
-    bool replaying_ = false;  // a sweep recomputes a segment of the recorded run
     // The live run's kept iteration matrix (and the first-order blocks factorized with it),
     // set aside while a sweep recomputes segments in matrices of their own (adjoint.cpp).
     struct KeptMatrix {

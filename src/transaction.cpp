@@ -49,9 +49,17 @@ ga_status Solver::before_attempt(const StepPlan &plan)
 {
     return sens.active() ? sensitivity_before_attempt(plan) : GA_OK;
 }
-// The attempt converged (and passed the error test): the sensitivities' linear step, whose
-// failure fails the step.
-ga_status Solver::on_converged(double h) { return sensitivity_step(h); }
+// The attempt converged (and passed the error test): the record's room and how the step began,
+// then the sensitivities' linear step; a failure of either fails the step.
+ga_status Solver::on_converged(double h)
+{
+    if (!sens.active())
+        return GA_OK;
+    if (sens.adjoint)
+        if (auto st = record_on_converged(h))
+            return st;
+    return sensitivity_step(h);
+}
 // An attempt's error was rejected: the adjoint's replays from a checkpoint cannot know the
 // matrix the rejected attempt left, so the run drops it too.
 void Solver::on_rejection()
