@@ -134,7 +134,8 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
         // Newton test's floors): what the estimate from a makes of that round-off widens its
         // weights (as atol does; subtracted instead, the error jumped between 0 and O(1) and
         // the predictive controller shrank the steps without end).
-        const double q_max = std::max(model.space.max_magnitude(s.q), model.space.max_magnitude(x.q));
+        const double q_max =
+            std::max(model.space.max_magnitude(s.q), model.space.max_magnitude(x.q));
         const auto a_noise = [&](double step) {
             return kRoundoffUlps * kEps * q_max / (p.beta * step * step);
         };

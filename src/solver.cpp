@@ -320,7 +320,8 @@ void Solver::take_back_matrix(KeptMatrix &kept)
 void Solver::setup_index2()
 {
     if (!S2_.ready()) {
-        S2_.setup(nv_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_, active_ptr());
+        S2_.setup(nv_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_,
+                  active_ptr());
         S2_.reserve_factors();
     }
     if (initialized_)

@@ -249,9 +249,9 @@ private:
     void on_rejection();
     void on_commit();
     void on_undo();
-    // transaction.cpp: a step (take_step(h), or adaptive_step(t_stop) if adaptive) with the event search
-    // after it; a failure of either leaves the solver as it was and the search as the
-    // caller saved it.
+    // transaction.cpp: a step (take_step(h), or adaptive_step(t_stop) if adaptive) with the
+    // event search after it; a failure of either leaves the solver as it was and the search
+    // as the caller saved it.
     ga_status step_with_events(bool adaptive, double h_or_t_stop);
     ga_status adaptive_step_with_events(double t_stop) { return step_with_events(true, t_stop); }
     ga_status watched_step(bool adaptive, double h_or_t_stop);
