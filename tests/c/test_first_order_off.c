@@ -12,20 +12,12 @@
 
 #include <cmocka.h>
 
+#include "fnv.h"
 #include "scene_catalog.h"
 
 /* The counters galpha 912a78b had: later ones are not part of the recorded hash. */
 enum { kRuns = 3, kCountersBefore = 15 };
 
-static uint64_t fnv(uint64_t h, const void *data, size_t len)
-{
-    const unsigned char *p = data;
-    for (size_t k = 0; k < len; ++k) {
-        h ^= p[k];
-        h *= 1099511628211ull;
-    }
-    return h;
-}
 
 /* run 0: index 3, h = t_end / 200; run 1: index 2, the same h; run 2: index 2 adaptive,
  * rtol = atol = 1e-6 to t_end. */

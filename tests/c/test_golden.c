@@ -26,6 +26,7 @@
 
 #include <cmocka.h>
 
+#include "fnv.h"
 #include "scene_catalog.h"
 
 enum { kModes = 4, kMaxParams = 2, kMaxState = 4096 };
@@ -50,15 +51,6 @@ static const char *const kFeatureNames[kFeatures] = {
     "adjoint", "adjoint with checkpoints", "checkpoint", "first order", "combined"};
 
 /* ---- the hash ---- */
-static uint64_t fnv(uint64_t h, const void *data, size_t len)
-{
-    const unsigned char *p = data;
-    for (size_t k = 0; k < len; ++k) {
-        h ^= p[k];
-        h *= 1099511628211ull;
-    }
-    return h;
-}
 #define HASH(h, x) ((h) = fnv((h), &(x), sizeof(x)))
 
 /* ---- what the callbacks of a run need (one run at a time) ---- */
