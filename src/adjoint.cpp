@@ -70,9 +70,9 @@ ga_status Solver::set_adjoint_checkpoints(long interval, long count)
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
     record.max_steps = adjoint_.max_steps;
     if (interval > 0)
-        record.allocate_checkpointed(nq_, nv_, m_, r(), sens.np, interval, count, state_size());
+        record.allocate_checkpointed(nq_, nv_, m_, r(), forward_.sens.np, interval, count, state_size());
     else
-        record.allocate(nq_, nv_, m_, r(), sens.np, adjoint_.max_steps);
+        record.allocate(nq_, nv_, m_, r(), forward_.sens.np, adjoint_.max_steps);
     adjoint_ = std::move(record);
     return GA_OK;
 }
@@ -87,10 +87,10 @@ ga_status Solver::set_sensitivity_method(int methods, long max_steps)
                          "keeps one segment", max_steps, stride);
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
     if (methods & GA_SENSITIVITY_ADJOINT)
-        record.allocate(nq_, nv_, m_, r(), sens.np, max_steps);
+        record.allocate(nq_, nv_, m_, r(), forward_.sens.np, max_steps);
     adjoint_ = std::move(record);
-    sens.forward = (methods & GA_SENSITIVITY_FORWARD) != 0;
-    sens.adjoint = (methods & GA_SENSITIVITY_ADJOINT) != 0;
+    forward_.sens.forward = (methods & GA_SENSITIVITY_FORWARD) != 0;
+    forward_.sens.adjoint = (methods & GA_SENSITIVITY_ADJOINT) != 0;
     return GA_OK;
 }
 
@@ -115,9 +115,9 @@ ga_status Solver::record_on_converged(double h)
         return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (max_steps = %ld: "
                          "ga_set_sensitivity_method)", r.capacity);
     r.pending_rho = 1.0;
-    if (sens.step_done || (sens.start_given && !start_pending_)) {
+    if (forward_.sens.step_done || (forward_.sens.start_given && !start_pending_)) {
         r.pending_kind = AdjointRecord::Unsupported;
-    } else if (sens.start_given) {
+    } else if (forward_.sens.start_given) {
         r.pending_kind = AdjointRecord::First;
     } else {
         r.pending_kind = AdjointRecord::Regular;
@@ -146,8 +146,8 @@ void Solver::record_start()
     e += m_;
     put(x.y, e);
     put(x.ydot, e);
-    for (int j = 0; j < sens.np; ++j) {
-        const StateDerivative &s = sens.accepted[j];
+    for (int j = 0; j < forward_.sens.np; ++j) {
+        const StateDerivative &s = forward_.sens.accepted[j];
         StateDerivative &d = r.sigma0[j];
         d.q = s.q;
         d.v = s.v;
@@ -193,12 +193,12 @@ void Solver::record_step()
     put(x.y, e);
     put(x.ydot, e);
     if (r.pending_kind == AdjointRecord::First)
-        for (int j = 0; j < sens.np; ++j) {
-            r.start0[j].v = sens.start[j].v;
-            r.start0[j].a = sens.start[j].a;
-            r.start0[j].qdd = sens.start[j].qdd;
-            r.start0[j].w = sens.start[j].w;
-            r.start0[j].ydot = sens.start[j].ydot;
+        for (int j = 0; j < forward_.sens.np; ++j) {
+            r.start0[j].v = forward_.sens.start[j].v;
+            r.start0[j].a = forward_.sens.start[j].a;
+            r.start0[j].qdd = forward_.sens.start[j].qdd;
+            r.start0[j].w = forward_.sens.start[j].w;
+            r.start0[j].ydot = forward_.sens.start[j].ydot;
         }
     if (r.pending_kind == AdjointRecord::Unsupported && r.unsupported_at < 0)
         r.unsupported_at = r.steps;
@@ -504,18 +504,18 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
         w.yp.noalias() -= b.g_y.transpose() * w.ry;
     }
     for (int j = 0; j < w.np; ++j) {
-        Sensitivities &z = sens;
-        if ((st = constraint_parameter_terms(j, t1, x, index2, index2, e0[0], q_n, w.eta)))
+        Sensitivities &z = forward_.sens;
+        if ((st = forward_.constraint_parameter_terms(j, t1, x, index2, index2, e0[0], q_n, w.eta)))
             return st;
         z.rq = z.cq;
-        if ((st = parameter_residual(j, t1, x)))
+        if ((st = forward_.parameter_residual(j, t1, x)))
             return st;
         w.dJ[j] += w.rr.dot(z.rq) + w.rl.dot(z.cl) + w.qp.dot(z.cbt);
         if (index2 && m > 0)
             w.dJ[j] += w.rv.dot(z.cv);
         if (R > 0) {
             z.ry.setZero();
-            if ((st = rate_parameter_residual(j, t1, x)))
+            if ((st = forward_.rate_parameter_residual(j, t1, x)))
                 return st;
             w.dJ[j] += w.ry.dot(z.ry);
         }
@@ -539,7 +539,7 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     const Vec msqdd = (af / (1.0 - am)) * (map + w.ma);
     Vec msq = w.qp;
     if (index2 && m > 0) {
-        if ((st = correction_derivative(e0[0], q_n, w.eta, w.qp, w.tmp)))
+        if ((st = forward_.correction_derivative(e0[0], q_n, w.eta, w.qp, w.tmp)))
             return st;
         msq += w.tmp;
     }
@@ -601,13 +601,13 @@ ga_status Solver::replay_segment(long s)
         // records nothing (its entries are written below)
         ga_status st = attempt_step(h, l[4], std::fmod(l[5], 2.0) != 0.0);
         if (!st)
-            st = sensitivity_step(h);
+            st = forward_.step(h);
         if (st) {
             diag.append(" (recomputing step %ld from its checkpoint for the adjoint sweep)", k);
             return st;
         }
-        if (sens.forward)
-            sens.accepted.swap(sens.trial);
+        if (forward_.sens.forward)
+            forward_.sens.accepted.swap(forward_.sens.trial);
         accepted_.swap(trial_);
         accepted_.t = l[0];
         start_pending_ = false;
@@ -695,7 +695,7 @@ ga_status Solver::adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double 
         return diag.fail(GA_ERR_STATE, "the adjoint sweep with dropped redundant constraints is "
                          "not built");
     AdjointWork w;
-    w.allocate(nq_, nv_, m_, this->r(), sens.np);
+    w.allocate(nq_, nv_, m_, this->r(), forward_.sens.np);
     const long N = r.steps;
     // Cost terms at a recorded state k: its value into `value`, weight times its gradient
     // into the adjoint variables (and into dJ/dp).

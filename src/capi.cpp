@@ -200,11 +200,11 @@ template <class Copy>
 ga_status read_sensitivity(const ga_solver *s, const char *name, int j, Copy &&copy)
 {
     return reading(s, name, "j is not the index of a parameter", [&](const ga::Solver &c) {
-        if (!c.initialized() || !c.sens.active() || !c.sens.forward)
+        if (!c.initialized() || !c.sens().active() || !c.sens().forward)
             return GA_ERR_STATE;
-        if (j < 0 || j >= c.sens.np)
+        if (j < 0 || j >= c.sens().np)
             return GA_ERR_ARG;
-        copy(c.sens.accepted[j]);
+        copy(c.sens().accepted[j]);
         return GA_OK;
     });
 }
@@ -436,7 +436,7 @@ GA_API ga_status ga_set_constant_mass(ga_solver *s, int on)
     return guarded(s, [&](ga::Solver &c) {
         if (on != 0 && on != 1)
             return c.diag.fail(GA_ERR_ARG, "constant mass must be 0 or 1, got %d", on);
-        if (on == 1 && c.sens.active() && (c.sens.depends & GA_DEPENDS_MASS))
+        if (on == 1 && c.sens().active() && (c.sens().depends & GA_DEPENDS_MASS))
             return c.diag.fail(GA_ERR_STATE, "the mass matrix depends on the sensitivity "
                                "parameters (GA_DEPENDS_MASS): it is not constant");
         return change_tangents(c, [&] { c.model.constant_mass = on == 1; });
@@ -763,7 +763,7 @@ GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga
         if (c.events().fn_y())
             return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after ga_set_events_y: the "
                                "event functions take the states declared before them");
-        if (r > 0 && c.sens.active())
+        if (r > 0 && c.sens().active())
             return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after ga_set_sensitivity: "
                                "declare the states first (the sensitivities include theirs)");
         c.set_first_order(r);  // may throw std::bad_alloc before anything below changed
@@ -861,11 +861,11 @@ GA_API ga_status ga_set_sensitivity_start(ga_solver *s, int j, const double *dq0
                                           const double *dv0)
 {
     return guarded(s, [&](ga::Solver &c) {
-        if (!c.sens.active())
+        if (!c.sens().active())
             return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity_start before ga_set_sensitivity "
                                "with np > 0");
-        if (j < 0 || j >= c.sens.np)
-            return c.diag.fail(GA_ERR_ARG, "parameter %d: there are %d (0-based)", j, c.sens.np);
+        if (j < 0 || j >= c.sens().np)
+            return c.diag.fail(GA_ERR_ARG, "parameter %d: there are %d (0-based)", j, c.sens().np);
         for (int i = 0; i < c.nv(); ++i)
             if ((dq0 && !std::isfinite(dq0[i])) || (dv0 && !std::isfinite(dv0[i])))
                 return c.diag.fail(GA_ERR_ARG, "dq0 or dv0 entry %d is not finite", i);
@@ -920,7 +920,7 @@ GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_s
         if ((methods & GA_SENSITIVITY_ADJOINT) && max_steps < 1)
             return c.diag.fail(GA_ERR_ARG, "max_steps = %ld: the adjoint record needs room for "
                                "at least one step", max_steps);
-        if (!c.sens.active())
+        if (!c.sens().active())
             return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity_method before "
                                "ga_set_sensitivity with np > 0");
         if (c.initialized())
@@ -938,7 +938,7 @@ GA_API ga_status ga_set_adjoint_checkpoints(ga_solver *s, long interval, long co
         if (interval > 0 && count > LONG_MAX / interval)
             return c.diag.fail(GA_ERR_ARG, "interval = %ld times count = %ld steps overflows",
                                interval, count);
-        if (!c.sens.adjoint)
+        if (!c.sens().adjoint)
             return c.diag.fail(GA_ERR_STATE, "ga_set_adjoint_checkpoints before "
                                "ga_set_sensitivity_method with GA_SENSITIVITY_ADJOINT");
         if (c.initialized())
@@ -956,7 +956,7 @@ GA_API ga_status ga_adjoint_gradient(ga_solver *s, ga_cost_fn running, ga_cost_f
                                "are NULL)");
         if (!J || !dJ_dp)
             return c.diag.fail(GA_ERR_ARG, "ga_adjoint_gradient: J or dJ_dp is NULL");
-        if (!c.sens.adjoint)
+        if (!c.sens().adjoint)
             return c.diag.fail(GA_ERR_STATE, "ga_adjoint_gradient without a recorded run "
                                "(ga_set_sensitivity_method with GA_SENSITIVITY_ADJOINT)");
         if (!c.initialized())

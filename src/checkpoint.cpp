@@ -61,7 +61,7 @@ std::size_t Solver::state_size() const { return state_size_in(false); }
 std::size_t Solver::state_size_in(bool layout3) const
 {
     return layout(nq_, nv_, m_, layout3).end + 6 * static_cast<std::size_t>(r()) +
-           static_cast<std::size_t>(sens.np) *
+           static_cast<std::size_t>(forward_.sens.np) *
                (4 * static_cast<std::size_t>(nv_) + m_ + 3 * static_cast<std::size_t>(r()));
 }
 
@@ -116,7 +116,7 @@ void Solver::get_state(double *buf) const
         Eigen::Map<Vec>(p, x->size()) = *x;
         p += x->size();
     }
-    for (const StateDerivative &d : sens.accepted)
+    for (const StateDerivative &d : forward_.sens.accepted)
         for (const Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a, &d.y, &d.ydot, &d.w}) {
             Eigen::Map<Vec>(p, x->size()) = *x;
             p += x->size();
@@ -202,7 +202,7 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
     }
     if (!model.ready())
         return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
-    if (sens.adjoint && !internal)
+    if (forward_.sens.adjoint && !internal)
         return diag.fail(GA_ERR_STATE, "ga_set_state on a run recorded for the adjoint: the "
                          "record starts at ga_init (restoring into it is not built)");
     if (auto st = setup())
@@ -267,7 +267,7 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
             *x = Eigen::Map<const Vec>(py, x->size());
             py += x->size();
         }
-        for (StateDerivative &d : sens.accepted)
+        for (StateDerivative &d : forward_.sens.accepted)
             for (Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a, &d.y, &d.ydot, &d.w}) {
                 *x = Eigen::Map<const Vec>(py, x->size());
                 py += x->size();

@@ -280,9 +280,9 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
     }
     // parameter derivatives against differences in p_j (perturbed in place, as the
     // sensitivities do, and put back)
-    for (int j = 0; j < sens.np && !st; ++j) {
-        double &p = sens.p[j];
-        const double p_kept = p, e = step_for(p) * std::max(1.0, sens.scale[j]);
+    for (int j = 0; j < forward_.sens.np && !st; ++j) {
+        double &p = forward_.sens.p[j];
+        const double p_kept = p, e = step_for(p) * std::max(1.0, forward_.sens.scale[j]);
         const auto at = [&](double value, auto &&eval) {
             p = value;
             const ga_status s2 = eval();

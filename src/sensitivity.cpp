@@ -44,25 +44,17 @@ void Sensitivities::allocate_matrices(const ModelMatrix &M, const ModelMatrix &J
     J_pert.copy_layout(J);
 }
 
-double Sensitivities::increment(int j) const
-{
-    return std::cbrt(kEps) * scale[j];
-}
+double Sensitivities::increment(int j) const { return std::cbrt(kEps) * scale[j]; }
 
-double Sensitivities::extrapolated_increment(int j) const
-{
-    return std::pow(kEps, 0.2) * scale[j];
-}
+double Sensitivities::extrapolated_increment(int j) const { return std::pow(kEps, 0.2) * scale[j]; }
 
 namespace {
 // half = (4 D(e/2) - D(e)) / 3 from half = D(e/2) and wide = D(e)
-void extrapolate(Vec &half, const Vec &wide)
-{
-    half = (4.0 / 3.0) * half - (1.0 / 3.0) * wide;
-}
+void extrapolate(Vec &half, const Vec &wide) { half = (4.0 / 3.0) * half - (1.0 / 3.0) * wide; }
 }  // namespace
 
-ga_status Solver::set_sensitivity(int np, double *p, const double *p_scale, int depends)
+void ForwardSensitivity::set(int np, double *p, const double *p_scale, int depends, int nq, int nv,
+                             int m, int r, const ModelMatrix *M, const ModelMatrix *J)
 {
     Sensitivities s;  // built aside: a failed allocation leaves the old set
     s.np = np;
@@ -72,32 +64,29 @@ ga_status Solver::set_sensitivity(int np, double *p, const double *p_scale, int 
     for (int j = 0; j < np; ++j)
         s.scale[j] = p_scale ? p_scale[j] : (p[j] != 0.0 ? std::fabs(p[j]) : 1.0);
     if (np > 0) {
-        s.allocate(nq_, nv_, m_, r());  // (d/dp of q is a tangent: nv)
-        if (workspace_ready_)
-            s.allocate_matrices(M_, J_);
-        sens_scratch_.allocate(nq_, nv_, m_);
-        sens_scratch_.allocate_first_order(r());
+        s.allocate(nq, nv, m, r);  // (d/dp of q is a tangent: nv)
+        if (M && J)
+            s.allocate_matrices(*M, *J);
+        scratch_.allocate(nq, nv, m);
+        scratch_.allocate_first_order(r);
     }
     sens = std::move(s);
-    adjoint_ = AdjointRecord{};  // the method is forward again (ga_set_sensitivity_method)
-    return GA_OK;
 }
 
-ga_status Solver::set_sensitivity_start(int j, const double *dq0, const double *dv0)
+void ForwardSensitivity::set_start(int j, const double *dq0, const double *dv0, int nv)
 {
-    Vec q = dq0 ? Vec(Eigen::Map<const Vec>(dq0, nv_)) : Vec::Zero(nv_);
-    Vec v = dv0 ? Vec(Eigen::Map<const Vec>(dv0, nv_)) : Vec::Zero(nv_);
+    Vec q = dq0 ? Vec(Eigen::Map<const Vec>(dq0, nv)) : Vec::Zero(nv);
+    Vec v = dv0 ? Vec(Eigen::Map<const Vec>(dv0, nv)) : Vec::Zero(nv);
     sens.seed_q[j].swap(q);  // (no allocation after the two above)
     sens.seed_v[j].swap(v);
-    return GA_OK;
 }
 
 // Runs `evaluate` with p_j at p_j + e and at p_j - e (and, through `perturb`, the state moved
 // by the same multiple of its derivative); p_j is restored bit for bit whatever happens.
 // Returns the divisor of the central difference in `span`.
 template <class Perturb, class Evaluate>
-ga_status Solver::central_difference(int j, Perturb &&perturb, Evaluate &&evaluate,
-                                     double &span, double increment)
+ga_status ForwardSensitivity::central_difference(int j, Perturb &&perturb, Evaluate &&evaluate,
+                                                 double &span, double increment)
 {
     double &pj = sens.p[j];
     const double p0 = pj, e = increment > 0.0 ? increment : sens.increment(j);
@@ -120,42 +109,44 @@ ga_status Solver::central_difference(int j, Perturb &&perturb, Evaluate &&evalua
 // projections: dq0 onto Phi_q dq = 0, dv0 onto Phi_q dv = -d(Phi_q v + Phi_t)/dq dq0; qdd0 and
 // lambda0 follow through the acceleration-level system they solve (central differences of
 // that solve along (dq0, dv0) and p_j: it is linear in p, and cheap once).
-ga_status Solver::sensitivity_start(const State &x)
+ga_status ForwardSensitivity::start(const State &x)
 {
     // Exact derivatives need every tangent in the matrix (sensitivity_step): on the sparse
     // path a tangent without a pattern has no place there.
-    const bool damped = model.has_force() || model.cb.damping;
-    if (sparse_backend_ && ((!K_.zero() && K_.dense()) || (damped && !C_.zero() && C_.dense())))
-        return diag.fail(GA_ERR_ARG, "sensitivities on the sparse path need the patterns of K_t "
-                         "and C_t (ga_set_pattern; an empty pattern declares a zero matrix)");
-    if (r() > 0 && !coupling_exact)
-        return diag.fail(GA_ERR_ARG, "sensitivities with first-order states need the coupling "
-                         "blocks in the iteration matrix (ga_set_coupling_exact)");
+    const bool damped = k_.model.has_force() || k_.model.cb.damping;
+    if (k_.sparse_backend_ &&
+        ((!k_.K_.zero() && k_.K_.dense()) || (damped && !k_.C_.zero() && k_.C_.dense())))
+        return k_.diag.fail(GA_ERR_ARG,
+                            "sensitivities on the sparse path need the patterns of K_t "
+                            "and C_t (ga_set_pattern; an empty pattern declares a zero matrix)");
+    if (k_.r() > 0 && !k_.coupling_exact)
+        return k_.diag.fail(GA_ERR_ARG, "sensitivities with first-order states need the coupling "
+                                        "blocks in the iteration matrix (ga_set_coupling_exact)");
     Sensitivities &z = sens;
     for (int j = 0; j < z.np; ++j) {
         StateDerivative &s = z.trial[j];
         s.q = z.seed_q[j];
         s.v = z.seed_v[j];
         const bool moves = (z.depends & GA_DEPENDS_CONSTRAINT) != 0;
-        if (m_ > 0 && (moves || !s.q.isZero(0.0) || !s.v.isZero(0.0)))
+        if (k_.m_ > 0 && (moves || !s.q.isZero(0.0) || !s.v.isZero(0.0)))
             if (auto st = project_seeds(x, j, s)) {
-                diag.append(" (the start's derivative in parameter %d)", j);
+                k_.diag.append(" (the start's derivative in parameter %d)", j);
                 return st;
             }
         double span = 0.0;
         const auto perturb = [&](bool on, double shift) {
             if (!on)
                 return;
-            model.space.shifted(x.q, shift, s.q, z.xq);
+            k_.model.space.shifted(x.q, shift, s.q, z.xq);
             z.xv = x.v + shift * s.v;
         };
         const auto evaluate = [&](int side) {
-            SaddleWorkspace w{S_, M_, J_, f_, c_, rq_};
+            SaddleWorkspace w{k_.S_, k_.M_, k_.J_, k_.f_, k_.c_, k_.rq_};
             Vec &qdd = side == 0 ? s.qdd : z.d;
             Vec &lambda = side == 0 ? s.lambda : z.dl;
-            ga_status st = acceleration_level(x.t, z.xq, z.xv, w, qdd, lambda);
-            if (!st && r() > 0)  // y'_0 = g(t0, q0, v0, y0), y0 independent of p
-                st = model.rate(x.t, z.xq, z.xv, x.y, side == 0 ? z.rate_plus : z.rate_minus);
+            ga_status st = k_.acceleration_level(x.t, z.xq, z.xv, w, qdd, lambda);
+            if (!st && k_.r() > 0)  // y'_0 = g(t0, q0, v0, y0), y0 independent of p
+                st = k_.model.rate(x.t, z.xq, z.xv, x.y, side == 0 ? z.rate_plus : z.rate_minus);
             return st;
         };
         // extrapolated differences: in index 3 the start's error reaches dqdd/dp / (beta h^2)
@@ -164,7 +155,7 @@ ga_status Solver::sensitivity_start(const State &x)
                 return st;
             s.qdd = (s.qdd - z.d) / span;
             s.lambda = (s.lambda - z.dl) / span;
-            if (r() > 0)
+            if (k_.r() > 0)
                 s.ydot = (z.rate_plus - z.rate_minus) / span;
             return GA_OK;
         };
@@ -176,16 +167,16 @@ ga_status Solver::sensitivity_start(const State &x)
             s.v.swap(z.wide.v);
             st = pass(0.5 * e);
         }
-        jacobian_valid_ = false;  // S_ holds another matrix now
-        mass_valid_ = false;      // and M_ was evaluated with p perturbed
+        k_.jacobian_valid_ = false;  // S_ holds another matrix now
+        k_.mass_valid_ = false;      // and M_ was evaluated with p perturbed
         if (st) {
-            diag.append(" (sensitivity of the consistent start to parameter %d)", j);
+            k_.diag.append(" (sensitivity of the consistent start to parameter %d)", j);
             return st;
         }
         extrapolate(s.qdd, z.wide.qdd);
         extrapolate(s.lambda, z.wide.lambda);
         s.a = s.qdd;  // a_0 = qdd_0
-        if (r() > 0) {
+        if (k_.r() > 0) {
             extrapolate(s.ydot, z.wide.ydot);
             s.y.setZero();
             s.w = s.ydot;  // w_0 = y'_0
@@ -198,50 +189,53 @@ ga_status Solver::sensitivity_start(const State &x)
 // at the start x: [I Phi_q^T; Phi_q 0] [dq; mu] = [dq0; -Phi_p], then [dv; mu] = [dv0; -Z dq
 // - (Phi_q v + Phi_t)_p] with Z dq = d/de (Phi_q(q + e dq) v + Phi_t(q + e dq)) by central
 // differences (the _p terms where the constraints depend on p_j).
-ga_status Solver::project_seeds(const State &x, int j, StateDerivative &s)
+ga_status ForwardSensitivity::project_seeds(const State &x, int j, StateDerivative &s)
 {
     Sensitivities &z = sens;
     if (auto st = constraint_parameter_terms(j, x.t, x, true, false, x.t, x.q, x.lambda))
         return st;
-    if (auto st = model.jacobian(x.t, x.q, J_))
+    if (auto st = k_.model.jacobian(x.t, x.q, k_.J_))
         return st;
-    count(counters, GA_COUNT_FACTORIZATIONS);
-    jacobian_valid_ = false;  // S_ holds another matrix now
-    if (!S_.factorize_projection(J_))
-        return diag.fail(GA_ERR_SINGULAR, "cannot project the start's derivative: Phi_q is rank "
-                         "deficient (rcond of [I Phi_q^T; Phi_q 0] = %.3g)", S_.rcond());
+    count(k_.counters, GA_COUNT_FACTORIZATIONS);
+    k_.jacobian_valid_ = false;  // S_ holds another matrix now
+    if (!k_.S_.factorize_projection(k_.J_))
+        return k_.diag.fail(GA_ERR_SINGULAR,
+                            "cannot project the start's derivative: Phi_q is rank "
+                            "deficient (rcond of [I Phi_q^T; Phi_q 0] = %.3g)",
+                            k_.S_.rcond());
     z.rq = -s.q;
     z.rl = z.cl;
-    S_.solve(z.rq, z.rl, z.d, z.dl);
+    k_.S_.solve(z.rq, z.rl, z.d, z.dl);
     s.q = z.d;
     z.rl = z.cv;
     const double s_max = s.q.lpNorm<Eigen::Infinity>();
     if (s_max > 0.0) {
-        const double e = std::cbrt(kEps) * std::max(model.space.max_magnitude(x.q), 1.0) / s_max;
+        const double e = std::cbrt(kEps) * std::max(k_.model.space.max_magnitude(x.q), 1.0) / s_max;
         for (int side = 0; side < 2; ++side) {
             const double sign = side == 0 ? 1.0 : -1.0;
-            model.space.shifted(x.q, sign * e, s.q, z.xq);
-            if (auto st = model.jacobian(x.t, z.xq, z.J_pert))
+            k_.model.space.shifted(x.q, sign * e, s.q, z.xq);
+            if (auto st = k_.model.jacobian(x.t, z.xq, z.J_pert))
                 return st;
-            if (auto st = model.constraint_dt(x.t, z.xq, z.rv))
+            if (auto st = k_.model.constraint_dt(x.t, z.xq, z.rv))
                 return st;
             z.J_pert.multiply_add(1.0, x.v, z.rv);
             z.rl += (sign * 0.5 / e) * z.rv;
         }
     }
     z.rq = -s.v;
-    S_.solve(z.rq, z.rl, z.d, z.dl);
+    k_.S_.solve(z.rq, z.rl, z.d, z.dl);
     s.v = z.d;
     return GA_OK;
 }
 
 // The state moved by `shift` times the derivative of parameter j (the quantities a step reads).
-void Solver::shift_state(const State &from, const StateDerivative &s, double shift, State &to) const
+void ForwardSensitivity::shift_state(const State &from, const StateDerivative &s, double shift,
+                                     State &to) const
 {
     to.t = from.t;
     to.h_last = from.h_last;
     to.sliver_span = from.sliver_span;
-    model.space.shifted(from.q, shift, s.q, to.q);
+    k_.model.space.shifted(from.q, shift, s.q, to.q);
     to.v = from.v + shift * s.v;
     to.qdd = from.qdd + shift * s.qdd;
     to.lambda = from.lambda + shift * s.lambda;
@@ -255,41 +249,37 @@ void Solver::shift_state(const State &from, const StateDerivative &s, double shi
     }
 }
 
-// The sensitivities' and the adjoint record's part of a commit, and of its undoing.
-void Solver::sensitivity_on_commit()
+// The sensitivities' part of a commit, and of its undoing.
+void ForwardSensitivity::on_commit()
 {
     // The step's derivatives, where forward sensitivities computed them (an adjoint-only run
     // keeps the start's: its trial ones are scratch, NaN after a failed start, which the next
     // checkpoint carried and a restore refused)
     if (sens.forward)
         sens.accepted.swap(sens.trial);
-    if (sens.adjoint)
-        record_step();
 }
 
-void Solver::sensitivity_on_undo()
+void ForwardSensitivity::on_undo()
 {
     if (sens.forward)
         sens.accepted.swap(sens.trial);
-    if (sens.adjoint && --adjoint_.steps < adjoint_.unsupported_at)
-        adjoint_.unsupported_at = -1;  // that step is gone
 }
 
 // Before an attempt: the starts that are not the linear map of the step before -- a Taylor
 // step, a fresh start -- by differences of the start functions (forward); with the adjoint
 // only, the record learns that its sweep does not cover them.
-ga_status Solver::sensitivity_before_attempt(const StepPlan &plan)
+ga_status ForwardSensitivity::before_attempt(const StepPlan &plan, const State &accepted)
 {
     sens.step_done = false;
     if (plan.kind == StepPlan::Sliver) {
         if (sens.forward)
-            return sensitivity_by_differences(plan.h, true, false);
+            return by_differences(accepted, plan.h, true, false);
         sens.step_done = true;  // (adjoint only: recorded as a step not covered)
         return GA_OK;
     }
     sens.start_given = false;
-    if (plan.fresh && (sens.forward || start_pending_))
-        return sensitivity_by_differences(plan.h, false, plan.restart_short);
+    if (plan.fresh && (sens.forward || k_.start_pending_))
+        return by_differences(accepted, plan.h, false, plan.restart_short);
     if (plan.fresh)
         sens.start_given = true;  // (adjoint only: recorded as a start not covered)
     return GA_OK;
@@ -299,20 +289,21 @@ ga_status Solver::sensitivity_before_attempt(const StepPlan &plan)
 // step far longer than the one before) or a Taylor step: their computations differenced along
 // the derivative of the state and p_j. A Taylor step's derivative is that of the step; a
 // start's is that of (v_n, a_n, qdd_n) as the step uses them.
-ga_status Solver::sensitivity_by_differences(double h, bool taylor_step, bool restart_short)
+ga_status ForwardSensitivity::by_differences(const State &accepted, double h, bool taylor_step,
+                                             bool restart_short)
 {
     for (int j = 0; j < sens.np; ++j) {
         StateDerivative &out = taylor_step ? sens.trial[j] : sens.start[j];
         const StateDerivative &s = sens.accepted[j];
-        // The start functions run from the perturbed state, sens_scratch_ (evaluate is called
+        // The start functions run from the perturbed state, scratch_ (evaluate is called
         // between perturb(true) and perturb(false) only).
         const auto perturb = [&](bool on, double shift) {
             if (on)
-                shift_state(accepted_, s, shift, sens_scratch_);
+                shift_state(accepted, s, shift, scratch_);
         };
         const auto evaluate = [&](int side) {
-            if (auto st = taylor_step ? sliver_step(sens_scratch_, h)
-                                      : prepare_start(sens_scratch_, h, restart_short))
+            if (auto st = taylor_step ? k_.sliver_step(scratch_, h)
+                                      : k_.prepare_start(scratch_, h, restart_short))
                 return st;
             const auto take = [side](Vec &to, const Vec &from) {
                 if (side == 0)
@@ -321,29 +312,29 @@ ga_status Solver::sensitivity_by_differences(double h, bool taylor_step, bool re
                     to -= from;
             };
             if (taylor_step) {
-                take(out.q, trial_.q);
-                take(out.v, trial_.v);
-                take(out.qdd, trial_.qdd);
-                take(out.lambda, trial_.lambda);
-                take(out.a, trial_.a);
-                if (r() > 0) {
-                    take(out.y, trial_.y);
-                    take(out.ydot, trial_.ydot);
-                    take(out.w, trial_.w);
+                take(out.q, k_.trial_.q);
+                take(out.v, k_.trial_.v);
+                take(out.qdd, k_.trial_.qdd);
+                take(out.lambda, k_.trial_.lambda);
+                take(out.a, k_.trial_.a);
+                if (k_.r() > 0) {
+                    take(out.y, k_.trial_.y);
+                    take(out.ydot, k_.trial_.ydot);
+                    take(out.w, k_.trial_.w);
                 }
             } else {
-                take(out.v, *v_start_);
-                take(out.a, *a_start_);
-                take(out.qdd, *qdd_start_);
-                if (r() > 0) {
-                    take(out.w, *w_start_);
-                    take(out.ydot, *ydot_start_);
+                take(out.v, *k_.v_start_);
+                take(out.a, *k_.a_start_);
+                take(out.qdd, *k_.qdd_start_);
+                if (k_.r() > 0) {
+                    take(out.w, *k_.w_start_);
+                    take(out.ydot, *k_.ydot_start_);
                 }
             }
             return GA_OK;
         };
         // extrapolated differences (sensitivity_start)
-        const bool first_order = r() > 0;
+        const bool first_order = k_.r() > 0;
         const auto fields = [&](StateDerivative &x) {
             std::array<Vec *, 8> f{&x.v, &x.a, &x.qdd, nullptr, nullptr, nullptr, nullptr, nullptr};
             if (first_order) {
@@ -374,8 +365,8 @@ ga_status Solver::sensitivity_by_differences(double h, bool taylor_step, bool re
             st = pass(0.5 * e);
         }
         if (st) {
-            diag.append(" (sensitivity of the %s to parameter %d)",
-                        taylor_step ? "short step" : "start of the step", j);
+            k_.diag.append(" (sensitivity of the %s to parameter %d)",
+                           taylor_step ? "short step" : "start of the step", j);
             return st;
         }
         const auto half = fields(out), wide = fields(sens.wide);
@@ -392,39 +383,41 @@ ga_status Solver::sensitivity_by_differences(double h, bool taylor_step, bool re
 
 // R_p: the derivative of r^q = M qdd - f + Phi_q^T lambda in p_j at the converged step x,
 // into sens.rq (added).
-ga_status Solver::parameter_residual(int j, double t, const State &x)
+ga_status ForwardSensitivity::parameter_residual(int j, double t, const State &x)
 {
     Sensitivities &z = sens;
     if (z.depends & GA_DEPENDS_FORCE) {
-        if (model.cb.force_p) {
-            if (auto st = model.force_p(t, x.q, x.v, j, z.f_plus))
+        if (k_.model.cb.force_p) {
+            if (auto st = k_.model.force_p(t, x.q, x.v, j, z.f_plus))
                 return st;
             z.rq -= z.f_plus;
-        } else if (model.has_force()) {
+        } else if (k_.model.has_force()) {
             double span = 0.0;
             const auto evaluate = [&](int side) {
-                return model.force(t, x.q, x.v, side == 0 ? z.f_plus : z.f_minus);
+                return k_.model.force(t, x.q, x.v, side == 0 ? z.f_plus : z.f_minus);
             };
-            if (auto st = central_difference(j, [](bool, double) {}, evaluate, span))
+            if (auto st = central_difference(
+                    j, [](bool, double) {}, evaluate, span))
                 return st;
             z.rq -= (z.f_plus - z.f_minus) / span;
         }
     }
     if (z.depends & GA_DEPENDS_MASS) {
-        if (model.cb.mass_p) {
-            if (auto st = model.mass_p(t, x.q, j, x.qdd, z.f_plus))
+        if (k_.model.cb.mass_p) {
+            if (auto st = k_.model.mass_p(t, x.q, j, x.qdd, z.f_plus))
                 return st;
             z.rq += z.f_plus;
         } else {
             double span = 0.0;
             z.f_plus.setZero();
             const auto evaluate = [&](int side) {
-                if (auto st = model.mass(t, x.q, z.M_pert))
+                if (auto st = k_.model.mass(t, x.q, z.M_pert))
                     return st;
                 z.M_pert.multiply_add(side == 0 ? 1.0 : -1.0, x.qdd, z.f_plus);
                 return GA_OK;
             };
-            if (auto st = central_difference(j, [](bool, double) {}, evaluate, span))
+            if (auto st = central_difference(
+                    j, [](bool, double) {}, evaluate, span))
                 return st;
             z.rq += z.f_plus / span;
         }
@@ -434,16 +427,17 @@ ga_status Solver::parameter_residual(int j, double t, const State &x)
 
 // d/dp_j of r^y = y' - g: -dg/dp_j by central differences of the rate (GA_DEPENDS_RATE), into
 // sens.ry (added).
-ga_status Solver::rate_parameter_residual(int j, double t, const State &x)
+ga_status ForwardSensitivity::rate_parameter_residual(int j, double t, const State &x)
 {
     Sensitivities &z = sens;
     if (!(z.depends & GA_DEPENDS_RATE))
         return GA_OK;
     double span = 0.0;
     const auto evaluate = [&](int side) {
-        return model.rate(t, x.q, x.v, x.y, side == 0 ? z.rate_plus : z.rate_minus);
+        return k_.model.rate(t, x.q, x.v, x.y, side == 0 ? z.rate_plus : z.rate_minus);
     };
-    if (auto st = central_difference(j, [](bool, double) {}, evaluate, span))
+    if (auto st = central_difference(
+            j, [](bool, double) {}, evaluate, span))
         return st;
     z.ry -= (z.rate_plus - z.rate_minus) / span;
     return GA_OK;
@@ -454,24 +448,24 @@ ga_status Solver::rate_parameter_residual(int j, double t, const State &x)
 // d/dp_j (Phi_q v + Phi_t); with `correction` (index 2) into sens.cbt the derivative of the
 // position correction -B^T eta_bar, B = Phi_q(q_n) at t_n. Without that flag they stay the
 // zeros they were allocated as.
-ga_status Solver::constraint_parameter_terms(int j, double t, const State &x, bool velocity,
-                                             bool correction, double t_n, const Vec &q_n,
-                                             const Vec &eta)
+ga_status ForwardSensitivity::constraint_parameter_terms(int j, double t, const State &x,
+                                                         bool velocity, bool correction, double t_n,
+                                                         const Vec &q_n, const Vec &eta)
 {
     Sensitivities &z = sens;
-    if (!(z.depends & GA_DEPENDS_CONSTRAINT) || m_ == 0)
+    if (!(z.depends & GA_DEPENDS_CONSTRAINT) || k_.m_ == 0)
         return GA_OK;
     for (Vec *c : {&z.cq, &z.cl, &z.cv, &z.cbt})
         c->setZero();
     ModelMatrix &Jp = z.J_pert;
-    if (model.cb.constraint_p) {
-        if (auto st = model.constraint_p(t, x.q, j, z.cl, Jp, velocity ? &z.cv : nullptr))
+    if (k_.model.cb.constraint_p) {
+        if (auto st = k_.model.constraint_p(t, x.q, j, z.cl, Jp, velocity ? &z.cv : nullptr))
             return st;
         Jp.multiply_transpose_add(1.0, x.lambda, z.cq);
         if (velocity)
             Jp.multiply_add(1.0, x.v, z.cv);
         if (correction) {
-            if (auto st = model.constraint_p(t_n, q_n, j, z.phi, Jp, nullptr))
+            if (auto st = k_.model.constraint_p(t_n, q_n, j, z.phi, Jp, nullptr))
                 return st;
             Jp.multiply_transpose_add(-1.0, eta, z.cbt);
         }
@@ -482,20 +476,20 @@ ga_status Solver::constraint_parameter_terms(int j, double t, const State &x, bo
     // divided by beta h^2.
     const auto evaluate = [&](int side) {
         const double sign = side == 0 ? 1.0 : -1.0;
-        if (auto st = model.constraint(t, x.q, z.phi))
+        if (auto st = k_.model.constraint(t, x.q, z.phi))
             return st;
         z.cl += sign * z.phi;
-        if (auto st = model.jacobian(t, x.q, Jp))
+        if (auto st = k_.model.jacobian(t, x.q, Jp))
             return st;
         Jp.multiply_transpose_add(sign, x.lambda, z.cq);
         if (velocity) {
-            if (auto st = model.constraint_dt(t, x.q, z.phi))
+            if (auto st = k_.model.constraint_dt(t, x.q, z.phi))
                 return st;
             z.cv += sign * z.phi;
             Jp.multiply_add(sign, x.v, z.cv);
         }
         if (correction) {
-            if (auto st = model.jacobian(t_n, q_n, Jp))
+            if (auto st = k_.model.jacobian(t_n, q_n, Jp))
                 return st;
             Jp.multiply_transpose_add(-sign, eta, z.cbt);
         }
@@ -504,13 +498,15 @@ ga_status Solver::constraint_parameter_terms(int j, double t, const State &x, bo
     Vec *terms[] = {&z.cq, &z.cl, &z.cv, &z.cbt}, *wide[] = {&z.cq2, &z.cl2, &z.cv2, &z.cbt2};
     const double e = z.extrapolated_increment(j);
     double span = 0.0, half = 0.0;
-    if (auto st = central_difference(j, [](bool, double) {}, evaluate, span, e))
+    if (auto st = central_difference(
+            j, [](bool, double) {}, evaluate, span, e))
         return st;
     for (int k = 0; k < 4; ++k) {
         wide[k]->swap(*terms[k]);
         terms[k]->setZero();
     }
-    if (auto st = central_difference(j, [](bool, double) {}, evaluate, half, 0.5 * e))
+    if (auto st = central_difference(
+            j, [](bool, double) {}, evaluate, half, 0.5 * e))
         return st;
     for (int k = 0; k < 4; ++k)
         *terms[k] = (4.0 / (3.0 * half)) * *terms[k] - (1.0 / (3.0 * span)) * *wide[k];
@@ -521,53 +517,34 @@ ga_status Solver::constraint_parameter_terms(int j, double t, const State &x, bo
 // position correction -B^T eta_bar uses B = Phi_q(q_n) of the step's start. The matrix
 // d/dq (Phi_q^T eta) is symmetric (second derivatives of eta^T Phi), so this also applies its
 // transpose (adjoint.cpp).
-ga_status Solver::correction_derivative(double t, const Vec &q, const Vec &eta, const Vec &s,
-                                        Vec &out)
+ga_status ForwardSensitivity::correction_derivative(double t, const Vec &q, const Vec &eta,
+                                                    const Vec &s, Vec &out)
 {
     Sensitivities &z = sens;
     out.setZero();
     const double s_max = s.lpNorm<Eigen::Infinity>();
     if (s_max == 0.0)
         return GA_OK;
-    const double e = std::cbrt(kEps) * std::max(model.space.max_magnitude(q), 1.0) / s_max;
+    const double e = std::cbrt(kEps) * std::max(k_.model.space.max_magnitude(q), 1.0) / s_max;
     for (int side = 0; side < 2; ++side) {
-        model.space.shifted(q, side == 0 ? e : -e, s, z.q_pert);
-        if (auto st = model.jacobian(t, z.q_pert, z.J_pert))
+        k_.model.space.shifted(q, side == 0 ? e : -e, s, z.q_pert);
+        if (auto st = k_.model.jacobian(t, z.q_pert, z.J_pert))
             return st;
         z.J_pert.multiply_transpose_add(side == 0 ? -0.5 / e : 0.5 / e, eta, out);
     }
     return GA_OK;
 }
 
-// M, f, Phi_q and every tangent at the converged step x (the user's callbacks whatever the
-// tangent mode, or central differences), into M_, f_, J_, K_, C_, Z_; which tangents exist.
-ga_status Solver::exact_tangents(double t, const State &x, bool &K, bool &C, bool &Z)
-{
-    ga_status st = residual(t, x);
-    const Restore<ga_tangent_mode> keep_mode(model.tangent_mode);
-    model.tangent_mode = GA_TANGENT_AUTO;
-    K = !K_.zero() && K_.size() > 0;
-    C = !C_.zero() && C_.size() > 0 && (model.has_force() || model.cb.damping);
-    Z = formulation == GA_INDEX2_STABILIZED && m_ > 0;
-    if (!st && K)
-        st = model.stiffness(t, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_, true);
-    if (!st && C)
-        st = model.damping(t, x.q, x.v, f_, C_, true);
-    if (!st && Z)
-        st = model.velocity_constraint_tangent(t, x.q, x.v, J_, Z_, true);
-    return st;
-}
-
 // After a step converged (trial_ holds it), the derivatives of its state.
-ga_status Solver::sensitivity_step(double h)
+ga_status ForwardSensitivity::step(double h)
 {
     if (!sens.active() || !sens.forward || sens.step_done)
         return GA_OK;
-    const State &s = accepted_;
-    const State &x = trial_;
-    const Params &p = params;
+    const State &s = k_.accepted_;
+    const State &x = k_.trial_;
+    const Params &p = k_.params;
     const NewtonCoefficients c = newton_coefficients(p, h);
-    const bool index2 = formulation == GA_INDEX2_STABILIZED;
+    const bool index2 = k_.formulation == GA_INDEX2_STABILIZED;
     const double t1 = x.t;
 
     // The exact iteration matrix at the converged step: every tangent, whatever the option,
@@ -575,19 +552,19 @@ ga_status Solver::sensitivity_step(double h)
     // at full size; a kept matrix is of an older iterate). The next step's Newton iteration
     // starts with it.
     bool K = false, C = false, Z = false;
-    ga_status st = exact_tangents(t1, x, K, C, Z);
-    if (!st && r() > 0)  // the coupling blocks likewise, and the Schur complement on y
-        st = first_order_matrix(t1, x, true);
+    ga_status st = k_.exact_tangents(t1, x, K, C, Z);
+    if (!st && k_.r() > 0)  // the coupling blocks likewise, and the Schur complement on y
+        st = k_.first_order_matrix(t1, x, true);
     if (!st)
-        st = factorize(t1, x, h, K, C, Z, 0);
-    recipe_.central = !st;
-    if (!st && r() > 0)
-        st = first_order_schur(h, c);
+        st = k_.factorize(t1, x, h, K, C, Z, 0);
+    k_.recipe_.central = !st;
+    if (!st && k_.r() > 0)
+        st = k_.first_order_schur(h, c);
     if (st) {
-        diag.append(" (the exact iteration matrix for the sensitivities)");
+        k_.diag.append(" (the exact iteration matrix for the sensitivities)");
         return st;
     }
-    const double row_scale = step_row_scale(p, h, scaling);
+    const double row_scale = step_row_scale(p, h, k_.scaling);
     Sensitivities &z = sens;
     for (int j = 0; j < z.np; ++j) {
         const StateDerivative &sn = z.accepted[j];
@@ -598,18 +575,18 @@ ga_status Solver::sensitivity_step(double h)
         const Vec *sa = &sn.a;
         if (z.start_given) {
             sa = &z.start[j].a;
-        } else if (a_start_ != &s.a) {  // a_n rescaled to h
+        } else if (k_.a_start_ != &s.a) {  // a_n rescaled to h
             z.a0 = sn.qdd + (h / s.h_last) * (sn.a - sn.qdd);
             sa = &z.a0;
         }
         // first-order states: the w the step started from, and the predictor with y' = 0
-        const FirstOrderParams &p1 = params1;
+        const FirstOrderParams &p1 = k_.params1;
         const Vec *sw = &sn.w;
         const Vec &sydot = z.start_given ? z.start[j].ydot : sn.ydot;
-        if (r() > 0) {
+        if (k_.r() > 0) {
             if (z.start_given) {
                 sw = &z.start[j].w;
-            } else if (w_start_ != &s.w) {  // w_n rescaled to h (first_order_start)
+            } else if (k_.w_start_ != &s.w) {  // w_n rescaled to h (first_order_start)
                 z.w0 = sn.ydot + (h / s.h_last) * (sn.w - sn.ydot);
                 sw = &z.w0;
             }
@@ -624,13 +601,13 @@ ga_status Solver::sensitivity_step(double h)
         s1.q = sn.q + h * sv + (h * h) * ((0.5 - p.beta) * *sa + p.beta * s1.a);
         s1.v = sv + h * ((1.0 - p.gamma) * *sa + p.gamma * s1.a);
         // the constraints' parameter terms (zero unless they depend on p)
-        if ((st = constraint_parameter_terms(j, t1, x, index2, index2, b_t_, s.q,
-                                             eta_total_))) {
-            diag.append(" (derivative of the constraints in parameter %d)", j);
+        if ((st = constraint_parameter_terms(j, t1, x, index2, index2, k_.b_t_, s.q,
+                                             k_.eta_total_))) {
+            k_.diag.append(" (derivative of the constraints in parameter %d)", j);
             return st;
         }
-        if (index2 && m_ > 0) {
-            if ((st = correction_derivative(b_t_, s.q, eta_total_, sn.q, z.bt)))
+        if (index2 && k_.m_ > 0) {
+            if ((st = correction_derivative(k_.b_t_, s.q, k_.eta_total_, sn.q, z.bt)))
                 return st;
             s1.q += z.bt;
             s1.q += z.cbt;
@@ -638,43 +615,43 @@ ga_status Solver::sensitivity_step(double h)
         // the residual linearized at the converged step
         z.rq = z.cq;
         if ((st = parameter_residual(j, t1, x))) {
-            diag.append(" (derivative of the residual in parameter %d)", j);
+            k_.diag.append(" (derivative of the residual in parameter %d)", j);
             return st;
         }
         if (K)
-            K_.multiply_add(1.0, s1.q, z.rq);
+            k_.K_.multiply_add(1.0, s1.q, z.rq);
         if (C)
-            C_.multiply_add(1.0, s1.v, z.rq);
-        if (r() > 0) {  // r^q sees y through f; r^y = y' - g(t, q, v, y)
-            z.rq.noalias() -= blocks_.f_y * s1.y;
+            k_.C_.multiply_add(1.0, s1.v, z.rq);
+        if (k_.r() > 0) {  // r^q sees y through f; r^y = y' - g(t, q, v, y)
+            z.rq.noalias() -= k_.blocks_.f_y * s1.y;
             z.ry = s1.ydot;
-            z.ry.noalias() -= blocks_.g_q * s1.q;
-            z.ry.noalias() -= blocks_.g_v * s1.v;
-            z.ry.noalias() -= blocks_.g_y * s1.y;
+            z.ry.noalias() -= k_.blocks_.g_q * s1.q;
+            z.ry.noalias() -= k_.blocks_.g_v * s1.v;
+            z.ry.noalias() -= k_.blocks_.g_y * s1.y;
             if ((st = rate_parameter_residual(j, t1, x)))
                 return st;
         }
         z.rl = z.cl;
-        J_.multiply_add(1.0, s1.q, z.rl);
+        k_.J_.multiply_add(1.0, s1.q, z.rl);
         if (index2) {
             z.rv = z.cv;
             if (Z)
-                Z_.multiply_add(1.0, s1.q, z.rv);
-            J_.multiply_add(1.0, s1.v, z.rv);
-            S2_.solve(z.rq, z.rl, z.rv, p, h, B_, z.d, z.w, z.dl, z.e);
+                k_.Z_.multiply_add(1.0, s1.q, z.rv);
+            k_.J_.multiply_add(1.0, s1.v, z.rv);
+            k_.S2_.solve(z.rq, z.rl, z.rv, p, h, k_.B_, z.d, z.w, z.dl, z.e);
         } else {
-            S_.solve(z.rq, z.rl, z.d, z.dl, row_scale);
+            k_.S_.solve(z.rq, z.rl, z.d, z.dl, row_scale);
         }
-        if (r() > 0) {  // elimination onto y (first_order.cpp): dy, then x0 - Z dy
+        if (k_.r() > 0) {  // elimination onto y (first_order.cpp): dy, then x0 - Z dy
             z.gy = -z.ry;
-            z.gy.noalias() += blocks_.g_q * z.d;
-            z.gy.noalias() += c.gamma_prime * (blocks_.g_v * (index2 ? z.w : z.d));
-            z.dy = C1_lu_.solve(z.gy);
-            if (forces_see_y()) {
-                z.d.noalias() -= Zq_ * z.dy;
-                z.dl.noalias() -= Zl_ * z.dy;
+            z.gy.noalias() += k_.blocks_.g_q * z.d;
+            z.gy.noalias() += c.gamma_prime * (k_.blocks_.g_v * (index2 ? z.w : z.d));
+            z.dy = k_.C1_lu_.solve(z.gy);
+            if (k_.forces_see_y()) {
+                z.d.noalias() -= k_.Zq_ * z.dy;
+                z.dl.noalias() -= k_.Zl_ * z.dy;
                 if (index2)
-                    z.w.noalias() -= Zw_ * z.dy;
+                    z.w.noalias() -= k_.Zw_ * z.dy;
             }
             s1.y += z.dy;
             s1.ydot = first_order_newton_coefficient(p1, h) * z.dy;
@@ -686,14 +663,13 @@ ga_status Solver::sensitivity_step(double h)
         s1.v += c.gamma_prime * dw;
         s1.qdd += c.beta_prime * dw;
         s1.lambda = z.dl;
-        s1.a = (p.alpha_f * sqdd - p.alpha_m * *sa + (1.0 - p.alpha_f) * s1.qdd) /
-               (1.0 - p.alpha_m);
-        if (!all_finite(s1.q) || !all_finite(s1.v) || !all_finite(s1.qdd) ||
-            !all_finite(s1.lambda))
-            return diag.fail(GA_ERR_NONFINITE,
-                             "the sensitivity to parameter %d is not finite after the step "
-                             "from t = %.17g with h = %g",
-                             j, s.t, h);
+        s1.a =
+            (p.alpha_f * sqdd - p.alpha_m * *sa + (1.0 - p.alpha_f) * s1.qdd) / (1.0 - p.alpha_m);
+        if (!all_finite(s1.q) || !all_finite(s1.v) || !all_finite(s1.qdd) || !all_finite(s1.lambda))
+            return k_.diag.fail(GA_ERR_NONFINITE,
+                                "the sensitivity to parameter %d is not finite after the step "
+                                "from t = %.17g with h = %g",
+                                j, s.t, h);
     }
     return GA_OK;
 }

@@ -1,6 +1,7 @@
 // Forward sensitivities of the discrete solution (docs/algorithms.md sec. 13): what they are
 // taken with respect to, their values at the accepted step and the step being computed, and
-// the scratch of their step. The mathematics is in sensitivity.cpp (Solver members).
+// the scratch of their step; and the service that computes them (ForwardSensitivity,
+// sensitivity.cpp), attached to the step transaction at its doors.
 #pragma once
 
 #include <utility>
@@ -8,6 +9,8 @@
 
 #include "galpha.h"
 #include "matrix.hpp"
+#include "state.hpp"
+#include "step_plan.hpp"
 #include "types.hpp"
 
 namespace ga {
@@ -39,7 +42,7 @@ struct StateDerivative {
 
 struct Sensitivities {
     int np = 0;
-    double *p = nullptr;       // the user's parameters, perturbed in place by differences
+    double *p = nullptr;        // the user's parameters, perturbed in place by differences
     std::vector<double> scale;  // of those perturbations (p_scale)
     int depends = GA_DEPENDS_FORCE;
     bool forward = true;   // GA_SENSITIVITY_FORWARD: derivatives after each step
@@ -51,7 +54,7 @@ struct Sensitivities {
     // The step's start (v_n, a_n, qdd_n as the step uses them) when it is not the accepted
     // state's own: fresh starts and their corrected values, by differences.
     std::vector<StateDerivative> start;
-    StateDerivative wide;  // a difference at the wider increment (extrapolated differences)
+    StateDerivative wide;      // a difference at the wider increment (extrapolated differences)
     bool start_given = false;  // start holds this step's
     bool step_done = false;    // a Taylor step (sliver): trial holds its derivative already
 
@@ -74,6 +77,56 @@ struct Sensitivities {
     // differences, (4 D(e/2) - D(e)) / 3 with error O(eps^(4/5)).
     double increment(int j) const;
     double extrapolated_increment(int j) const;
+};
+
+class Solver;
+
+// The forward sensitivities as a service of the step (docs/algorithms.md sec. 13): their start
+// at ga_init, the starts by differences before Taylor steps and fresh starts, the linear step
+// once a step converged, their half of a commit and of its undoing; and the derivatives in p
+// of the residual and the constraints, which the adjoint sweep uses too. It works through the
+// solver's kernel (`k_`): the start functions, the exact iteration matrix and its solves.
+class ForwardSensitivity {
+  public:
+    explicit ForwardSensitivity(Solver &kernel) : k_(kernel) {}
+    ForwardSensitivity(const ForwardSensitivity &) = delete;
+    ForwardSensitivity &operator=(const ForwardSensitivity &) = delete;
+
+    Sensitivities sens;
+
+    // ga_set_sensitivity (the C API validated the arguments): allocates aside, so that
+    // std::bad_alloc leaves the set as it was.
+    void set(int np, double *p, const double *p_scale, int depends, int nq, int nv, int m, int r,
+             const ModelMatrix *M, const ModelMatrix *J);
+    void set_start(int j, const double *dq0, const double *dv0, int nv);
+
+    // The doors of the transaction (transaction.cpp).
+    ga_status start(const State &x);  // at ga_init, before the consistent accelerations
+    void started() { sens.accepted.swap(sens.trial); }
+    ga_status before_attempt(const StepPlan &plan, const State &accepted);
+    ga_status step(double h);  // after a step converged
+    void on_commit();          // after the states' swap
+    void on_undo();            // after undo_step's swaps
+
+    // d/dp_j of the residual and the constraints at a converged step x (into sens.rq, sens.ry,
+    // sens.cq, cl, cv, cbt), and -d/dq (Phi_q^T eta) s: the forward step's and the adjoint's.
+    ga_status parameter_residual(int j, double t, const State &x);
+    ga_status rate_parameter_residual(int j, double t, const State &x);
+    ga_status constraint_parameter_terms(int j, double t, const State &x, bool velocity,
+                                         bool correction, double t_n, const Vec &q_n,
+                                         const Vec &eta);
+    ga_status correction_derivative(double t, const Vec &q, const Vec &eta, const Vec &s, Vec &out);
+
+  private:
+    template <class Perturb, class Evaluate>
+    ga_status central_difference(int j, Perturb &&perturb, Evaluate &&evaluate, double &span,
+                                 double increment = 0.0);
+    ga_status project_seeds(const State &x, int j, StateDerivative &s);
+    void shift_state(const State &from, const StateDerivative &s, double shift, State &to) const;
+    ga_status by_differences(const State &accepted, double h, bool taylor_step, bool restart_short);
+
+    State scratch_;  // the accepted state moved along a derivative (by_differences)
+    Solver &k_;
 };
 
 }  // namespace ga

@@ -727,6 +727,23 @@ ga_status Solver::residual(double t, const State &x)
 
 // Rebuild and factorize the iteration matrix at the iterate x at time t (M_, J_, the tangents
 // and in index 2 B_ evaluated there by the caller), and remember where (checkpoints).
+ga_status Solver::exact_tangents(double t, const State &x, bool &K, bool &C, bool &Z)
+{
+    ga_status st = residual(t, x);
+    const Restore<ga_tangent_mode> keep_mode(model.tangent_mode);
+    model.tangent_mode = GA_TANGENT_AUTO;
+    K = !K_.zero() && K_.size() > 0;
+    C = !C_.zero() && C_.size() > 0 && (model.has_force() || model.cb.damping);
+    Z = formulation == GA_INDEX2_STABILIZED && m_ > 0;
+    if (!st && K)
+        st = model.stiffness(t, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_, true);
+    if (!st && C)
+        st = model.damping(t, x.q, x.v, f_, C_, true);
+    if (!st && Z)
+        st = model.velocity_constraint_tangent(t, x.q, x.v, J_, Z_, true);
+    return st;
+}
+
 ga_status Solver::factorize(double t, const State &x, double h, bool tangents_K,
                             bool tangents_C, bool tangent_Z, int iter)
 {

@@ -130,9 +130,9 @@ public:
     // does not yet; throws std::bad_alloc.
     void setup_output();
 
-    // Forward sensitivities (sensitivity.cpp): the C API validated the arguments; allocates
-    // (std::bad_alloc leaves the set before).
-    Sensitivities sens;
+    // Forward sensitivities (ForwardSensitivity, sensitivity.cpp): the C API validated the
+    // arguments; allocates (std::bad_alloc leaves the set before).
+    const Sensitivities &sens() const { return forward_.sens; }
     ga_status set_sensitivity(int np, double *p, const double *p_scale, int depends);
     ga_status set_sensitivity_start(int j, const double *dq0, const double *dv0);
     // adjoint.cpp
@@ -293,27 +293,11 @@ private:
     {
         return from.h_last > 0.0 && h > kShortStepRatio * from.h_last;
     }
-    // sensitivity.cpp
-    template <class Perturb, class Evaluate>
-    ga_status central_difference(int j, Perturb &&perturb, Evaluate &&evaluate, double &span,
-                                 double increment = 0.0);
-    ga_status sensitivity_start(const State &x);
-    ga_status project_seeds(const State &x, int j, StateDerivative &s);
-    void shift_state(const State &from, const StateDerivative &s, double shift, State &to) const;
-    ga_status sensitivity_by_differences(double h, bool taylor_step, bool restart_short);
-    ga_status sensitivity_before_attempt(const StepPlan &plan);
-    void sensitivity_on_commit();  // after the states' swap in commit
-    void sensitivity_on_undo();    // after undo_step's swaps
-    ga_status parameter_residual(int j, double t, const State &x);
-    ga_status rate_parameter_residual(int j, double t, const State &x);
-    ga_status constraint_parameter_terms(int j, double t, const State &x, bool velocity,
-                                         bool correction, double t_n, const Vec &q_n,
-                                         const Vec &eta);
-    ga_status correction_derivative(double t, const Vec &q, const Vec &eta, const Vec &s,
-                                    Vec &out);
-    ga_status sensitivity_step(double h);
+    // M, f, Phi_q and every tangent at the converged step x (the user's callbacks whatever the
+    // tangent mode, or central differences), into M_, f_, J_, K_, C_, Z_; which tangents exist.
     ga_status exact_tangents(double t, const State &x, bool &K, bool &C, bool &Z);
-    State sens_scratch_;  // the accepted state while a perturbed one takes its place
+    friend class ForwardSensitivity;
+    ForwardSensitivity forward_{*this};
     AdjointRecord adjoint_;
     void record_start();   // adjoint.cpp: x_0 and the start's derivatives, at ga_init
     ga_status record_on_converged(double h);  // adjoint.cpp: room, and how the step began

@@ -29,62 +29,84 @@ Model &Solver::callbacks() { return model; }
 // A start (ga_init): the sensitivities' initial derivatives, before the consistent
 // accelerations; and once it is the accepted state, the sensitivities take theirs, the record
 // its first entry, the event search starts afresh.
-ga_status Solver::on_start(const State &x) { return sens.active() ? sensitivity_start(x) : GA_OK; }
+ga_status Solver::on_start(const State &x)
+{
+    return forward_.sens.active() ? forward_.start(x) : GA_OK;
+}
 void Solver::on_started()
 {
-    sens.accepted.swap(sens.trial);
-    if (sens.adjoint)
+    forward_.started();
+    if (forward_.sens.adjoint)
         record_start();
     events_.restart();
 }
 // At setup, once the matrices' layouts are known: the sensitivities' matrices like them.
 void Solver::on_setup()
 {
-    if (sens.active())
-        sens.allocate_matrices(M_, J_);
+    if (forward_.sens.active())
+        forward_.sens.allocate_matrices(M_, J_);
 }
 // Before an attempt: the forward sensitivities start by differences before Taylor slivers
 // and fresh starts.
 ga_status Solver::before_attempt(const StepPlan &plan)
 {
-    return sens.active() ? sensitivity_before_attempt(plan) : GA_OK;
+    return forward_.sens.active() ? forward_.before_attempt(plan, accepted_) : GA_OK;
 }
 // The attempt converged (and passed the error test): the record's room and how the step began,
 // then the sensitivities' linear step; a failure of either fails the step.
 ga_status Solver::on_converged(double h)
 {
-    if (!sens.active())
+    if (!forward_.sens.active())
         return GA_OK;
-    if (sens.adjoint)
+    if (forward_.sens.adjoint)
         if (auto st = record_on_converged(h))
             return st;
-    return sensitivity_step(h);
+    return forward_.step(h);
 }
 // An attempt's error was rejected: the adjoint's replays from a checkpoint cannot know the
 // matrix the rejected attempt left, so the run drops it too.
 void Solver::on_rejection()
 {
-    if (sens.adjoint)
+    if (forward_.sens.adjoint)
         invalidate_jacobian();
 }
 // The commit (after the states' swap): the sensitivities swap theirs, the record logs the step.
 void Solver::on_commit()
 {
-    if (sens.active())
-        sensitivity_on_commit();
+    if (!forward_.sens.active())
+        return;
+    forward_.on_commit();
+    if (forward_.sens.adjoint)
+        record_step();
 }
 // undo_step (after its swaps): each puts back its own.
 void Solver::on_undo()
 {
-    if (sens.active())
-        sensitivity_on_undo();
+    if (!forward_.sens.active())
+        return;
+    forward_.on_undo();
+    if (forward_.sens.adjoint && --adjoint_.steps < adjoint_.unsupported_at)
+        adjoint_.unsupported_at = -1;  // that step is gone
+}
+
+// ---- the services' options ----
+ga_status Solver::set_sensitivity(int np, double *p, const double *p_scale, int depends)
+{
+    const bool ready = workspace_ready_;
+    forward_.set(np, p, p_scale, depends, nq_, nv_, m_, r(), ready ? &M_ : nullptr,
+                 ready ? &J_ : nullptr);
+    adjoint_ = AdjointRecord{};  // the method is forward again (ga_set_sensitivity_method)
+    return GA_OK;
+}
+
+ga_status Solver::set_sensitivity_start(int j, const double *dq0, const double *dv0)
+{
+    forward_.set_start(j, dq0, dv0, nv_);
+    return GA_OK;
 }
 
 // ---- the calls ----
-ga_status Solver::step(double h)
-{
-    return hooked(false, h, &Solver::one_step);
-}
+ga_status Solver::step(double h) { return hooked(false, h, &Solver::one_step); }
 
 ga_status Solver::step_adaptive(double t_stop)
 {
