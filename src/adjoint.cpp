@@ -38,8 +38,8 @@ void AdjointRecord::allocate(int nq_, int nv_, int m_, int r_, int np, long capa
     }
 }
 
-void AdjointRecord::allocate_checkpointed(int nq_, int nv_, int m_, int r_, int np,
-                                          long interval_, long count, std::size_t state_size)
+void AdjointRecord::allocate_checkpointed(int nq_, int nv_, int m_, int r_, int np, long interval_,
+                                          long count, std::size_t state_size)
 {
     const long full = max_steps;
     allocate(nq_, nv_, m_, r_, np, interval_);
@@ -51,44 +51,52 @@ void AdjointRecord::allocate_checkpointed(int nq_, int nv_, int m_, int r_, int 
     log.assign(static_cast<std::size_t>(capacity) * kLog, 0.0);
 }
 
-ga_status Solver::set_adjoint_checkpoints(long interval, long count)
+ga_status Adjoint::set_checkpoints(long interval, long count)
 {
     // (interval * count fits in a long: the C API checked it)
-    const std::size_t stride = AdjointRecord::stride_for(nq_, nv_, m_, r());
+    const std::size_t stride = AdjointRecord::stride_for(k_.nq_, k_.nv_, k_.m_, k_.r());
     if (interval > 0 && !fits_doubles(static_cast<std::size_t>(interval) + 1, stride))
-        return diag.fail(GA_ERR_NOMEM, "an adjoint segment of interval = %ld steps (%zu doubles "
-                         "each) is larger than memory can hold", interval, stride);
-    if (interval > 0 && !fits_doubles(static_cast<std::size_t>(count), state_size()))
-        return diag.fail(GA_ERR_NOMEM, "count = %ld adjoint checkpoints of %zu doubles each are "
-                         "more than memory can hold", count, state_size());
+        return k_.diag.fail(GA_ERR_NOMEM,
+                            "an adjoint segment of interval = %ld steps (%zu doubles "
+                            "each) is larger than memory can hold",
+                            interval, stride);
+    if (interval > 0 && !fits_doubles(static_cast<std::size_t>(count), k_.state_size()))
+        return k_.diag.fail(GA_ERR_NOMEM,
+                            "count = %ld adjoint checkpoints of %zu doubles each are "
+                            "more than memory can hold",
+                            count, k_.state_size());
     if (interval > 0 &&
         !fits_doubles(static_cast<std::size_t>(interval) * static_cast<std::size_t>(count),
                       AdjointRecord::kLog))
-        return diag.fail(GA_ERR_NOMEM, "the step log of interval * count = %ld adjoint steps "
-                         "(%zu doubles each) is larger than memory can hold", interval * count,
-                         AdjointRecord::kLog);
+        return k_.diag.fail(GA_ERR_NOMEM,
+                            "the step log of interval * count = %ld adjoint steps "
+                            "(%zu doubles each) is larger than memory can hold",
+                            interval * count, AdjointRecord::kLog);
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
-    record.max_steps = adjoint_.max_steps;
+    record.max_steps = record_.max_steps;
     if (interval > 0)
-        record.allocate_checkpointed(nq_, nv_, m_, r(), forward_.sens.np, interval, count, state_size());
+        record.allocate_checkpointed(k_.nq_, k_.nv_, k_.m_, k_.r(), forward_.sens.np, interval,
+                                     count, k_.state_size());
     else
-        record.allocate(nq_, nv_, m_, r(), forward_.sens.np, adjoint_.max_steps);
-    adjoint_ = std::move(record);
+        record.allocate(k_.nq_, k_.nv_, k_.m_, k_.r(), forward_.sens.np, record_.max_steps);
+    record_ = std::move(record);
     return GA_OK;
 }
 
-ga_status Solver::set_sensitivity_method(int methods, long max_steps)
+ga_status Adjoint::set_method(int methods, long max_steps)
 {
-    const std::size_t stride = AdjointRecord::stride_for(nq_, nv_, m_, r());
+    const std::size_t stride = AdjointRecord::stride_for(k_.nq_, k_.nv_, k_.m_, k_.r());
     if ((methods & GA_SENSITIVITY_ADJOINT) &&
         !fits_doubles(static_cast<std::size_t>(max_steps) + 1, stride))
-        return diag.fail(GA_ERR_NOMEM, "an adjoint record of max_steps = %ld steps (%zu doubles "
-                         "each) is larger than memory can hold; ga_set_adjoint_checkpoints "
-                         "keeps one segment", max_steps, stride);
+        return k_.diag.fail(GA_ERR_NOMEM,
+                            "an adjoint record of max_steps = %ld steps (%zu doubles "
+                            "each) is larger than memory can hold; ga_set_adjoint_checkpoints "
+                            "keeps one segment",
+                            max_steps, stride);
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
     if (methods & GA_SENSITIVITY_ADJOINT)
-        record.allocate(nq_, nv_, m_, r(), forward_.sens.np, max_steps);
-    adjoint_ = std::move(record);
+        record.allocate(k_.nq_, k_.nv_, k_.m_, k_.r(), forward_.sens.np, max_steps);
+    record_ = std::move(record);
     forward_.sens.forward = (methods & GA_SENSITIVITY_FORWARD) != 0;
     forward_.sens.adjoint = (methods & GA_SENSITIVITY_ADJOINT) != 0;
     return GA_OK;
@@ -102,48 +110,51 @@ void put(const Vec &x, double *&out)
 }
 }  // namespace
 
-// A step converged (before its commit): room for it, and how it began (record_step logs it).
-ga_status Solver::record_on_converged(double h)
+// A step converged (before its commit): room for it, and how it began (on_commit logs it).
+ga_status Adjoint::on_converged(double h)
 {
-    const State &s = accepted_;
-    AdjointRecord &r = adjoint_;
+    const State &s = k_.accepted_;
+    AdjointRecord &r = record_;
     if (r.steps >= r.capacity && r.interval > 0)
-        return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (%ld steps: interval "
-                         "= %ld times %ld checkpoints, ga_set_adjoint_checkpoints)",
-                         r.capacity, r.interval, r.capacity / r.interval);
+        return k_.diag.fail(GA_ERR_NOMEM,
+                            "the adjoint record is full (%ld steps: interval "
+                            "= %ld times %ld checkpoints, ga_set_adjoint_checkpoints)",
+                            r.capacity, r.interval, r.capacity / r.interval);
     if (r.steps >= r.capacity)
-        return diag.fail(GA_ERR_NOMEM, "the adjoint record is full (max_steps = %ld: "
-                         "ga_set_sensitivity_method)", r.capacity);
+        return k_.diag.fail(GA_ERR_NOMEM,
+                            "the adjoint record is full (max_steps = %ld: "
+                            "ga_set_sensitivity_method)",
+                            r.capacity);
     r.pending_rho = 1.0;
-    if (forward_.sens.step_done || (forward_.sens.start_given && !start_pending_)) {
+    if (forward_.sens.step_done || (forward_.sens.start_given && !k_.start_pending_)) {
         r.pending_kind = AdjointRecord::Unsupported;
     } else if (forward_.sens.start_given) {
         r.pending_kind = AdjointRecord::First;
     } else {
         r.pending_kind = AdjointRecord::Regular;
-        if (a_start_ != &s.a)
+        if (k_.a_start_ != &s.a)
             r.pending_rho = h / s.h_last;
     }
     return GA_OK;
 }
 
-void Solver::record_start()
+void Adjoint::started()
 {
-    AdjointRecord &r = adjoint_;
-    const State &x = accepted_;
+    AdjointRecord &r = record_;
+    const State &x = k_.accepted_;
     r.steps = 0;
     r.base = 0;
     r.unsupported_at = -1;
     if (r.interval > 0)
-        get_state(r.checkpoint(0));
+        k_.get_state(r.checkpoint(0));
     double *e = r.entry(0);
     e[0] = x.t;
     e[1] = e[2] = e[3] = 0.0;
     e += 4;
     for (const Vec *v : {&x.q, &x.v, &x.qdd, &x.lambda})
         put(*v, e);
-    Eigen::Map<Vec>(e, m_).setZero();
-    e += m_;
+    Eigen::Map<Vec>(e, k_.m_).setZero();
+    e += k_.m_;
     put(x.y, e);
     put(x.ydot, e);
     for (int j = 0; j < forward_.sens.np; ++j) {
@@ -160,10 +171,10 @@ void Solver::record_start()
     }
 }
 
-void Solver::record_step()
+void Adjoint::on_commit()
 {
-    AdjointRecord &r = adjoint_;
-    const State &x = accepted_;
+    AdjointRecord &r = record_;
+    const State &x = k_.accepted_;
     const long k = ++r.steps;
     if (r.interval > 0 && k - r.base > r.interval) {  // a new segment starts at step k - 1
         std::copy_n(r.entry(k - 1), r.stride(), r.data.data());
@@ -177,7 +188,7 @@ void Solver::record_step()
     if (r.interval > 0) {
         double *l = r.log_entry(k);
         std::copy_n(e, 4, l);
-        const StepReport &report = step_report_;  // of the attempt accepted
+        const StepReport &report = k_.step_report_;  // of the attempt accepted
         l[4] = report.plan.tol;
         l[5] = (report.plan.sliver_allowed ? 1.0 : 0.0) + (report.adaptive ? 2.0 : 0.0);
         std::copy_n(report.reuse_before, kReuseStateSize, l + 6);
@@ -185,11 +196,11 @@ void Solver::record_step()
     e += 4;
     for (const Vec *v : {&x.q, &x.v, &x.qdd, &x.lambda})
         put(*v, e);
-    if (formulation == GA_INDEX2_STABILIZED)
-        Eigen::Map<Vec>(e, m_) = eta_total_;
+    if (k_.formulation == GA_INDEX2_STABILIZED)
+        Eigen::Map<Vec>(e, k_.m_) = k_.eta_total_;
     else
-        Eigen::Map<Vec>(e, m_).setZero();
-    e += m_;
+        Eigen::Map<Vec>(e, k_.m_).setZero();
+    e += k_.m_;
     put(x.y, e);
     put(x.ydot, e);
     if (r.pending_kind == AdjointRecord::First)
@@ -203,20 +214,20 @@ void Solver::record_step()
     if (r.pending_kind == AdjointRecord::Unsupported && r.unsupported_at < 0)
         r.unsupported_at = r.steps;
     if (r.interval > 0 && k % r.interval == 0 && k < r.capacity)
-        get_state(r.checkpoint(k / r.interval));
+        k_.get_state(r.checkpoint(k / r.interval));
 }
 
 // The sweep's state and scratch: the adjoint variables of the state derivative (q, v, qdd,
 // lambda, a) of the step being taken back, and the transposed system.
-struct Solver::AdjointWork {
-    Vec mq, mv, mqdd, ml, ma;      // adjoint of sigma_{k+1}, then of sigma_k
-    Vec cq, cv, cqdd, cl, cp;      // a cost term's gradient
-    Vec yq, yl, ye, zq, zl, ze;    // right-hand side and solution of S^T z = y
-    Vec rr, rl, rv, qp, vp, tmp;   // adjoints of the linearized residual and the predictor
+struct Adjoint::Work {
+    Vec mq, mv, mqdd, ml, ma;     // adjoint of sigma_{k+1}, then of sigma_k
+    Vec cq, cv, cqdd, cl, cp;     // a cost term's gradient
+    Vec yq, yl, ye, zq, zl, ze;   // right-hand side and solution of S^T z = y
+    Vec rr, rl, rv, qp, vp, tmp;  // adjoints of the linearized residual and the predictor
     Vec eta;
-    Vec my, mydot, mw, ry, yp;      // first-order states (r): adjoints of y, y', w; r^y, y_p
+    Vec my, mydot, mw, ry, yp;  // first-order states (r): adjoints of y, y', w; r^y, y_p
     std::vector<double> dJ;
-    State x;                        // a recorded state
+    State x;  // a recorded state
     // S, sparse on the sparse path (its pattern ordered once per sweep: the entries come from
     // the user's fixed patterns), else dense
 #ifdef GALPHA_HAVE_KLU
@@ -290,12 +301,12 @@ void add_block(std::vector<Eigen::Triplet<double>> &t, const Sparse &A, double s
 
 // Step k -> k + 1 backwards: w.mq ... w.ma hold the adjoint of sigma_{k+1}; on return they
 // hold that of sigma_k (k > 0), or the parameters have received the start's share (k = 0).
-ga_status Solver::adjoint_step(long k, AdjointWork &w)
+ga_status Adjoint::step_back(long k, Work &w)
 {
-    const AdjointRecord &r = adjoint_;
-    const Params &p = params;
-    const bool index2 = formulation == GA_INDEX2_STABILIZED;
-    const int nq = nq_, n = nv_, m = m_;  // (n: the linear algebra's, nv)
+    const AdjointRecord &r = record_;
+    const Params &p = k_.params;
+    const bool index2 = k_.formulation == GA_INDEX2_STABILIZED;
+    const int nq = k_.nq_, n = k_.nv_, m = k_.m_;  // (n: the linear algebra's, nv)
     const double *e0 = r.entry(k), *e1 = r.entry(k + 1);
     const double h = e1[1], rho = e1[2];
     const auto kind = static_cast<AdjointRecord::Kind>(e1[3]);
@@ -313,19 +324,19 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     }
     x.lambda = Eigen::Map<const Vec>(src, m);
     w.eta = Eigen::Map<const Vec>(src + m, m);
-    const int R = this->r();
+    const int R = k_.r();
     x.y = Eigen::Map<const Vec>(src + 2 * m, R);
     x.ydot = Eigen::Map<const Vec>(src + 2 * m + R, R);
     bool K = false, C = false, Z = false;
-    ga_status st = exact_tangents(t1, x, K, C, Z);
+    ga_status st = k_.exact_tangents(t1, x, K, C, Z);
     if (!st && R > 0) {  // the coupling blocks at the recorded state (f_ and g there)
-        st = model.rate(t1, x.q, x.v, x.y, rate_);
+        st = k_.model.rate(t1, x.q, x.v, x.y, k_.rate_);
         if (!st)
-            st = first_order_matrix(t1, x, true);
+            st = k_.first_order_matrix(t1, x, true);
     }
     const Vec q_n = Eigen::Map<const Vec>(e0 + 4, nq);
     if (!st && index2 && m > 0)
-        st = model.jacobian(e0[0], q_n, B_);
+        st = k_.model.jacobian(e0[0], q_n, k_.B_);
     if (st)
         return st;
 
@@ -335,16 +346,16 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     // First-order states: dy as unknown beside them (rows of r^y = y' - g, scale 1), the
     // f_y column in the rows of r^q; y-rows -g_q dq - gamma' g_v dw + (c1 I - g_y) dy with
     // dq = w - B^T e, dw = w in index 2 (first_order.cpp eliminates it; here it is assembled).
-    const FirstOrderParams &p1 = params1;
+    const FirstOrderParams &p1 = k_.params1;
     const double c1 = R > 0 ? first_order_newton_coefficient(p1, h) : 0.0;
     Mat Fy, Gw, Ge, Gy;
     if (R > 0) {
-        const CouplingBlocks &b = blocks_;
+        const CouplingBlocks &b = k_.blocks_;
         Fy = -bh2 * b.f_y;
         Gw = -(b.g_q + c.gamma_prime * b.g_v);
         Gy = c1 * Mat::Identity(R, R) - b.g_y;
         if (index2 && m > 0) {
-            dense_of(B_, w.Bd);
+            dense_of(k_.B_, w.Bd);
             Ge = b.g_q * w.Bd.transpose();
         }
     }
@@ -353,24 +364,24 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
             for (int i = 0; i < X.rows(); ++i)
                 w.entries.emplace_back(row0 + i, col0 + j, X(i, j));
     };
-    count(counters, GA_COUNT_FACTORIZATIONS);
+    count(k_.counters, GA_COUNT_FACTORIZATIONS);
     bool singular = false;
-    if (sparse_backend_) {
-        const Sparse Ms = to_sparse(M_), Js = to_sparse(J_);
+    if (k_.sparse_backend_) {
+        const Sparse Ms = to_sparse(k_.M_), Js = to_sparse(k_.J_);
         Sparse A = (bh2 * c.beta_prime) * Ms;
         if (K)
-            A += bh2 * to_sparse(K_);
+            A += bh2 * to_sparse(k_.K_);
         if (C)
-            A += (bh2 * c.gamma_prime) * to_sparse(C_);
+            A += (bh2 * c.gamma_prime) * to_sparse(k_.C_);
         w.entries.clear();
         add_block(w.entries, A, 1.0, 0, 0);
         add_block(w.entries, Js, 1.0, 0, n, true);
         add_block(w.entries, Js, 1.0, n, 0);
         if (index2 && m > 0) {
-            const Sparse Zs = to_sparse(Z_);
-            const Sparse BT = to_sparse(B_).transpose();
+            const Sparse Zs = to_sparse(k_.Z_);
+            const Sparse BT = to_sparse(k_.B_).transpose();
             if (K)
-                add_block(w.entries, Sparse(to_sparse(K_) * BT), -bh2, 0, n + m);
+                add_block(w.entries, Sparse(to_sparse(k_.K_) * BT), -bh2, 0, n + m);
             add_block(w.entries, Sparse(Js * BT), -1.0, n, n + m);
             add_block(w.entries, Zs, s3, n + m, 0);
             add_block(w.entries, Js, 1.0, n + m, 0);
@@ -396,7 +407,7 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
                 w.slots[k] = w.klu->slot(w.entries[k].row(), w.entries[k].col());
         }
         if (w.slots.size() != w.entries.size())
-            return diag.fail(GA_ERR_INTERNAL, "the adjoint's sparse pattern changed");
+            return k_.diag.fail(GA_ERR_INTERNAL, "the adjoint's sparse pattern changed");
         std::vector<double> &values = w.klu->values();
         std::fill(values.begin(), values.end(), 0.0);
         for (std::size_t k = 0; k < w.entries.size(); ++k)
@@ -408,22 +419,22 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     } else {
         Mat &D = w.D;
         D.setZero(N + R, N + R);
-        dense_of(M_, w.Md);
-        dense_of(J_, w.Jd);
+        dense_of(k_.M_, w.Md);
+        dense_of(k_.J_, w.Jd);
         D.topLeftCorner(n, n) = (bh2 * c.beta_prime) * w.Md;
         if (K) {
-            dense_of(K_, w.Kd);
+            dense_of(k_.K_, w.Kd);
             D.topLeftCorner(n, n) += bh2 * w.Kd;
         }
         if (C) {
-            dense_of(C_, w.Cd);
+            dense_of(k_.C_, w.Cd);
             D.topLeftCorner(n, n) += (bh2 * c.gamma_prime) * w.Cd;
         }
         D.block(0, n, n, m) = w.Jd.transpose();
         D.block(n, 0, m, n) = w.Jd;
         if (index2 && m > 0) {
-            dense_of(B_, w.Bd);
-            dense_of(Z_, w.Zd);
+            dense_of(k_.B_, w.Bd);
+            dense_of(k_.Z_, w.Zd);
             if (K)
                 D.block(0, n + m, n, m) = -bh2 * (w.Kd * w.Bd.transpose());
             D.block(n, n + m, m, m) = -(w.Jd * w.Bd.transpose());
@@ -441,10 +452,10 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
         singular = !(w.dense_lu.rcond() > std::numeric_limits<double>::epsilon());
     }
     if (singular)
-        return diag.fail(GA_ERR_SINGULAR,
-                         "iteration matrix of the step from t = %.17g (h = %g) is singular in "
-                         "the adjoint sweep",
-                         e0[0], h);
+        return k_.diag.fail(GA_ERR_SINGULAR,
+                            "iteration matrix of the step from t = %.17g (h = %g) is singular in "
+                            "the adjoint sweep",
+                            e0[0], h);
 
     // U^T: s_q' = q_p + d, s_v' = v_p + gamma' w, s_qdd' = beta' w, s_lambda' = dlambda,
     // s_a' = (alpha_f sqdd - alpha_m sa + (1 - alpha_f) s_qdd') / (1 - alpha_m)
@@ -460,7 +471,7 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
         y.head(n) = w.tmp + w.mq;  // d = w - B^T e
         y.segment(n, m) = w.ml / bh2;
         w.ye.setZero();
-        B_.multiply_add(-1.0, w.mq, w.ye);
+        k_.B_.multiply_add(-1.0, w.mq, w.ye);
         y.segment(n + m, m) = w.ye;
     } else {
         y.head(n) = w.tmp + w.mq;
@@ -469,7 +480,7 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     // S^{-T}; the right-hand side was -(rows' scales) (r, r_lambda, r_v)
     Eigen::VectorXd z;
 #ifdef GALPHA_HAVE_KLU
-    if (sparse_backend_) {
+    if (k_.sparse_backend_) {
         z = y;
         w.klu->solve_transpose(z.data());
     } else
@@ -487,16 +498,16 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     w.qp = w.mq;
     w.vp = w.mv;
     if (K)
-        K_.multiply_transpose_add(1.0, w.rr, w.qp);
+        k_.K_.multiply_transpose_add(1.0, w.rr, w.qp);
     if (C)
-        C_.multiply_transpose_add(1.0, w.rr, w.vp);
-    J_.multiply_transpose_add(1.0, w.rl, w.qp);
+        k_.C_.multiply_transpose_add(1.0, w.rr, w.vp);
+    k_.J_.multiply_transpose_add(1.0, w.rl, w.qp);
     if (index2 && m > 0) {
-        Z_.multiply_transpose_add(1.0, w.rv, w.qp);
-        J_.multiply_transpose_add(1.0, w.rv, w.vp);
+        k_.Z_.multiply_transpose_add(1.0, w.rv, w.qp);
+        k_.J_.multiply_transpose_add(1.0, w.rv, w.vp);
     }
     if (R > 0) {  // r^q sees y_p through -f_y; r^y = y'_p - g_q q_p - g_v v_p - g_y y_p
-        const CouplingBlocks &b = blocks_;
+        const CouplingBlocks &b = k_.blocks_;
         w.qp.noalias() -= b.g_q.transpose() * w.ry;
         w.vp.noalias() -= b.g_v.transpose() * w.ry;
         w.yp = w.my;
@@ -545,11 +556,11 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
     }
     if (kind == AdjointRecord::First) {  // the start, differenced in p (sensitivity.cpp)
         for (int j = 0; j < w.np; ++j) {
-            w.dJ[j] += msq.dot(r.sigma0[j].q) + msv.dot(r.start0[j].v) +
-                       msa.dot(r.start0[j].a) + msqdd.dot(r.start0[j].qdd);
+            w.dJ[j] += msq.dot(r.sigma0[j].q) + msv.dot(r.start0[j].v) + msa.dot(r.start0[j].a) +
+                       msqdd.dot(r.start0[j].qdd);
             if (R > 0)
-                w.dJ[j] += msy.dot(r.sigma0[j].y) + msydot.dot(r.start0[j].ydot) +
-                           msw.dot(r.start0[j].w);
+                w.dJ[j] +=
+                    msy.dot(r.sigma0[j].y) + msydot.dot(r.start0[j].ydot) + msw.dot(r.start0[j].w);
         }
         return GA_OK;
     }
@@ -571,140 +582,140 @@ ga_status Solver::adjoint_step(long k, AdjointWork &w)
 // the checkpoint after step s K into the record's entries, as commit would have written them.
 // The steps are attempted as they were (h, Newton tolerance, Taylor steps allowed) and, with
 // forward sensitivities, followed by theirs, whose matrix the next step's Newton uses.
-ga_status Solver::replay_segment(long s)
+ga_status Adjoint::replay_segment(long s)
 {
-    AdjointRecord &r = adjoint_;
+    AdjointRecord &r = record_;
     const long first = s * r.interval, last = std::min(first + r.interval, r.steps);
-    if (auto st = set_state(r.checkpoint(s), r.checkpoint_size, true))
+    if (auto st = k_.set_state(r.checkpoint(s), r.checkpoint_size, true))
         return st;
     r.base = first;
     double *e = r.entry(first);
-    e[0] = accepted_.t;
+    e[0] = k_.accepted_.t;
     e += 4;
-    for (const Vec *v : {&accepted_.q, &accepted_.v, &accepted_.qdd, &accepted_.lambda})
+    for (const Vec *v : {&k_.accepted_.q, &k_.accepted_.v, &k_.accepted_.qdd, &k_.accepted_.lambda})
         put(*v, e);
-    e += m_;
-    put(accepted_.y, e);
-    put(accepted_.ydot, e);
+    e += k_.m_;
+    put(k_.accepted_.y, e);
+    put(k_.accepted_.ydot, e);
     for (long k = first + 1; k <= last; ++k) {
         const double *l = r.log_entry(k);
         const double h = l[1];
         if (l[6] == 0.0)  // the matrix the attempt began with, and its reuse state
-            invalidate_jacobian();
-        theta_prev_ = l[7];
-        refresh_steps_left_ = static_cast<int>(l[8]);
-        reuse_backoff_ = static_cast<int>(l[9]);
-        fd_tangents_ = l[10] != 0.0;
-        const Restore<bool> keep_mode(adaptive_attempt_);
-        adaptive_attempt_ = l[5] >= 2.0;  // (a fresh start: its first-order states' start)
+            k_.invalidate_jacobian();
+        k_.theta_prev_ = l[7];
+        k_.refresh_steps_left_ = static_cast<int>(l[8]);
+        k_.reuse_backoff_ = static_cast<int>(l[9]);
+        k_.fd_tangents_ = l[10] != 0.0;
+        const Restore<bool> keep_mode(k_.adaptive_attempt_);
+        k_.adaptive_attempt_ = l[5] >= 2.0;  // (a fresh start: its first-order states' start)
         // the kernel and the forward sensitivities' linear step, not the doors: a replay
         // records nothing (its entries are written below)
-        ga_status st = attempt_step(h, l[4], std::fmod(l[5], 2.0) != 0.0);
+        ga_status st = k_.attempt_step(h, l[4], std::fmod(l[5], 2.0) != 0.0);
         if (!st)
             st = forward_.step(h);
         if (st) {
-            diag.append(" (recomputing step %ld from its checkpoint for the adjoint sweep)", k);
+            k_.diag.append(" (recomputing step %ld from its checkpoint for the adjoint sweep)", k);
             return st;
         }
         if (forward_.sens.forward)
             forward_.sens.accepted.swap(forward_.sens.trial);
-        accepted_.swap(trial_);
-        accepted_.t = l[0];
-        start_pending_ = false;
+        k_.accepted_.swap(k_.trial_);
+        k_.accepted_.t = l[0];
+        k_.start_pending_ = false;
         double *x = r.entry(k);
         std::copy_n(l, 4, x);
         x += 4;
-        for (const Vec *v : {&accepted_.q, &accepted_.v, &accepted_.qdd, &accepted_.lambda})
+        for (const Vec *v :
+             {&k_.accepted_.q, &k_.accepted_.v, &k_.accepted_.qdd, &k_.accepted_.lambda})
             put(*v, x);
-        if (formulation == GA_INDEX2_STABILIZED)
-            Eigen::Map<Vec>(x, m_) = eta_total_;
+        if (k_.formulation == GA_INDEX2_STABILIZED)
+            Eigen::Map<Vec>(x, k_.m_) = k_.eta_total_;
         else
-            Eigen::Map<Vec>(x, m_).setZero();
-        x += m_;
-        put(accepted_.y, x);
-        put(accepted_.ydot, x);
+            Eigen::Map<Vec>(x, k_.m_).setZero();
+        x += k_.m_;
+        put(k_.accepted_.y, x);
+        put(k_.accepted_.ydot, x);
     }
     return GA_OK;
 }
 
-ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, double *J,
-                                   double *dJ)
+ga_status Adjoint::gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ)
 {
-    if (adjoint_.interval == 0) {
-        const ga_status st = adjoint_sweep(running, terminal, J, dJ);
-        model.y_now = &accepted_.y;  // (the sweep pointed the forces at recorded states)
+    if (record_.interval == 0) {
+        const ga_status st = sweep(running, terminal, J, dJ);
+        k_.model.y_now = &k_.accepted_.y;  // (the sweep pointed the forces at recorded states)
         return st;
     }
     // The sweep recomputes segments in place: the run is restored afterwards as it was --
     // its state and kept matrix from a checkpoint of it, the rest as saved here.
-    AdjointRecord &r = adjoint_;
-    std::vector<double> here(state_size());
-    get_state(here.data());
-    const State previous = previous_;
-    const bool previous_valid = previous_valid_, start_pending = start_pending_;
-    const EventSet events = events_;
-    const long state_id = state_id_, base = r.base;
+    AdjointRecord &r = record_;
+    std::vector<double> here(k_.state_size());
+    k_.get_state(here.data());
+    const State previous = k_.previous_;
+    const bool previous_valid = k_.previous_valid_, start_pending = k_.start_pending_;
+    const EventSet events = k_.events_;
+    const long state_id = k_.state_id_, base = r.base;
     const std::vector<double> segment = r.data;
     // The segments are computed in matrices of their own, the run's kept one set aside: it
     // comes back as it was, without callbacks (one failing while it was rebuilt made the run
     // go on with a fresh matrix, at Newton's tolerance from the run without the call).
     KeptMatrix kept;
-    set_aside_matrix(kept);
+    k_.set_aside_matrix(kept);
     const auto restore = [&] {
-        take_back_matrix(kept);
-        const ga_status back = set_state(here.data(), here.size(), true, true);
-        previous_ = previous;
-        previous_valid_ = previous_valid;
-        start_pending_ = start_pending;
-        events_ = events;
-        model.y_now = &accepted_.y;
-        state_id_ = state_id;
-        output_for_ = -1;  // (its buffers may hold a recomputed step's output now)
+        k_.take_back_matrix(kept);
+        const ga_status back = k_.set_state(here.data(), here.size(), true, true);
+        k_.previous_ = previous;
+        k_.previous_valid_ = previous_valid;
+        k_.start_pending_ = start_pending;
+        k_.events_ = events;
+        k_.model.y_now = &k_.accepted_.y;
+        k_.state_id_ = state_id;
+        k_.output_for_ = -1;  // (its buffers may hold a recomputed step's output now)
         r.data = segment;
         r.base = base;
         return back;
     };
     ga_status st = GA_OK;
     try {
-        st = adjoint_sweep(running, terminal, J, dJ);
+        st = sweep(running, terminal, J, dJ);
     } catch (...) {  // out of memory in a recomputed segment: the run is restored all the same
         restore();
         throw;
     }
     char message[Diagnostics::kSize];
-    diag.copy_to(message);
+    k_.diag.copy_to(message);
     const ga_status back = restore();
     if (st) {
-        diag.restore(message);
+        k_.diag.restore(message);
         return st;
     }
     if (back)  // (its own checkpoint, no callback: not expected)
-        diag.append(" (restoring the run after the adjoint sweep)");
+        k_.diag.append(" (restoring the run after the adjoint sweep)");
     return back;
 }
 
-ga_status Solver::adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ)
+ga_status Adjoint::sweep(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ)
 {
-    AdjointRecord &r = adjoint_;
+    AdjointRecord &r = record_;
     if (r.unsupported_at >= 0)
-        return diag.fail(GA_ERR_STATE,
-                         "the recorded run has a step the adjoint sweep does not cover (step "
-                         "%ld: a Taylor step, or a fresh start after short steps)",
-                         r.unsupported_at);
-    if (redundancy == GA_REDUNDANT_DROP && m_ > 0)
-        return diag.fail(GA_ERR_STATE, "the adjoint sweep with dropped redundant constraints is "
-                         "not built");
-    AdjointWork w;
-    w.allocate(nq_, nv_, m_, this->r(), forward_.sens.np);
+        return k_.diag.fail(GA_ERR_STATE,
+                            "the recorded run has a step the adjoint sweep does not cover (step "
+                            "%ld: a Taylor step, or a fresh start after short steps)",
+                            r.unsupported_at);
+    if (k_.redundancy == GA_REDUNDANT_DROP && k_.m_ > 0)
+        return k_.diag.fail(GA_ERR_STATE, "the adjoint sweep with dropped redundant constraints is "
+                                          "not built");
+    Work w;
+    w.allocate(k_.nq_, k_.nv_, k_.m_, k_.r(), forward_.sens.np);
     const long N = r.steps;
     // Cost terms at a recorded state k: its value into `value`, weight times its gradient
     // into the adjoint variables (and into dJ/dp).
     const auto cost = [&](ga_cost_fn fn, long k, double weight, double &total) {
         const double *e = r.entry(k);
-        const double *q = e + 4, *v = q + nq_, *qdd = v + nv_, *lambda = qdd + nv_;
+        const double *q = e + 4, *v = q + k_.nq_, *qdd = v + k_.nv_, *lambda = qdd + k_.nv_;
         double value = 0.0;
-        if (auto st = model.cost(fn, e[0], q, v, qdd, lambda, value, w.cq, w.cv, w.cqdd, w.cl,
-                                 w.cp))
+        if (auto st =
+                k_.model.cost(fn, e[0], q, v, qdd, lambda, value, w.cq, w.cv, w.cqdd, w.cl, w.cp))
             return st;
         total += weight * value;
         w.mq += weight * w.cq;
@@ -743,8 +754,8 @@ ga_status Solver::adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double 
             }
             break;
         }
-        if (auto st = adjoint_step(k - 1, w)) {
-            diag.append(" (adjoint sweep, step %ld of %ld)", k, N);
+        if (auto st = step_back(k - 1, w)) {
+            k_.diag.append(" (adjoint sweep, step %ld of %ld)", k, N);
             return st;
         }
         if (k - 1 == 0) {  // the first step took the start's share (sigma_0 included)
@@ -765,10 +776,10 @@ ga_status Solver::adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double 
         if (!std::isfinite(w.dJ[j]))
             bad = j;
     if (!std::isfinite(total) || bad >= 0)
-        return diag.fail(GA_ERR_NONFINITE,
-                         "the adjoint sweep overflowed: J = %g, dJ/dp_%d = %g (the recorded "
-                         "run's values or step sizes near the range of double)",
-                         total, bad < 0 ? 0 : bad, w.dJ[bad < 0 ? 0 : bad]);
+        return k_.diag.fail(GA_ERR_NONFINITE,
+                            "the adjoint sweep overflowed: J = %g, dJ/dp_%d = %g (the recorded "
+                            "run's values or step sizes near the range of double)",
+                            total, bad < 0 ? 0 : bad, w.dJ[bad < 0 ? 0 : bad]);
     *J = total;
     for (int j = 0; j < w.np; ++j)
         dJ[j] = w.dJ[j];

@@ -87,7 +87,7 @@ class Solver;
 // of the residual and the constraints, which the adjoint sweep uses too. It works through the
 // solver's kernel (`k_`): the start functions, the exact iteration matrix and its solves.
 class ForwardSensitivity {
-  public:
+public:
     explicit ForwardSensitivity(Solver &kernel) : k_(kernel) {}
     ForwardSensitivity(const ForwardSensitivity &) = delete;
     ForwardSensitivity &operator=(const ForwardSensitivity &) = delete;
@@ -117,7 +117,7 @@ class ForwardSensitivity {
                                          const Vec &eta);
     ga_status correction_derivative(double t, const Vec &q, const Vec &eta, const Vec &s, Vec &out);
 
-  private:
+private:
     template <class Perturb, class Evaluate>
     ga_status central_difference(int j, Perturb &&perturb, Evaluate &&evaluate, double &span,
                                  double increment = 0.0);

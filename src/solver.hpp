@@ -53,6 +53,14 @@ private:
     T value_;
 };
 
+// The live run's kept iteration matrix (and the first-order blocks factorized with it),
+// set aside while a sweep recomputes segments in matrices of their own (adjoint.cpp).
+struct KeptMatrix {
+    IterationMatrix S;
+    Index2Matrix S2;
+    CouplingBlocks blocks;
+};
+
 class Solver : private StepOutput {
 public:
     Solver(int n, int m);
@@ -135,7 +143,7 @@ public:
     const Sensitivities &sens() const { return forward_.sens; }
     ga_status set_sensitivity(int np, double *p, const double *p_scale, int depends);
     ga_status set_sensitivity_start(int j, const double *dq0, const double *dv0);
-    // adjoint.cpp
+    // The adjoint (Adjoint, adjoint.cpp)
     ga_status set_sensitivity_method(int methods, long max_steps);
     ga_status adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ);
     ga_status set_adjoint_checkpoints(long interval, long count);
@@ -298,21 +306,8 @@ private:
     ga_status exact_tangents(double t, const State &x, bool &K, bool &C, bool &Z);
     friend class ForwardSensitivity;
     ForwardSensitivity forward_{*this};
-    AdjointRecord adjoint_;
-    void record_start();   // adjoint.cpp: x_0 and the start's derivatives, at ga_init
-    ga_status record_on_converged(double h);  // adjoint.cpp: room, and how the step began
-    void record_step();    // the accepted step, at commit
-    struct AdjointWork;
-    ga_status adjoint_step(long k, AdjointWork &w);
-    ga_status adjoint_sweep(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ);
-    ga_status replay_segment(long s);
-    // The live run's kept iteration matrix (and the first-order blocks factorized with it),
-    // set aside while a sweep recomputes segments in matrices of their own (adjoint.cpp).
-    struct KeptMatrix {
-        IterationMatrix S;
-        Index2Matrix S2;
-        CouplingBlocks blocks;
-    };
+    friend class Adjoint;
+    Adjoint adjoint_{*this, forward_};
     void set_aside_matrix(KeptMatrix &kept);  // allocates the replay's matrices
     void take_back_matrix(KeptMatrix &kept);
     Vec eta_total_;       // index 2: the converged step's eta_bar (sum of its increments)

@@ -37,7 +37,7 @@ void Solver::on_started()
 {
     forward_.started();
     if (forward_.sens.adjoint)
-        record_start();
+        adjoint_.started();
     events_.restart();
 }
 // At setup, once the matrices' layouts are known: the sensitivities' matrices like them.
@@ -59,7 +59,7 @@ ga_status Solver::on_converged(double h)
     if (!forward_.sens.active())
         return GA_OK;
     if (forward_.sens.adjoint)
-        if (auto st = record_on_converged(h))
+        if (auto st = adjoint_.on_converged(h))
             return st;
     return forward_.step(h);
 }
@@ -77,7 +77,7 @@ void Solver::on_commit()
         return;
     forward_.on_commit();
     if (forward_.sens.adjoint)
-        record_step();
+        adjoint_.on_commit();
 }
 // undo_step (after its swaps): each puts back its own.
 void Solver::on_undo()
@@ -85,8 +85,8 @@ void Solver::on_undo()
     if (!forward_.sens.active())
         return;
     forward_.on_undo();
-    if (forward_.sens.adjoint && --adjoint_.steps < adjoint_.unsupported_at)
-        adjoint_.unsupported_at = -1;  // that step is gone
+    if (forward_.sens.adjoint)
+        adjoint_.on_undo();
 }
 
 // ---- the services' options ----
@@ -95,7 +95,7 @@ ga_status Solver::set_sensitivity(int np, double *p, const double *p_scale, int 
     const bool ready = workspace_ready_;
     forward_.set(np, p, p_scale, depends, nq_, nv_, m_, r(), ready ? &M_ : nullptr,
                  ready ? &J_ : nullptr);
-    adjoint_ = AdjointRecord{};  // the method is forward again (ga_set_sensitivity_method)
+    adjoint_.forget();  // the method is forward again (ga_set_sensitivity_method)
     return GA_OK;
 }
 
@@ -103,6 +103,21 @@ ga_status Solver::set_sensitivity_start(int j, const double *dq0, const double *
 {
     forward_.set_start(j, dq0, dv0, nv_);
     return GA_OK;
+}
+
+ga_status Solver::set_sensitivity_method(int methods, long max_steps)
+{
+    return adjoint_.set_method(methods, max_steps);
+}
+
+ga_status Solver::set_adjoint_checkpoints(long interval, long count)
+{
+    return adjoint_.set_checkpoints(interval, count);
+}
+
+ga_status Solver::adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ)
+{
+    return adjoint_.gradient(running, terminal, J, dJ);
 }
 
 // ---- the calls ----

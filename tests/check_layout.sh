@@ -3,9 +3,9 @@
 # - the step kernel names no service: solver.cpp, control.cpp and init.cpp reach the
 #   sensitivities, the adjoint's record, the events and the hook only through the doors in
 #   transaction.cpp;
-# - the event search, the step hook and the forward sensitivities are services of their own:
-#   events.cpp, step_hook.cpp and sensitivity.cpp define no member of the class that runs the
-#   transaction;
+# - the event search, the step hook, the forward sensitivities and the adjoint are services of
+#   their own: events.cpp, step_hook.cpp, sensitivity.cpp and adjoint.cpp define no member of
+#   the class that runs the transaction;
 # - q moves only through the configuration space: outside configuration_space.hpp no file
 #   adds to q, steps it by Taylor or Newmark, or perturbs it by hand.
 set -eu
@@ -19,7 +19,7 @@ if [ -n "$kernel_services" ]; then
     echo "$kernel_services"; status=1
 fi
 members=$(grep -nE '^[A-Za-z_:<>*& ]*\bSolver::' "$src/events.cpp" "$src/step_hook.cpp" \
-    "$src/sensitivity.cpp" || true)
+    "$src/sensitivity.cpp" "$src/adjoint.cpp" || true)
 if [ -n "$members" ]; then
     echo "a service defines members of Solver:"; echo "$members"; status=1
 fi
