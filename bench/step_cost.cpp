@@ -135,7 +135,7 @@ Result measure(const Scene &sc, int solver, double tol, int repeats)
             r.limit = std::nan("");  // Solver::unavoidable_work is the index-3 step's
         } else if (rep == 0) {
             // the unavoidable work at the final state, with the factorization at hand
-            ga::Solver &core = s->core;
+            ga::Stepper &core = s->core.kernel();
             core.unavoidable_work(sc.h);  // makes a factorization if there is none
             // about a second of repetitions whatever the size
             const int reps = std::max(3, static_cast<int>(2e5 / (sc.n + sc.m)));
@@ -257,7 +257,7 @@ int main(int argc, char **argv)
                     return 1;
             if (mode == "scene_limit")
                 for (int k = 0; k < reps; ++k)
-                    s->core.unavoidable_work(sc.h);
+                    s->core.kernel().unavoidable_work(sc.h);
             std::printf("%ld\n", steps);
             ga_free(s);
             return 0;

@@ -60,11 +60,11 @@ ga_status Adjoint::set_checkpoints(long interval, long count)
                             "an adjoint segment of interval = %ld steps (%zu doubles "
                             "each) is larger than memory can hold",
                             interval, stride);
-    if (interval > 0 && !fits_doubles(static_cast<std::size_t>(count), k_.state_size()))
+    if (interval > 0 && !fits_doubles(static_cast<std::size_t>(count), run_.state_size()))
         return k_.diag.fail(GA_ERR_NOMEM,
                             "count = %ld adjoint checkpoints of %zu doubles each are "
                             "more than memory can hold",
-                            count, k_.state_size());
+                            count, run_.state_size());
     if (interval > 0 &&
         !fits_doubles(static_cast<std::size_t>(interval) * static_cast<std::size_t>(count),
                       AdjointRecord::kLog))
@@ -76,7 +76,7 @@ ga_status Adjoint::set_checkpoints(long interval, long count)
     record.max_steps = record_.max_steps;
     if (interval > 0)
         record.allocate_checkpointed(k_.nq_, k_.nv_, k_.m_, k_.r(), forward_.sens.np, interval,
-                                     count, k_.state_size());
+                                     count, run_.state_size());
     else
         record.allocate(k_.nq_, k_.nv_, k_.m_, k_.r(), forward_.sens.np, record_.max_steps);
     record_ = std::move(record);
@@ -146,7 +146,7 @@ void Adjoint::started()
     r.base = 0;
     r.unsupported_at = -1;
     if (r.interval > 0)
-        k_.get_state(r.checkpoint(0));
+        run_.get_state(r.checkpoint(0));
     double *e = r.entry(0);
     e[0] = x.t;
     e[1] = e[2] = e[3] = 0.0;
@@ -214,7 +214,7 @@ void Adjoint::on_commit()
     if (r.pending_kind == AdjointRecord::Unsupported && r.unsupported_at < 0)
         r.unsupported_at = r.steps;
     if (r.interval > 0 && k % r.interval == 0 && k < r.capacity)
-        k_.get_state(r.checkpoint(k / r.interval));
+        run_.get_state(r.checkpoint(k / r.interval));
 }
 
 // The sweep's state and scratch: the adjoint variables of the state derivative (q, v, qdd,
@@ -586,7 +586,7 @@ ga_status Adjoint::replay_segment(long s)
 {
     AdjointRecord &r = record_;
     const long first = s * r.interval, last = std::min(first + r.interval, r.steps);
-    if (auto st = k_.set_state(r.checkpoint(s), r.checkpoint_size, true))
+    if (auto st = run_.set_state(r.checkpoint(s), r.checkpoint_size, true))
         return st;
     r.base = first;
     double *e = r.entry(first);
@@ -606,11 +606,10 @@ ga_status Adjoint::replay_segment(long s)
         k_.refresh_steps_left_ = static_cast<int>(l[8]);
         k_.reuse_backoff_ = static_cast<int>(l[9]);
         k_.fd_tangents_ = l[10] != 0.0;
-        const Restore<bool> keep_mode(k_.adaptive_attempt_);
-        k_.adaptive_attempt_ = l[5] >= 2.0;  // (a fresh start: its first-order states' start)
-        // the kernel and the forward sensitivities' linear step, not the doors: a replay
-        // records nothing (its entries are written below)
-        ga_status st = k_.attempt_step(h, l[4], std::fmod(l[5], 2.0) != 0.0);
+        // the kernel and the forward sensitivities' linear step, not the doors after it: a
+        // replay records nothing (its entries are written below); adaptive or not as recorded
+        // (a fresh start: its first-order states' start)
+        ga_status st = k_.attempt_step(h, l[4], std::fmod(l[5], 2.0) != 0.0, l[5] >= 2.0);
         if (!st)
             st = forward_.step(h);
         if (st) {
@@ -649,11 +648,11 @@ ga_status Adjoint::gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, 
     // The sweep recomputes segments in place: the run is restored afterwards as it was --
     // its state and kept matrix from a checkpoint of it, the rest as saved here.
     AdjointRecord &r = record_;
-    std::vector<double> here(k_.state_size());
-    k_.get_state(here.data());
+    std::vector<double> here(run_.state_size());
+    run_.get_state(here.data());
     const State previous = k_.previous_;
     const bool previous_valid = k_.previous_valid_, start_pending = k_.start_pending_;
-    const EventSet events = k_.events_;
+    const EventSet events = run_.events();
     const long state_id = k_.state_id_, base = r.base;
     const std::vector<double> segment = r.data;
     // The segments are computed in matrices of their own, the run's kept one set aside: it
@@ -663,11 +662,11 @@ ga_status Adjoint::gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, 
     k_.set_aside_matrix(kept);
     const auto restore = [&] {
         k_.take_back_matrix(kept);
-        const ga_status back = k_.set_state(here.data(), here.size(), true, true);
+        const ga_status back = run_.set_state(here.data(), here.size(), true, true);
         k_.previous_ = previous;
         k_.previous_valid_ = previous_valid;
         k_.start_pending_ = start_pending;
-        k_.events_ = events;
+        run_.events() = events;
         k_.model.y_now = &k_.accepted_.y;
         k_.state_id_ = state_id;
         k_.output_for_ = -1;  // (its buffers may hold a recomputed step's output now)

@@ -14,7 +14,7 @@
 namespace ga {
 
 struct AdjointRecord {
-    // How a recorded step began (Solver::prepare_start): a_n as accepted or rescaled by rho
+    // How a recorded step began (Stepper::prepare_start): a_n as accepted or rescaled by rho
     // (Regular), the first step's start (differenced, start0), or a start the sweep does not
     // cover (Taylor steps, fresh starts after short steps).
     enum Kind { Regular = 0, First = 1, Unsupported = 2 };
@@ -63,6 +63,7 @@ struct AdjointRecord {
                                std::size_t state_size);
 };
 
+class Stepper;
 class Solver;
 
 // The discrete adjoint as a service of the step (docs/algorithms.md sec. 13): at the doors of
@@ -72,7 +73,10 @@ class Solver;
 // derivatives in p come from the forward sensitivities' service.
 class Adjoint {
 public:
-    Adjoint(Solver &kernel, ForwardSensitivity &forward) : k_(kernel), forward_(forward) {}
+    Adjoint(Stepper &kernel, ForwardSensitivity &forward, Solver &run)
+        : k_(kernel), forward_(forward), run_(run)
+    {
+    }
     Adjoint(const Adjoint &) = delete;
     Adjoint &operator=(const Adjoint &) = delete;
 
@@ -101,8 +105,9 @@ private:
     ga_status replay_segment(long s);
 
     AdjointRecord record_;
-    Solver &k_;
+    Stepper &k_;
     ForwardSensitivity &forward_;
+    Solver &run_;  // its checkpoints and event search, restored after a sweep
 };
 
 }  // namespace ga

@@ -158,7 +158,7 @@ ga_status copy_out(const ga::Solver &c, const ga::Vec &x, double *out)
 {
     if (!out)
         return GA_ERR_ARG;
-    if (!c.initialized())
+    if (!c.kernel().initialized())
         return GA_ERR_STATE;
     Eigen::Map<ga::Vec>(out, x.size()) = x;
     return GA_OK;
@@ -182,7 +182,7 @@ ga_status change_tangents(ga::Solver &c, Change &&change)
     };
     change();
     try {
-        if (const ga_status st = c.tangent_options_changed()) {
+        if (const ga_status st = c.kernel().tangent_options_changed()) {
             restore();
             return st;
         }
@@ -200,7 +200,7 @@ template <class Copy>
 ga_status read_sensitivity(const ga_solver *s, const char *name, int j, Copy &&copy)
 {
     return reading(s, name, "j is not the index of a parameter", [&](const ga::Solver &c) {
-        if (!c.initialized() || !c.sens().active() || !c.sens().forward)
+        if (!c.kernel().initialized() || !c.sens().active() || !c.sens().forward)
             return GA_ERR_STATE;
         if (j < 0 || j >= c.sens().np)
             return GA_ERR_ARG;
@@ -291,8 +291,8 @@ GA_API ga_status ga_get_size(const ga_solver *s, int *n, int *m)
     return reading(s, "ga_get_size", "n or m is NULL", [&](const ga::Solver &c) {
         if (!n || !m)
             return GA_ERR_ARG;
-        *n = c.nv();  // (ga_create's n: nq = nv)
-        *m = c.m();
+        *n = c.kernel().nv();  // (ga_create's n: nq = nv)
+        *m = c.kernel().m();
         return GA_OK;
     });
 }
@@ -304,15 +304,15 @@ GA_API ga_status ga_set_callbacks(ga_solver *s, ga_mass_fn mass, ga_force_fn for
     return guarded(s, [&](ga::Solver &c) {
         if (!mass)
             return c.diag.fail(GA_ERR_ARG, "the mass matrix callback is required");
-        if (c.m() > 0 && (!constraint || !jacobian))
+        if (c.kernel().m() > 0 && (!constraint || !jacobian))
             return c.diag.fail(GA_ERR_ARG, "m = %d > 0: constraint and jacobian callbacks are "
-                               "required", c.m());
+                               "required", c.kernel().m());
         c.model.cb.mass = mass;
         c.model.cb.force = force;
-        c.model.cb.constraint = c.m() > 0 ? constraint : nullptr;
-        c.model.cb.jacobian = c.m() > 0 ? jacobian : nullptr;
+        c.model.cb.constraint = c.kernel().m() > 0 ? constraint : nullptr;
+        c.model.cb.jacobian = c.kernel().m() > 0 ? jacobian : nullptr;
         c.model.cb.user = user;
-        c.invalidate_jacobian();
+        c.kernel().invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -357,9 +357,9 @@ GA_API ga_status ga_set_rho_inf(ga_solver *s, double rho_inf)
     return guarded(s, [&](ga::Solver &c) {
         if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
             return c.diag.fail(GA_ERR_ARG, "rho_inf = %g is outside [0, 1]", rho_inf);
-        c.params = ga::params_from_rho_inf(rho_inf);
-        c.params1 = ga::first_order_params_from_rho_inf(rho_inf);
-        c.invalidate_jacobian();
+        c.kernel().params = ga::params_from_rho_inf(rho_inf);
+        c.kernel().params1 = ga::first_order_params_from_rho_inf(rho_inf);
+        c.kernel().invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -371,11 +371,11 @@ GA_API ga_status ga_set_params(ga_solver *s, double alpha_m, double alpha_f, dou
         const ga::Params p{alpha_m, alpha_f, beta, gamma};
         if (const char *why = ga::check_params(p))
             return c.diag.fail(GA_ERR_ARG, "parameters refused: %s", why);
-        c.params = p;
+        c.kernel().params = p;
         // the first-order states' damping from the same alpha_f = rho_inf / (1 + rho_inf)
-        c.params1 = ga::first_order_params_from_rho_inf(
+        c.kernel().params1 = ga::first_order_params_from_rho_inf(
             std::min(1.0, std::max(0.0, alpha_f / (1.0 - alpha_f))));
-        c.invalidate_jacobian();
+        c.kernel().invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -385,13 +385,13 @@ GA_API ga_status ga_get_params(const ga_solver *s, double *alpha_m, double *alph
 {
     return reading(s, "ga_get_params", "no argument can fail", [&](const ga::Solver &c) {
         if (alpha_m)
-            *alpha_m = c.params.alpha_m;
+            *alpha_m = c.kernel().params.alpha_m;
         if (alpha_f)
-            *alpha_f = c.params.alpha_f;
+            *alpha_f = c.kernel().params.alpha_f;
         if (beta)
-            *beta = c.params.beta;
+            *beta = c.kernel().params.beta;
         if (gamma)
-            *gamma = c.params.gamma;
+            *gamma = c.kernel().params.gamma;
         return GA_OK;
     });
 }
@@ -403,8 +403,8 @@ GA_API ga_status ga_set_newton(ga_solver *s, double tol, int max_iter)
             return c.diag.fail(GA_ERR_ARG, "Newton tolerance %g is outside (0, 1)", tol);
         if (max_iter < 1)
             return c.diag.fail(GA_ERR_ARG, "max_iter = %d < 1", max_iter);
-        c.newton_tol = tol;
-        c.max_iter = max_iter;
+        c.kernel().newton_tol = tol;
+        c.kernel().max_iter = max_iter;
         return GA_OK;
     });
 }
@@ -414,8 +414,8 @@ GA_API ga_status ga_set_scaling(ga_solver *s, int on)
     return guarded(s, [&](ga::Solver &c) {
         if (on != 0 && on != 1)
             return c.diag.fail(GA_ERR_ARG, "scaling must be 0 or 1, got %d", on);
-        c.scaling = on == 1;
-        c.invalidate_jacobian();
+        c.kernel().scaling = on == 1;
+        c.kernel().invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -425,8 +425,8 @@ GA_API ga_status ga_set_jacobian_reuse(ga_solver *s, int mode)
     return guarded(s, [&](ga::Solver &c) {
         if (mode != GA_REUSE_AUTO && mode != GA_REUSE_NEVER)
             return c.diag.fail(GA_ERR_ARG, "unknown reuse mode %d", mode);
-        c.reuse = static_cast<ga_reuse_mode>(mode);
-        c.invalidate_jacobian();
+        c.kernel().reuse = static_cast<ga_reuse_mode>(mode);
+        c.kernel().invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -449,18 +449,19 @@ ga_status declare_pattern(ga::Solver &c, int which, int nnz, const int *rows, co
 {
     if (which < GA_MATRIX_MASS || which > GA_MATRIX_DAMPING)
         return c.diag.fail(GA_ERR_ARG, "unknown matrix %d", which);
-    if (c.setup_done())
+    if (c.kernel().setup_done())
         return c.diag.fail(GA_ERR_STATE, "patterns are declared before ga_init");
     if (nnz < 0 || (nnz > 0 && (!rows || !cols)))
         return c.diag.fail(GA_ERR_ARG, "pattern with nnz = %d needs rows and cols", nnz);
-    const int nr = which == GA_MATRIX_JACOBIAN ? c.m() : c.nv(), nc = c.nv();
-    if (which == GA_MATRIX_JACOBIAN && c.m() == 0)
+    const int nv = c.kernel().nv();
+    const int nr = which == GA_MATRIX_JACOBIAN ? c.kernel().m() : nv, nc = nv;
+    if (which == GA_MATRIX_JACOBIAN && c.kernel().m() == 0)
         return c.diag.fail(GA_ERR_ARG, "m = 0: there is no constraint Jacobian");
     for (int k = 0; k < nnz; ++k)
         if (rows[k] < 0 || rows[k] >= nr || cols[k] < 0 || cols[k] >= nc)
             return c.diag.fail(GA_ERR_ARG, "pattern entry %d = (%d, %d) is outside the "
                                "%d x %d matrix", k, rows[k], cols[k], nr, nc);
-    c.matrix(static_cast<ga_matrix>(which)).set_pattern(nr, nc, rows, cols, nnz);
+    c.kernel().matrix(static_cast<ga_matrix>(which)).set_pattern(nr, nc, rows, cols, nnz);
     return GA_OK;
 }
 }  // namespace
@@ -479,7 +480,7 @@ GA_API ga_status ga_set_pattern_csc(ga_solver *s, int which, const int *colptr,
             return c.diag.fail(GA_ERR_ARG, "pattern in CSC form needs colptr");
         if (colptr[0] != 0)
             return c.diag.fail(GA_ERR_ARG, "colptr[0] = %d, not 0", colptr[0]);
-        const int nc = c.nv();
+        const int nc = c.kernel().nv();
         for (int j = 0; j < nc; ++j)
             if (colptr[j + 1] < colptr[j])
                 return c.diag.fail(GA_ERR_ARG, "colptr decreases at column %d (%d -> %d)", j,
@@ -499,9 +500,9 @@ GA_API ga_status ga_set_linear_solver(ga_solver *s, int solver)
     return guarded(s, [&](ga::Solver &c) {
         if (solver < GA_LINEAR_AUTO || solver > GA_LINEAR_DENSE_UNBLOCKED)
             return c.diag.fail(GA_ERR_ARG, "unknown linear solver %d", solver);
-        if (c.setup_done())
+        if (c.kernel().setup_done())
             return c.diag.fail(GA_ERR_STATE, "the linear solver is chosen before ga_init");
-        c.linear_solver = static_cast<ga_linear_solver>(solver);
+        c.kernel().linear_solver = static_cast<ga_linear_solver>(solver);
         return GA_OK;
     });
 }
@@ -510,7 +511,7 @@ GA_API const char *ga_linear_solver_name(const ga_solver *s)
 {
     if (!s)
         return "none";
-    return s->core.linear_backend();
+    return s->core.kernel().linear_backend();
 }
 
 GA_API ga_status ga_set_redundant_constraints(ga_solver *s, int mode)
@@ -518,10 +519,10 @@ GA_API ga_status ga_set_redundant_constraints(ga_solver *s, int mode)
     return guarded(s, [&](ga::Solver &c) {
         if (mode != GA_REDUNDANT_REFUSE && mode != GA_REDUNDANT_DROP)
             return c.diag.fail(GA_ERR_ARG, "unknown redundancy mode %d", mode);
-        if (c.setup_done())
+        if (c.kernel().setup_done())
             return c.diag.fail(GA_ERR_STATE,
                                "the treatment of redundant constraints is chosen before ga_init");
-        c.redundancy = static_cast<ga_redundancy>(mode);
+        c.kernel().redundancy = static_cast<ga_redundancy>(mode);
         return GA_OK;
     });
 }
@@ -532,10 +533,10 @@ GA_API ga_status ga_get_active_constraints(const ga_solver *s, int *active)
                    [&](const ga::Solver &c) {
         if (!active)
             return GA_ERR_ARG;
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return GA_ERR_STATE;
-        for (int i = 0; i < c.m(); ++i)
-            active[i] = c.constraint_active(i) ? 1 : 0;
+        for (int i = 0; i < c.kernel().m(); ++i)
+            active[i] = c.kernel().constraint_active(i) ? 1 : 0;
         return GA_OK;
     });
 }
@@ -545,10 +546,10 @@ GA_API ga_status ga_set_formulation(ga_solver *s, int formulation)
     return guarded(s, [&](ga::Solver &c) {
         if (formulation != GA_INDEX3 && formulation != GA_INDEX2_STABILIZED)
             return c.diag.fail(GA_ERR_ARG, "unknown formulation %d", formulation);
-        if (formulation == GA_INDEX2_STABILIZED && c.setup_done())
-            c.setup_index2();  // may throw std::bad_alloc: the formulation stays as it was
-        c.formulation = static_cast<ga_formulation>(formulation);
-        c.invalidate_jacobian();
+        if (formulation == GA_INDEX2_STABILIZED && c.kernel().setup_done())
+            c.kernel().setup_index2();  // may throw std::bad_alloc: the formulation stays as it was
+        c.kernel().formulation = static_cast<ga_formulation>(formulation);
+        c.kernel().invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -559,29 +560,29 @@ GA_API ga_status ga_set_resolution_check(ga_solver *s, double limit)
         if (!(limit > 0.0))
             return c.diag.fail(GA_ERR_ARG, "resolution check limit %g must be > 0 (INFINITY: "
                                "no check)", limit);
-        c.max_velocity_residual = limit;
+        c.kernel().max_velocity_residual = limit;
         return GA_OK;
     });
 }
 
-static ga_status set_switch(ga_solver *s, int on, const char *what, bool ga::Solver::*field)
+static ga_status set_switch(ga_solver *s, int on, const char *what, bool ga::Stepper::*field)
 {
     return guarded(s, [&](ga::Solver &c) {
         if (on != 0 && on != 1)
             return c.diag.fail(GA_ERR_ARG, "%s must be 0 or 1, got %d", what, on);
-        c.*field = on == 1;
+        c.kernel().*field = on == 1;
         return GA_OK;
     });
 }
 
 GA_API ga_status ga_set_rescale(ga_solver *s, int on)
 {
-    return set_switch(s, on, "rescale", &ga::Solver::rescale_a);
+    return set_switch(s, on, "rescale", &ga::Stepper::rescale_a);
 }
 
 GA_API ga_status ga_set_corrected_start(ga_solver *s, int on)
 {
-    return set_switch(s, on, "corrected start", &ga::Solver::corrected_start);
+    return set_switch(s, on, "corrected start", &ga::Stepper::corrected_start);
 }
 
 GA_API ga_status ga_set_tolerances(ga_solver *s, double rtol, double atol)
@@ -623,7 +624,7 @@ GA_API ga_status ga_step_adaptive(ga_solver *s, double t_stop)
 {
     return guarded(s, [&](ga::Solver &c) {
         c.events().clear_log();  // the log is this call's, even if it fails at once
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_step_adaptive before ga_init");
         if (!std::isfinite(t_stop))
             return c.diag.fail(GA_ERR_ARG, "t_stop = %g is not finite", t_stop);
@@ -635,7 +636,7 @@ GA_API ga_status ga_advance(ga_solver *s, double t_out)
 {
     return guarded(s, [&](ga::Solver &c) {
         c.events().clear_log();  // the log is this call's, even if it fails at once
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_advance before ga_init");
         if (!std::isfinite(t_out))
             return c.diag.fail(GA_ERR_ARG, "t_out = %g is not finite", t_out);
@@ -654,7 +655,7 @@ ga_status set_events(ga_solver *s, const char *name, int count, ga_event_fn fn,
             return c.diag.fail(GA_ERR_ARG, "%s: count = %d is negative", name, count);
         if (count > 0 && !fn && !fn_y)
             return c.diag.fail(GA_ERR_ARG, "%s: %d functions but fn is NULL", name, count);
-        if (count > 0 && fn_y && c.r() == 0)
+        if (count > 0 && fn_y && c.kernel().r() == 0)
             return c.diag.fail(GA_ERR_STATE, "%s before ga_set_first_order: no first-order "
                                "states to pass", name);
         for (int k = 0; direction && k < count; ++k)
@@ -662,7 +663,7 @@ ga_status set_events(ga_solver *s, const char *name, int count, ga_event_fn fn,
                 return c.diag.fail(GA_ERR_ARG, "%s: direction[%d] = %d is not -1, 0 or 1", name,
                                    k, direction[k]);
         c.events().configure(count, fn, fn_y, direction, terminal, with_multipliers != 0,
-                             c.nq(), c.nv(), c.m(), c.r());
+                             c.kernel().nq(), c.kernel().nv(), c.kernel().m(), c.kernel().r());
         return GA_OK;
     });
 }
@@ -730,23 +731,23 @@ GA_API ga_status ga_interpolate(const ga_solver *s, double t, double *q, double 
                                 double *lambda)
 {
     return computing(s, [&](ga::Solver &c) {
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_interpolate before ga_init");
         if (!std::isfinite(t))
             return c.diag.fail(GA_ERR_ARG, "ga_interpolate: t = %g is not finite", t);
-        return c.interpolate(t, q, v, nullptr, lambda);
+        return c.kernel().interpolate(t, q, v, nullptr, lambda);
     });
 }
 
 GA_API ga_status ga_interpolate_qdd(const ga_solver *s, double t, double *qdd)
 {
     return computing(s, [&](ga::Solver &c) {
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_interpolate_qdd before ga_init");
         if (!std::isfinite(t) || !qdd)
             return c.diag.fail(GA_ERR_ARG, "ga_interpolate_qdd: t = %g not finite or qdd NULL",
                                t);
-        return c.interpolate(t, nullptr, nullptr, qdd, nullptr);
+        return c.kernel().interpolate(t, nullptr, nullptr, qdd, nullptr);
     });
 }
 
@@ -757,7 +758,7 @@ GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga
             return c.diag.fail(GA_ERR_ARG, "r = %d first-order states: must be >= 0", r);
         if (r > 0 && !rate)
             return c.diag.fail(GA_ERR_ARG, "r = %d > 0: the rate callback is required", r);
-        if (c.setup_done())
+        if (c.kernel().setup_done())
             return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after the solver was set up "
                                "(ga_init or ga_set_state): declare the states before");
         if (c.events().fn_y())
@@ -766,7 +767,7 @@ GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga
         if (r > 0 && c.sens().active())
             return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after ga_set_sensitivity: "
                                "declare the states first (the sensitivities include theirs)");
-        c.set_first_order(r);  // may throw std::bad_alloc before anything below changed
+        c.kernel().set_first_order(r);  // may throw std::bad_alloc before anything below changed
         c.model.cb.force_y = r > 0 ? force : nullptr;
         c.model.cb.rate = r > 0 ? rate : nullptr;
         return GA_OK;
@@ -777,7 +778,7 @@ GA_API ga_status ga_set_coupling(ga_solver *s, ga_coupling_fn fn)
 {
     return guarded(s, [&](ga::Solver &c) {
         c.model.cb.coupling = fn;
-        c.invalidate_jacobian();
+        c.kernel().invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -788,20 +789,21 @@ GA_API ga_status ga_set_coupling_pattern(ga_solver *s, int which, int nnz, const
     return guarded(s, [&](ga::Solver &c) {
         if (which != GA_COUPLING_G_Q && which != GA_COUPLING_G_V)
             return c.diag.fail(GA_ERR_ARG, "unknown coupling block %d", which);
-        if (c.r() == 0)
+        if (c.kernel().r() == 0)
             return c.diag.fail(GA_ERR_STATE, "ga_set_coupling_pattern before ga_set_first_order "
                                "with r > 0");
-        if (c.setup_done())
+        if (c.kernel().setup_done())
             return c.diag.fail(GA_ERR_STATE, "coupling patterns are declared before ga_init_y");
         if (nnz < 0 || (nnz > 0 && (!rows || !cols)))
             return c.diag.fail(GA_ERR_ARG, "pattern with nnz = %d needs rows and cols", nnz);
+        const int r = c.kernel().r(), nv = c.kernel().nv();
         for (int k = 0; k < nnz; ++k)
-            if (rows[k] < 0 || rows[k] >= c.r() || cols[k] < 0 || cols[k] >= c.nv())
+            if (rows[k] < 0 || rows[k] >= r || cols[k] < 0 || cols[k] >= nv)
                 return c.diag.fail(GA_ERR_ARG, "pattern entry %d = (%d, %d) is outside the "
-                                   "%d x %d block", k, rows[k], cols[k], c.r(), c.nv());
+                                   "%d x %d block", k, rows[k], cols[k], r, nv);
         (which == GA_COUPLING_G_Q ? c.model.g_q_pattern : c.model.g_v_pattern)
-            .set_pattern(c.r(), c.nv(), rows, cols, nnz);
-        c.invalidate_jacobian();
+            .set_pattern(c.kernel().r(), c.kernel().nv(), rows, cols, nnz);
+        c.kernel().invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -809,8 +811,8 @@ GA_API ga_status ga_set_coupling_pattern(ga_solver *s, int which, int nnz, const
 GA_API ga_status ga_set_coupling_exact(ga_solver *s, int exact)
 {
     return guarded(s, [&](ga::Solver &c) {
-        c.coupling_exact = exact != 0;
-        c.invalidate_jacobian();
+        c.kernel().coupling_exact = exact != 0;
+        c.kernel().invalidate_jacobian();
         return GA_OK;
     });
 }
@@ -819,7 +821,7 @@ GA_API ga_status ga_init_y(ga_solver *s, double t0, const double *q0, const doub
                            const double *y0)
 {
     return guarded(s, [&](ga::Solver &c) {
-        if (!q0 || !v0 || (!y0 && c.r() > 0))
+        if (!q0 || !v0 || (!y0 && c.kernel().r() > 0))
             return c.diag.fail(GA_ERR_ARG, "q0, v0 and y0 must not be NULL");
         if (!std::isfinite(t0))
             return c.diag.fail(GA_ERR_ARG, "t0 = %g is not finite", t0);
@@ -850,7 +852,7 @@ GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const doubl
         if ((depends & GA_DEPENDS_MASS) && c.model.constant_mass)
             return c.diag.fail(GA_ERR_ARG, "a mass matrix that depends on the parameters is not "
                                "constant (ga_set_constant_mass)");
-        if (c.initialized())
+        if (c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity after ga_init: sensitivities "
                                "start at ga_init");
         return c.set_sensitivity(np, p, p_scale, depends);
@@ -866,7 +868,7 @@ GA_API ga_status ga_set_sensitivity_start(ga_solver *s, int j, const double *dq0
                                "with np > 0");
         if (j < 0 || j >= c.sens().np)
             return c.diag.fail(GA_ERR_ARG, "parameter %d: there are %d (0-based)", j, c.sens().np);
-        for (int i = 0; i < c.nv(); ++i)
+        for (int i = 0; i < c.kernel().nv(); ++i)
             if ((dq0 && !std::isfinite(dq0[i])) || (dv0 && !std::isfinite(dv0[i])))
                 return c.diag.fail(GA_ERR_ARG, "dq0 or dv0 entry %d is not finite", i);
         return c.set_sensitivity_start(j, dq0, dv0);
@@ -923,7 +925,7 @@ GA_API ga_status ga_set_sensitivity_method(ga_solver *s, int methods, long max_s
         if (!c.sens().active())
             return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity_method before "
                                "ga_set_sensitivity with np > 0");
-        if (c.initialized())
+        if (c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_set_sensitivity_method after ga_init");
         return c.set_sensitivity_method(methods, max_steps);
     });
@@ -941,7 +943,7 @@ GA_API ga_status ga_set_adjoint_checkpoints(ga_solver *s, long interval, long co
         if (!c.sens().adjoint)
             return c.diag.fail(GA_ERR_STATE, "ga_set_adjoint_checkpoints before "
                                "ga_set_sensitivity_method with GA_SENSITIVITY_ADJOINT");
-        if (c.initialized())
+        if (c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_set_adjoint_checkpoints after ga_init");
         return c.set_adjoint_checkpoints(interval, count);
     });
@@ -959,7 +961,7 @@ GA_API ga_status ga_adjoint_gradient(ga_solver *s, ga_cost_fn running, ga_cost_f
         if (!c.sens().adjoint)
             return c.diag.fail(GA_ERR_STATE, "ga_adjoint_gradient without a recorded run "
                                "(ga_set_sensitivity_method with GA_SENSITIVITY_ADJOINT)");
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_adjoint_gradient before ga_init");
         return c.adjoint_gradient(running, terminal, J, dJ_dp);
     });
@@ -968,12 +970,12 @@ GA_API ga_status ga_adjoint_gradient(ga_solver *s, ga_cost_fn running, ga_cost_f
 GA_API ga_status ga_get_y(const ga_solver *s, double *y, double *ydot)
 {
     return reading(s, "ga_get_y", "no argument can fail", [&](const ga::Solver &c) {
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return GA_ERR_STATE;
         if (y)
-            Eigen::Map<ga::Vec>(y, c.r()) = c.state().y;
+            Eigen::Map<ga::Vec>(y, c.kernel().r()) = c.kernel().state().y;
         if (ydot)
-            Eigen::Map<ga::Vec>(ydot, c.r()) = c.state().ydot;
+            Eigen::Map<ga::Vec>(ydot, c.kernel().r()) = c.kernel().state().ydot;
         return GA_OK;
     });
 }
@@ -981,11 +983,11 @@ GA_API ga_status ga_get_y(const ga_solver *s, double *y, double *ydot)
 GA_API ga_status ga_interpolate_y(const ga_solver *s, double t, double *y, double *ydot)
 {
     return computing(s, [&](ga::Solver &c) {
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_interpolate_y before ga_init");
         if (!std::isfinite(t))
             return c.diag.fail(GA_ERR_ARG, "ga_interpolate_y: t = %g is not finite", t);
-        return c.interpolate_y(t, y, ydot);
+        return c.kernel().interpolate_y(t, y, ydot);
     });
 }
 
@@ -995,7 +997,7 @@ GA_API ga_status ga_set_predictor(ga_solver *s, int predictor)
         if (predictor != GA_PREDICTOR_CONSTANT_A && predictor != GA_PREDICTOR_ZERO &&
             predictor != GA_PREDICTOR_EXTRAPOLATE)
             return c.diag.fail(GA_ERR_ARG, "unknown predictor %d", predictor);
-        c.predictor = static_cast<ga_predictor>(predictor);
+        c.kernel().predictor = static_cast<ga_predictor>(predictor);
         return GA_OK;
     });
 }
@@ -1008,8 +1010,8 @@ GA_API ga_status ga_set_init_mode(ga_solver *s, int mode, double init_tol)
         if (!(init_tol > 0.0 && std::isfinite(init_tol)))
             return c.diag.fail(GA_ERR_ARG, "init_tol = %g must be positive and finite",
                                init_tol);
-        c.init_mode = static_cast<ga_init_mode>(mode);
-        c.init_tol = init_tol;
+        c.kernel().init_mode = static_cast<ga_init_mode>(mode);
+        c.kernel().init_tol = init_tol;
         return GA_OK;
     });
 }
@@ -1031,13 +1033,13 @@ GA_API ga_status ga_step(ga_solver *s, double h)
 {
     return guarded(s, [&](ga::Solver &c) {
         c.events().clear_log();  // the log is this call's, even if it fails at once
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_step before ga_init");
         if (!(h > 0.0) || !std::isfinite(h))
             return c.diag.fail(GA_ERR_ARG, "step size h = %g must be positive and finite", h);
-        if (c.state().t + h == c.state().t)
+        if (c.kernel().state().t + h == c.kernel().state().t)
             return c.diag.fail(GA_ERR_ARG, "step size h = %g is too small to advance t = %.17g",
-                               h, c.state().t);
+                               h, c.kernel().state().t);
         return c.step(h);
     });
 }
@@ -1047,9 +1049,9 @@ GA_API ga_status ga_get_t(const ga_solver *s, double *t)
     return reading(s, "ga_get_t", "t is NULL", [&](const ga::Solver &c) {
         if (!t)
             return GA_ERR_ARG;
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return GA_ERR_STATE;
-        *t = c.state().t;
+        *t = c.kernel().state().t;
         return GA_OK;
     });
 }
@@ -1059,9 +1061,9 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h)
     return reading(s, "ga_get_h_last", "h is NULL", [&](const ga::Solver &c) {
         if (!h)
             return GA_ERR_ARG;
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return GA_ERR_STATE;
-        *h = c.state().h_last;
+        *h = c.kernel().state().h_last;
         return GA_OK;
     });
 }
@@ -1069,13 +1071,13 @@ GA_API ga_status ga_get_h_last(const ga_solver *s, double *h)
 GA_API ga_status ga_get_q(const ga_solver *s, double *q)
 {
     return reading(s, "ga_get_q", "q is NULL",
-                   [&](const ga::Solver &c) { return copy_out(c, c.state().q, q); });
+                   [&](const ga::Solver &c) { return copy_out(c, c.kernel().state().q, q); });
 }
 
 GA_API ga_status ga_get_v(const ga_solver *s, double *v)
 {
     return reading(s, "ga_get_v", "v is NULL",
-                   [&](const ga::Solver &c) { return copy_out(c, c.state().v, v); });
+                   [&](const ga::Solver &c) { return copy_out(c, c.kernel().state().v, v); });
 }
 
 GA_API ga_status ga_get_qdd(const ga_solver *s, double *qdd)
@@ -1083,22 +1085,22 @@ GA_API ga_status ga_get_qdd(const ga_solver *s, double *qdd)
     return computing(s, [&](ga::Solver &c) {
         if (!qdd)
             return c.diag.fail(GA_ERR_ARG, "ga_get_qdd: qdd is NULL");
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_get_qdd before ga_init or ga_set_state");
-        return c.output_state(qdd, nullptr);
+        return c.kernel().output_state(qdd, nullptr);
     });
 }
 
 GA_API ga_status ga_get_lambda(const ga_solver *s, double *lambda)
 {
     return computing(s, [&](ga::Solver &c) {
-        if (c.m() == 0 && c.initialized())
+        if (c.kernel().m() == 0 && c.kernel().initialized())
             return GA_OK;  // nothing to copy; lambda may be NULL
         if (!lambda)
             return c.diag.fail(GA_ERR_ARG, "ga_get_lambda: lambda is NULL");
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return c.diag.fail(GA_ERR_STATE, "ga_get_lambda before ga_init or ga_set_state");
-        return c.output_state(nullptr, lambda);
+        return c.kernel().output_state(nullptr, lambda);
     });
 }
 
@@ -1108,8 +1110,8 @@ GA_API ga_status ga_set_output(ga_solver *s, int mode)
         if (mode != GA_OUTPUT_CONSISTENT && mode != GA_OUTPUT_STEP)
             return c.diag.fail(GA_ERR_ARG, "unknown output mode %d", mode);
         if (mode == GA_OUTPUT_CONSISTENT)
-            c.setup_output();  // may throw std::bad_alloc: the mode stays as it was
-        c.output = static_cast<ga_output>(mode);
+            c.kernel().setup_output();  // may throw std::bad_alloc: the mode stays as it was
+        c.kernel().output = static_cast<ga_output>(mode);
         return GA_OK;
     });
 }
@@ -1117,7 +1119,7 @@ GA_API ga_status ga_set_output(ga_solver *s, int mode)
 GA_API ga_status ga_get_a(const ga_solver *s, double *a)
 {
     return reading(s, "ga_get_a", "a is NULL",
-                   [&](const ga::Solver &c) { return copy_out(c, c.state().a, a); });
+                   [&](const ga::Solver &c) { return copy_out(c, c.kernel().state().a, a); });
 }
 
 GA_API ga_status ga_state_size(const ga_solver *s, size_t *len)
@@ -1136,7 +1138,7 @@ GA_API ga_status ga_get_state(const ga_solver *s, double *buf, size_t len)
                    [&](const ga::Solver &c) {
         if (!buf || len < c.state_size())
             return GA_ERR_ARG;
-        if (!c.initialized())
+        if (!c.kernel().initialized())
             return GA_ERR_STATE;
         c.get_state(buf);
         return GA_OK;
@@ -1158,7 +1160,7 @@ GA_API ga_status ga_get_counter(const ga_solver *s, int key, long long *value)
                    [&](const ga::Solver &c) {
         if (!value || key < 0 || key >= GA_COUNTER_COUNT)
             return GA_ERR_ARG;
-        *value = c.counters[key];
+        *value = c.kernel().counters[key];
         return GA_OK;
     });
 }
@@ -1170,12 +1172,12 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value)
         if (!value)
             return c.diag.fail(GA_ERR_ARG, "ga_get_info: value is NULL");
         switch (key) {
-        case GA_INFO_RCOND: *value = c.last_rcond(); return GA_OK;
-        case GA_INFO_NEWTON_ITERS: *value = c.last_newton_iters(); return GA_OK;
-        case GA_INFO_NEWTON_RATIO: *value = c.last_newton_ratio(); return GA_OK;
+        case GA_INFO_RCOND: *value = c.kernel().last_rcond(); return GA_OK;
+        case GA_INFO_NEWTON_ITERS: *value = c.kernel().last_newton_iters(); return GA_OK;
+        case GA_INFO_NEWTON_RATIO: *value = c.kernel().last_newton_ratio(); return GA_OK;
         case GA_INFO_ERROR_ESTIMATE: *value = c.control.err_last; return GA_OK;
         case GA_INFO_H_NEXT: *value = c.control.h_next; return GA_OK;
-        case GA_INFO_VELOCITY_RESIDUAL: *value = c.last_velocity_residual(); return GA_OK;
+        case GA_INFO_VELOCITY_RESIDUAL: *value = c.kernel().last_velocity_residual(); return GA_OK;
         default: return c.diag.fail(GA_ERR_ARG, "ga_get_info: unknown key %d", key);
         }
     });
@@ -1201,7 +1203,7 @@ GA_API ga_status ga_check_derivatives(ga_solver *s, double t, const double *q, c
 GA_API ga_status ga_reset_counters(ga_solver *s)
 {
     return guarded(s, [&](ga::Solver &c) {
-        c.counters.fill(0);
+        c.kernel().counters.fill(0);
         return GA_OK;
     });
 }

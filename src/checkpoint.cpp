@@ -19,7 +19,7 @@
 // to other round-off). Layout 2 (galpha 0.2: header up to grew, then the state) is read as a
 // restart: no kept matrix, pivots chosen afresh. Layout 3 (no c_count, c_dt, c, c_prev) is
 // read as a state whose index-3 error estimate has no consistent accelerations yet.
-#include "solver.hpp"
+#include "stepper.hpp"
 
 #include <cmath>
 
@@ -56,16 +56,12 @@ Layout layout(int nq, int nv, int m, bool layout3 = false)
 }
 }  // namespace
 
-std::size_t Solver::state_size() const { return state_size_in(false); }
-
-std::size_t Solver::state_size_in(bool layout3) const
+std::size_t Stepper::checkpoint_size(bool layout3) const
 {
-    return layout(nq_, nv_, m_, layout3).end + 6 * static_cast<std::size_t>(r()) +
-           static_cast<std::size_t>(forward_.sens.np) *
-               (4 * static_cast<std::size_t>(nv_) + m_ + 3 * static_cast<std::size_t>(r()));
+    return layout(nq_, nv_, m_, layout3).end + 6 * static_cast<std::size_t>(r());
 }
 
-void Solver::get_state(double *buf) const
+void Stepper::save_checkpoint(double *buf, const StepController &control) const
 {
     const Layout l = layout(nq_, nv_, m_);
     const State &s = accepted_;
@@ -116,22 +112,10 @@ void Solver::get_state(double *buf) const
         Eigen::Map<Vec>(p, x->size()) = *x;
         p += x->size();
     }
-    for (const StateDerivative &d : forward_.sens.accepted)
-        for (const Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a, &d.y, &d.ydot, &d.w}) {
-            Eigen::Map<Vec>(p, x->size()) = *x;
-            p += x->size();
-        }
 }
 
-ga_status Solver::set_state(const double *buf, std::size_t len, bool internal,
-                            bool keep_matrix)
-{
-    return undoing_a_first_setup(
-        [&] { return restore_state(buf, len, internal, keep_matrix); });
-}
-
-ga_status Solver::restore_state(const double *buf, std::size_t len, bool internal,
-                                bool keep_matrix)
+// The checks of a checkpoint, before anything changes (the transaction's own come after).
+ga_status Stepper::check_checkpoint(const double *buf, std::size_t len, std::size_t tail)
 {
     const bool layout2 = len >= 2 && buf[0] == kStateMagic && buf[1] == 2.0;
     const bool layout3 = len >= 2 && buf[0] == kStateMagic && buf[1] == 3.0;
@@ -139,7 +123,7 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
     const std::size_t expected =
         layout2 ? kHeader2 + static_cast<std::size_t>(nq_) + 4 * static_cast<std::size_t>(nv_) +
                       static_cast<std::size_t>(m_)
-                : state_size_in(layout3);
+                : checkpoint_size(layout3) + tail;
     if (len != expected)
         return diag.fail(GA_ERR_ARG, "checkpoint has %zu doubles, this solver needs %zu", len,
                          expected);
@@ -187,7 +171,6 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
         return diag.fail(GA_ERR_ARG, "checkpoint entries 19-20 (c_count = %g, c_dt = %g: the "
                          "consistent accelerations of the error estimate) are not those a "
                          "solver writes", buf[19], buf[20]);
-    const int c_count = with_c ? static_cast<int>(buf[19]) : 0;  // a count of 0-2 now
     // The constraints in use: as the checkpoint says (layout 2, which does not say, selects
     // them anew at its q). Dropped ones need a solver that drops them.
     for (int i = 0; i < m_ && !layout2; ++i) {
@@ -202,9 +185,19 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
     }
     if (!model.ready())
         return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
-    if (forward_.sens.adjoint && !internal)
-        return diag.fail(GA_ERR_STATE, "ga_set_state on a run recorded for the adjoint: the "
-                         "record starts at ga_init (restoring into it is not built)");
+    return GA_OK;
+}
+
+ga_status Stepper::load_checkpoint(const double *buf, bool internal, bool keep_matrix,
+                                   StepController &control)
+{
+    const bool layout2 = buf[1] == 2.0;
+    const bool layout3 = buf[1] == 3.0;
+    const Layout l = layout(nq_, nv_, m_, layout3);
+    const bool kept = !layout2 && buf[10] == 1.0;
+    const bool with_c = !layout2 && !layout3;
+    const int c_count = with_c ? static_cast<int>(buf[19]) : 0;  // a count of 0-2 (checked)
+    const double sliver_span = layout2 ? 0.0 : buf[9];
     if (auto st = setup())
         return st;
     if (!layout2) {
@@ -267,15 +260,9 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
             *x = Eigen::Map<const Vec>(py, x->size());
             py += x->size();
         }
-        for (StateDerivative &d : forward_.sens.accepted)
-            for (Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a, &d.y, &d.ydot, &d.w}) {
-                *x = Eigen::Map<const Vec>(py, x->size());
-                py += x->size();
-            }
     }
     invalidate_jacobian();
     previous_valid_ = false;
-    events_.restart();
     ++state_id_;
     // A checkpoint from before the first step (h_last = 0) still owes that step its corrected
     // starting values, as the solver it was taken from does.
@@ -342,8 +329,8 @@ ga_status Solver::restore_state(const double *buf, std::size_t len, bool interna
     return GA_OK;
 }
 
-// The kept iteration matrix, evaluated and factorized as Newton did (Solver::newton).
-ga_status Solver::rebuild_matrix()
+// The kept iteration matrix, evaluated and factorized as Newton did (Stepper::newton).
+ga_status Stepper::rebuild_matrix()
 {
     const MatrixRecipe &r = recipe_;
     State &x = trial_;  // scratch between steps

@@ -8,7 +8,7 @@
 #include <limits>
 #include <vector>
 
-#include "solver.hpp"
+#include "derivative_check.hpp"
 
 namespace ga {
 
@@ -81,11 +81,12 @@ double step_for(double x) { return 6.06e-6 * std::max(std::fabs(x), 1.0); }
 
 }  // namespace
 
-ga_status Solver::check_derivatives(double t, const double *q0, const double *v0,
-                                    const double *qdd0, const double *lambda0, const double *y0,
-                                    double tol, double *worst_out)
+ga_status check_derivatives(Stepper &kernel, const Sensitivities &sens, double t,
+                            const double *q0, const double *v0, const double *qdd0,
+                            const double *lambda0, const double *y0, double tol,
+                            double *worst_out)
 {
-    const int n = nv_, m = m_, R = r();
+    const int n = kernel.nv(), m = kernel.m(), R = kernel.r();
     Vec q = Eigen::Map<const Vec>(q0, n), v = Eigen::Map<const Vec>(v0, n);
     Vec qdd = qdd0 ? Vec(Eigen::Map<const Vec>(qdd0, n)) : Vec::Zero(n);
     // (ones: the multipliers' part of K_t is checked too)
@@ -93,27 +94,28 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
     Vec y = R > 0 && y0 ? Vec(Eigen::Map<const Vec>(y0, R)) : Vec::Zero(R);
     if (!all_finite(q) || !all_finite(v) || !all_finite(qdd) || !all_finite(lambda) ||
         !all_finite(y))
-        return diag.fail(GA_ERR_ARG, "ga_check_derivatives: a value of the state is not finite");
-    const Restore<const Vec *> keep_y(model.y_now);
-    const Restore<ga_tangent_mode> keep_mode(model.tangent_mode);
-    model.y_now = &y;
-    model.tangent_mode = GA_TANGENT_AUTO;  // (the callbacks, whatever the runs use)
+        return kernel.diag.fail(GA_ERR_ARG,
+                                "ga_check_derivatives: a value of the state is not finite");
+    const Restore<const Vec *> keep_y(kernel.model.y_now);
+    const Restore<ga_tangent_mode> keep_mode(kernel.model.tangent_mode);
+    kernel.model.y_now = &y;
+    kernel.model.tangent_mode = GA_TANGENT_AUTO;  // (the callbacks, whatever the runs use)
 
     ModelMatrix M, M2, J, J2, K, C;
-    M.copy_layout(M_);
-    M2.copy_layout(M_);
-    J.copy_layout(J_);
-    J2.copy_layout(J_);
+    M.copy_layout(kernel.matrix(GA_MATRIX_MASS));
+    M2.copy_layout(kernel.matrix(GA_MATRIX_MASS));
+    J.copy_layout(kernel.matrix(GA_MATRIX_JACOBIAN));
+    J2.copy_layout(kernel.matrix(GA_MATRIX_JACOBIAN));
     Vec f(n), f2(n), r1(n), r2(n), phi1(m), phi2(m), col_cb, col_fd;
     std::vector<Worst> checked;
     ga_status st = GA_OK;
     // r^q = M qdd - f + Phi_q^T lambda at (q, v), into r
     const auto residual_at = [&](const Vec &qq, const Vec &vv, Vec &r) {
-        ga_status s2 = model.mass(t, qq, M2);
+        ga_status s2 = kernel.model.mass(t, qq, M2);
         if (!s2)
-            s2 = model.force(t, qq, vv, f2);
+            s2 = kernel.model.force(t, qq, vv, f2);
         if (!s2 && m > 0)
-            s2 = model.jacobian(t, qq, J2);
+            s2 = kernel.model.jacobian(t, qq, J2);
         if (!s2)
             Model::dynamics_residual(M2, qdd, f2, J2, lambda, r);
         return s2;
@@ -121,7 +123,7 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
 
     if (m > 0) {  // Phi_q against differences of Phi in q
         Worst w{"Phi_q", "Phi in q"};
-        if ((st = model.jacobian(t, q, J)))
+        if ((st = kernel.model.jacobian(t, q, J)))
             return st;
         const Columns cols(J);
         const double scale = cols.max_abs();
@@ -129,11 +131,11 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
         for (int j = 0; j < n && !st; ++j) {
             Vec qq = q;
             const double e = step_for(q[j]);
-            model.space.shift_coordinate(qq, q, j, e);
-            st = model.constraint(t, qq, phi1);
-            model.space.shift_coordinate(qq, q, j, -e);
+            kernel.model.space.shift_coordinate(qq, q, j, e);
+            st = kernel.model.constraint(t, qq, phi1);
+            kernel.model.space.shift_coordinate(qq, q, j, -e);
             if (!st)
-                st = model.constraint(t, qq, phi2);
+                st = kernel.model.constraint(t, qq, phi2);
             if (!st) {
                 cols.column(j, col_cb);
                 row_max = row_max.cwiseMax(col_cb.cwiseAbs());
@@ -146,59 +148,61 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
         // a singular start, which its message called "redundant".
         for (int i = 0; i < m && !st; ++i)
             if (row_max[i] == 0.0)
-                return diag.fail(GA_ERR_DERIVATIVE, "constraint %d has a zero gradient at this "
-                                 "q (its row of Phi_q is zero: the constraint is degenerate "
-                                 "there, e.g. the square of a distance that is zero)", i);
+                return kernel.diag.fail(GA_ERR_DERIVATIVE,
+                                        "constraint %d has a zero gradient at this q (its row of "
+                                        "Phi_q is zero: the constraint is degenerate there, e.g. "
+                                        "the square of a distance that is zero)",
+                                        i);
     }
-    if (!st && m > 0 && model.cb.constraint_dt) {  // Phi_t against differences in t
+    if (!st && m > 0 && kernel.model.cb.constraint_dt) {  // Phi_t against differences in t
         Worst w{"Phi_t", "Phi in t"};
         Vec dt(m);
         const double e = step_for(t);
-        st = model.constraint_dt(t, q, dt);
+        st = kernel.model.constraint_dt(t, q, dt);
         if (!st)
-            st = model.constraint(t + e, q, phi1);
+            st = kernel.model.constraint(t + e, q, phi1);
         if (!st)
-            st = model.constraint(t - e, q, phi2);
+            st = kernel.model.constraint(t - e, q, phi2);
         if (!st) {
             col_fd = (phi1 - phi2) / (2.0 * e);
             compare(w, 0, dt, col_fd, 0.0);
             checked.push_back(w);
         }
     }
-    if (!st && m > 0 && model.cb.constraint_accel) {
+    if (!st && m > 0 && kernel.model.cb.constraint_accel) {
         // Phi_qq(v, v) + 2 Phi_qt v + Phi_tt = d^2/ds^2 Phi(q + s v, t + s) at s = 0
         Worst w{"constraint acceleration term", "Phi along (q + s v, t + s), second"};
         Vec accel(m), phi0(m), qq(q.size());
         const double e =
-            1.2e-4 * std::max({1.0, std::fabs(t), model.space.max_magnitude(q)}) /
+            1.2e-4 * std::max({1.0, std::fabs(t), kernel.model.space.max_magnitude(q)}) /
             std::max(1.0, v.cwiseAbs().maxCoeff());
-        st = model.constraint_accel(t, q, v, accel);
+        st = kernel.model.constraint_accel(t, q, v, accel);
         if (!st)
-            st = model.constraint(t, q, phi0);
+            st = kernel.model.constraint(t, q, phi0);
         if (!st)
-            model.space.shifted(q, e, v, qq), st = model.constraint(t + e, qq, phi1);
+            kernel.model.space.shifted(q, e, v, qq), st = kernel.model.constraint(t + e, qq, phi1);
         if (!st)
-            model.space.shifted(q, -e, v, qq), st = model.constraint(t - e, qq, phi2);
+            kernel.model.space.shifted(q, -e, v, qq), st = kernel.model.constraint(t - e, qq, phi2);
         if (!st) {
             col_fd = (phi1 - 2.0 * phi0 + phi2) / (e * e);
             compare(w, 0, accel, col_fd, 0.0);
             checked.push_back(w);
         }
     }
-    if (!st && model.cb.stiffness) {  // K_t against differences of r^q in q
+    if (!st && kernel.model.cb.stiffness) {  // K_t against differences of r^q in q
         Worst w{"K_t", "r^q = M qdd - f + Phi_q^T lambda in q"};
-        K.copy_layout(K_);
+        K.copy_layout(kernel.matrix(GA_MATRIX_STIFFNESS));
         if (!K.zero()) {
             if (!(st = residual_at(q, v, r1)))  // (M, f, Phi_q at q for the callback's r^q)
-                st = model.stiffness(t, q, v, qdd, lambda, r1, M2, K);
+                st = kernel.model.stiffness(t, q, v, qdd, lambda, r1, M2, K);
             const Columns cols(K);
             const double scale = cols.max_abs();
             for (int j = 0; j < n && !st; ++j) {
                 Vec qq = q;
                 const double e = step_for(q[j]);
-                model.space.shift_coordinate(qq, q, j, e);
+                kernel.model.space.shift_coordinate(qq, q, j, e);
                 st = residual_at(qq, v, r1);
-                model.space.shift_coordinate(qq, q, j, -e);
+                kernel.model.space.shift_coordinate(qq, q, j, -e);
                 if (!st)
                     st = residual_at(qq, v, r2);
                 if (!st) {
@@ -210,22 +214,22 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
             checked.push_back(w);
         }
     }
-    if (!st && model.cb.damping) {  // C_t = -df/dv against differences of f in v
+    if (!st && kernel.model.cb.damping) {  // C_t = -df/dv against differences of f in v
         Worst w{"C_t", "-f in v"};
-        C.copy_layout(C_);
+        C.copy_layout(kernel.matrix(GA_MATRIX_DAMPING));
         if (!C.zero()) {
-            if (!(st = model.force(t, q, v, f)))
-                st = model.damping(t, q, v, f, C);
+            if (!(st = kernel.model.force(t, q, v, f)))
+                st = kernel.model.damping(t, q, v, f, C);
             const Columns cols(C);
             const double scale = cols.max_abs();
             for (int j = 0; j < n && !st; ++j) {
                 Vec vv = v;
                 const double e = step_for(v[j]);
                 vv[j] = v[j] + e;
-                st = model.force(t, q, vv, f);
+                st = kernel.model.force(t, q, vv, f);
                 vv[j] = v[j] - e;
                 if (!st)
-                    st = model.force(t, q, vv, f2);
+                    st = kernel.model.force(t, q, vv, f2);
                 if (!st) {
                     cols.column(j, col_cb);
                     col_fd = -(f - f2) / (2.0 * e);
@@ -235,14 +239,14 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
             checked.push_back(w);
         }
     }
-    if (!st && R > 0 && model.cb.coupling) {  // g_q, g_v, g_y and f_y against differences
+    if (!st && R > 0 && kernel.model.cb.coupling) {  // g_q, g_v, g_y and f_y against differences
         CouplingBlocks B;
         B.allocate(n, R);
         Vec g(R), g1(R), g2(R);
-        if (!(st = model.force(t, q, v, f)))
-            st = model.rate(t, q, v, y, g);
+        if (!(st = kernel.model.force(t, q, v, f)))
+            st = kernel.model.rate(t, q, v, y, g);
         if (!st)
-            st = model.coupling(t, q, v, y, f, g, B);
+            st = kernel.model.coupling(t, q, v, y, f, g, B);
         Worst wq{"g_q", "g in q"}, wv{"g_v", "g in v"}, wy{"g_y", "g in y"}, wf{"f_y", "f in y"};
         for (int block = 0; block < 3 && !st; ++block) {
             Worst &w = block == 0 ? wq : block == 1 ? wv : wy;
@@ -253,16 +257,16 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
                 Vec &x = block == 0 ? qq : block == 1 ? vv : yy;
                 const double e = step_for(x[j]);
                 x[j] += e;
-                model.y_now = &yy;
-                st = model.rate(t, qq, vv, yy, g1);
+                kernel.model.y_now = &yy;
+                st = kernel.model.rate(t, qq, vv, yy, g1);
                 if (!st && block == 2)
-                    st = model.force(t, qq, vv, f);
+                    st = kernel.model.force(t, qq, vv, f);
                 x[j] -= 2.0 * e;
                 if (!st)
-                    st = model.rate(t, qq, vv, yy, g2);
+                    st = kernel.model.rate(t, qq, vv, yy, g2);
                 if (!st && block == 2)
-                    st = model.force(t, qq, vv, f2);
-                model.y_now = &y;
+                    st = kernel.model.force(t, qq, vv, f2);
+                kernel.model.y_now = &y;
                 if (!st) {
                     col_cb = G.col(j);
                     col_fd = (g1 - g2) / (2.0 * e);
@@ -280,39 +284,39 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
     }
     // parameter derivatives against differences in p_j (perturbed in place, as the
     // sensitivities do, and put back)
-    for (int j = 0; j < forward_.sens.np && !st; ++j) {
-        double &p = forward_.sens.p[j];
-        const double p_kept = p, e = step_for(p) * std::max(1.0, forward_.sens.scale[j]);
+    for (int j = 0; j < sens.np && !st; ++j) {
+        double &p = sens.p[j];
+        const double p_kept = p, e = step_for(p) * std::max(1.0, sens.scale[j]);
         const auto at = [&](double value, auto &&eval) {
             p = value;
             const ga_status s2 = eval();
             p = p_kept;
             return s2;
         };
-        if (model.cb.force_p) {
+        if (kernel.model.cb.force_p) {
             Worst w{"df/dp", "f in p"};
             Vec fp(n);
-            st = model.force_p(t, q, v, j, fp);
+            st = kernel.model.force_p(t, q, v, j, fp);
             if (!st)
-                st = at(p_kept + e, [&] { return model.force(t, q, v, f); });
+                st = at(p_kept + e, [&] { return kernel.model.force(t, q, v, f); });
             if (!st)
-                st = at(p_kept - e, [&] { return model.force(t, q, v, f2); });
+                st = at(p_kept - e, [&] { return kernel.model.force(t, q, v, f2); });
             if (!st) {
                 col_fd = (f - f2) / (2.0 * e);
                 compare(w, j, fp, col_fd, 0.0);
                 checked.push_back(w);
             }
         }
-        if (!st && model.cb.mass_p) {
+        if (!st && kernel.model.cb.mass_p) {
             Worst w{"(dM/dp) a", "M a in p, a = qdd"};
             Vec mp(n);
-            st = model.mass_p(t, q, j, qdd, mp);
+            st = kernel.model.mass_p(t, q, j, qdd, mp);
             if (!st)
-                st = at(p_kept + e, [&] { return model.mass(t, q, M2); });
+                st = at(p_kept + e, [&] { return kernel.model.mass(t, q, M2); });
             if (!st) {
                 r1.setZero();
                 M2.multiply_add(1.0, qdd, r1);
-                st = at(p_kept - e, [&] { return model.mass(t, q, M2); });
+                st = at(p_kept - e, [&] { return kernel.model.mass(t, q, M2); });
             }
             if (!st) {
                 r2.setZero();
@@ -322,21 +326,21 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
                 checked.push_back(w);
             }
         }
-        if (!st && m > 0 && model.cb.constraint_p) {
+        if (!st && m > 0 && kernel.model.cb.constraint_p) {
             Worst wp{"dPhi/dp", "Phi in p"}, wj{"dPhi_q/dp", "Phi_q in p"};
             Vec phi_p(m);
             ModelMatrix J_p;
-            J_p.copy_layout(J_);
-            st = model.constraint_p(t, q, j, phi_p, J_p, nullptr);
+            J_p.copy_layout(kernel.matrix(GA_MATRIX_JACOBIAN));
+            st = kernel.model.constraint_p(t, q, j, phi_p, J_p, nullptr);
             if (!st)
                 st = at(p_kept + e, [&] {
-                    const ga_status s2 = model.constraint(t, q, phi1);
-                    return s2 ? s2 : model.jacobian(t, q, J);
+                    const ga_status s2 = kernel.model.constraint(t, q, phi1);
+                    return s2 ? s2 : kernel.model.jacobian(t, q, J);
                 });
             if (!st)
                 st = at(p_kept - e, [&] {
-                    const ga_status s2 = model.constraint(t, q, phi2);
-                    return s2 ? s2 : model.jacobian(t, q, J2);
+                    const ga_status s2 = kernel.model.constraint(t, q, phi2);
+                    return s2 ? s2 : kernel.model.jacobian(t, q, J2);
                 });
             if (!st) {
                 col_fd = (phi1 - phi2) / (2.0 * e);
@@ -356,7 +360,7 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
         }
     }
     if (st) {
-        diag.append(" (ga_check_derivatives)");
+        kernel.diag.append(" (ga_check_derivatives)");
         return st;
     }
     double worst = 0.0;
@@ -366,11 +370,11 @@ ga_status Solver::check_derivatives(double t, const double *q0, const double *v0
         *worst_out = worst;
     if (!(worst > tol))
         return GA_OK;
-    diag.fail(GA_ERR_DERIVATIVE, "derivatives that disagree with central differences "
+    kernel.diag.fail(GA_ERR_DERIVATIVE, "derivatives that disagree with central differences "
               "(relative to their largest entry, tolerance %g):", tol);
     for (const Worst &w : checked)
         if (w.error > tol)
-            diag.append(" %s(%d, %d) = %.6g by the callback, %.6g by differences of %s "
+            kernel.diag.append(" %s(%d, %d) = %.6g by the callback, %.6g by differences of %s "
                         "(relative error %.2g);", w.name, w.row, w.col, w.by_callback,
                         w.by_differences, w.of, w.error);
     return GA_ERR_DERIVATIVE;

@@ -12,12 +12,12 @@
 #include <cmath>
 #include <limits>
 
-#include "solver.hpp"
+#include "stepper.hpp"
 
 namespace ga {
 
 // Transactional: everything is allocated before anything changes.
-void Solver::set_first_order(int r)
+void Stepper::set_first_order(int r)
 {
     State fresh[3];
     for (State &x : fresh)
@@ -40,7 +40,7 @@ void Solver::set_first_order(int r)
 // The w (and y') the step starts from, as a_n (and qdd_n) for q: after a fresh start those of
 // first_order_starting_values; after a change of h, w_n rescaled to the new h,
 // w_n <- y'_n + (h / h_last) (w_n - y'_n), as a_n is (sec. 1.2).
-void Solver::first_order_start(const State &from, double h)
+void Stepper::first_order_start(const State &from, double h)
 {
     const State &s = from;
     w_start_ = &s.w;
@@ -65,7 +65,7 @@ void Solver::first_order_start(const State &from, double h)
 // error where y is smooth (sec. 11, "Stiff start"). Rates that overflow along the polynomial
 // (a stiff nonlinear g) count as such for every state. Fixed steps only: an adaptive step's
 // error control shrinks h until the start is followed. qdd_start_ is the start's qdd.
-ga_status Solver::first_order_starting_values(const State &from, double h)
+ga_status Stepper::first_order_starting_values(const State &from, double h)
 {
     const State &s = from;
     State &x = trial_;  // scratch: the step has not started
@@ -100,7 +100,7 @@ ga_status Solver::first_order_starting_values(const State &from, double h)
 
 // Predictor: w_{n+1} = w_n, so that y'_{n+1} = (w_n - alpha_f1 y'_n) / (1 - alpha_f1) and
 // y_{n+1} = y_n + h w_n (the ConstantA predictor of q).
-void Solver::predict_first_order(double h)
+void Stepper::predict_first_order(double h)
 {
     const State &s = accepted_;
     State &x = trial_;
@@ -112,7 +112,7 @@ void Solver::predict_first_order(double h)
 
 // The coupling blocks at the iterate x where the iteration matrix is built (f_, rate_ from the
 // residual there); the Schur complement follows at the first solve with that matrix.
-ga_status Solver::first_order_matrix(double t, const State &x, bool central)
+ga_status Stepper::first_order_matrix(double t, const State &x, bool central)
 {
     if (auto st = model.coupling(t, x.q, x.v, x.y, f_, rate_, blocks_, central))
         return st;
@@ -133,7 +133,7 @@ void apply_G(const CouplingBlocks &B, double gamma_prime, const Vec &xq, const V
 // factorization, the row scale of h, in index 2 this step's B), C = c1 I - g_y + G Z and its LU.
 // Without coupling_exact, Z = 0 and G = 0: C = c1 I - g_y. Also the norms of C^-1 g_q, C^-1 g_v
 // for the convergence test's scale of y.
-ga_status Solver::first_order_schur(double h, const NewtonCoefficients &c)
+ga_status Stepper::first_order_schur(double h, const NewtonCoefficients &c)
 {
     const int r1 = r();
     const bool index2 = formulation == GA_INDEX2_STABILIZED;
@@ -174,7 +174,7 @@ ga_status Solver::first_order_schur(double h, const NewtonCoefficients &c)
 
 // After the mechanical solve x0 = Sol(r^q, ...) in dq_, dw_, dlambda_, deta_:
 // dy = C^-1 (-r^y + G x0), and the mechanical update x0 - Z dy.
-void Solver::first_order_correction(const NewtonCoefficients &c, Vec &dw)
+void Stepper::first_order_correction(const NewtonCoefficients &c, Vec &dw)
 {
     const bool index2 = formulation == GA_INDEX2_STABILIZED;
     z_y_ = -ry_;
@@ -195,7 +195,7 @@ void Solver::first_order_correction(const NewtonCoefficients &c, Vec &dw)
 
 // y += dy, y' += c1 dy (c1 of this step's h: the relation between them is exact, whatever
 // matrix is kept), and what the stopping test reads.
-void Solver::update_first_order(const NewtonCoefficients &c, double h, State &x,
+void Stepper::update_first_order(const NewtonCoefficients &c, double h, State &x,
                                 UpdateSizes &size)
 {
     const double c1 = first_order_newton_coefficient(params1, h);
@@ -217,7 +217,7 @@ void Solver::update_first_order(const NewtonCoefficients &c, double h, State &x,
 
 // The step's last line for y: w_{n+1} from the converged y'_{n+1}; w_n kept for the error
 // estimate of the next step.
-void Solver::finish_first_order(State &x)
+void Stepper::finish_first_order(State &x)
 {
     const FirstOrderParams &p = params1;
     const Vec &w_n = *w_start_;
@@ -233,7 +233,7 @@ void Solver::finish_first_order(State &x)
 // (0.084 at rho_inf = 0.9, 1/3 at 0; checked against the scheme run on y' = cos t), with y'''
 // from the divided differences of w over the last two steps, as e_v is from those of a
 // (control.cpp; none in the first step). The sum of the squared weighted errors.
-double Solver::first_order_error_sum(double h, double scale)
+double Stepper::first_order_error_sum(double h, double scale, const StepController &control)
 {
     const State &s = accepted_, &x = trial_;
     if (!(s.h_last > 0.0))
@@ -257,7 +257,7 @@ double Solver::first_order_error_sum(double h, double scale)
 }
 
 // Cubic Hermite from y, y' at both ends of the last step, and its derivative.
-ga_status Solver::interpolate_y(double t, double *y, double *ydot)
+ga_status Stepper::interpolate_y(double t, double *y, double *ydot)
 {
     double th = 0.0, h = 0.0;
     if (auto st = dense_.place(t, th, h, diag))

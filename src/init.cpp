@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "redundancy.hpp"
-#include "solver.hpp"
+#include "stepper.hpp"
 
 namespace ga {
 
@@ -41,7 +41,7 @@ Eigen::Index argmax_abs(const Vec &x)
 // A failed ga_init leaves the solver as it was, its state and the constraints in use included:
 // GA_REDUNDANT_DROP selects them at the new q0 before the rest can fail, and the old state
 // stepped on without a constraint it needed (issue 17).
-ga_status Solver::init(double t0, const double *q0, const double *v0)
+ga_status Stepper::init(double t0, const double *q0, const double *v0)
 {
     if (r() > 0 && !initialized_)  // (r is fixed once the solver is set up)
         return diag.fail(GA_ERR_STATE, "%d first-order states declared: the first start "
@@ -58,7 +58,7 @@ ga_status Solver::init(double t0, const double *q0, const double *v0)
     });
 }
 
-ga_status Solver::init_y(double t0, const double *q0, const double *v0, const double *y0)
+ga_status Stepper::init_y(double t0, const double *q0, const double *v0, const double *y0)
 {
     return undoing_a_first_setup([&] {
         if (auto st = setup())
@@ -75,7 +75,7 @@ ga_status Solver::init_y(double t0, const double *q0, const double *v0, const do
 }
 
 // Puts back the constraints in use (in place: the linear algebra holds their address).
-void Solver::restore_active(const std::vector<unsigned char> &before)
+void Stepper::restore_active(const std::vector<unsigned char> &before)
 {
     if (before != active_) {
         std::copy(before.begin(), before.end(), active_.begin());
@@ -83,7 +83,7 @@ void Solver::restore_active(const std::vector<unsigned char> &before)
     }
 }
 
-ga_status Solver::start(double t0, const double *q0, const double *v0)
+ga_status Stepper::start(double t0, const double *q0, const double *v0)
 {
     invalidate_jacobian();
     jacobian_valid_ = false;
@@ -111,7 +111,7 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
 
     if (r() > 0)
         model.y_now = &x.y;  // start() callers put y0 into trial_.y
-    if (auto st = on_start(x))  // first: differences leave the matrices at a perturbed p
+    if (auto st = doors_->on_start(x))  // first: differences leave the matrices at a perturbed p
         return st;
     if (auto st = consistent_accelerations(t0, x.q, x.v, x.qdd, x.lambda)) {
         diag.append(" (consistent initial accelerations at t0 = %.17g)", t0);
@@ -131,12 +131,11 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
     x.c_count = 1;
 
     accepted_.swap(trial_);
-    on_started();
+    doors_->on_started();
     ++state_id_;
     initialized_ = true;
     previous_valid_ = false;
     start_pending_ = true;  // corrected starting values need the h of the first step
-    control.reset();  // no accepted step: no proposal, no base for a prediction
     if (formulation == GA_INDEX2_STABILIZED)
         prefactor_index2();
     return GA_OK;
@@ -144,7 +143,7 @@ ga_status Solver::start(double t0, const double *q0, const double *v0)
 
 // [M Phi_q^T; Phi_q 0] [qdd; lambda] = [f; -(Phi_qq(v,v) + 2 Phi_qt v + Phi_tt)] at (t, q, v),
 // with the step's matrix S_ and scratch. Leaves M_, f_, J_ at q.
-ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v, Vec &qdd,
+ga_status Stepper::consistent_accelerations(double t, const Vec &q, const Vec &v, Vec &qdd,
                                            Vec &lambda)
 {
     SaddleWorkspace w{S_, M_, J_, f_, c_, rq_};
@@ -162,7 +161,7 @@ ga_status Solver::consistent_accelerations(double t, const Vec &q, const Vec &v,
 // sec. 3.3, 10) in the workspace w. The first block row is multiplied by
 // sigma = max|Phi_q| / max|M| (active constraints) so that both blocks have the same size;
 // the unknown in the second block is then sigma lambda.
-ga_status Solver::acceleration_level(double t, const Vec &q, const Vec &v, SaddleWorkspace &w,
+ga_status Stepper::acceleration_level(double t, const Vec &q, const Vec &v, SaddleWorkspace &w,
                                      Vec &qdd, Vec &lambda)
 {
     ga_status st = GA_OK;
@@ -222,7 +221,7 @@ ga_status Solver::acceleration_level(double t, const Vec &q, const Vec &v, Saddl
 
 // GA_REDUNDANT_DROP: the constraints that depend on the ones before them are dropped
 // (redundancy.hpp).
-ga_status Solver::select_active_constraints(double t, const Vec &q)
+ga_status Stepper::select_active_constraints(double t, const Vec &q)
 {
     if (auto st = model.jacobian(t, q, J_))
         return st;
@@ -240,7 +239,7 @@ ga_status Solver::select_active_constraints(double t, const Vec &q)
 // than m (redundant constraints: the ones that depend on the constraints before them are
 // named -- those GA_REDUNDANT_DROP would drop), or M is singular on the null space of Phi_q
 // (a massless coordinate that no constraint fixes). ga_init only (it allocates).
-void Solver::explain_singular_saddle_point()
+void Stepper::explain_singular_saddle_point()
 {
     // A row of zeros is no redundancy to drop but a constraint degenerate at this q (the
     // square of a distance that is zero, a Jacobian callback that left the row out).
@@ -292,7 +291,7 @@ void Solver::explain_singular_saddle_point()
 // velocity offset that lets the first step absorb its own position error
 // l_0 = h^3 (1 - 6 beta - 3 delta_alpha)/6 qddd_0 instead of passing it to a_1 and lambda.
 // Without them lambda carries an O(h) transient (index 3) or an O(delta_alpha h) one (index 2).
-ga_status Solver::starting_values(const State &from, double h)
+ga_status Stepper::starting_values(const State &from, double h)
 {
     const State &s = from;
     const Params &p = params;
@@ -332,7 +331,7 @@ ga_status Solver::starting_values(const State &from, double h)
     return GA_OK;
 }
 
-ga_status Solver::project_positions(double t, Vec &q)
+ga_status Stepper::project_positions(double t, Vec &q)
 {
     if (auto st = model.constraint(t, q, phi_))
         return st;
@@ -379,7 +378,7 @@ ga_status Solver::project_positions(double t, Vec &q)
 // v <- v + dv, the minimum-norm correction with Phi_q v + Phi_t = 0, from J_ = Phi_q(q),
 // c_ = Phi_t and phi_ = Phi_q v + Phi_t (linear: one correction, plus one pass of refinement
 // for round-off). Leaves phi_ at the corrected v.
-ga_status Solver::correct_velocities(Vec &v, const char *what)
+ga_status Stepper::correct_velocities(Vec &v, const char *what)
 {
     count(counters, GA_COUNT_FACTORIZATIONS);
     if (!S_.factorize_projection(J_))
@@ -398,7 +397,7 @@ ga_status Solver::correct_velocities(Vec &v, const char *what)
     return GA_OK;
 }
 
-ga_status Solver::project_velocities(double t, const Vec &q, Vec &v)
+ga_status Stepper::project_velocities(double t, const Vec &q, Vec &v)
 {
     // Velocity constraint w = Phi_q v + Phi_t.
     if (auto st = model.jacobian(t, q, J_))

@@ -117,7 +117,7 @@ public:
 
     // Callback values are checked for NaN and Inf as they come (Now), or by the caller
     // (Deferred) through a result that every value enters, with check_deferred() naming the
-    // culprit only if that result is not finite: Solver::residual checks r^q, which takes in
+    // culprit only if that result is not finite: Stepper::residual checks r^q, which takes in
     // every entry of f and Phi_q, instead of f and Phi_q (at 100 000 chain links 6 MB less
     // to read per Newton iteration).
     enum class Check { Now, Deferred };

@@ -10,11 +10,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "solver.hpp"
+#include "stepper.hpp"
 
 namespace ga {
 
-void Solver::setup_output()
+void Stepper::setup_output()
 {
     if (O_.ready() || !workspace_ready_)
         return;
@@ -34,7 +34,7 @@ void Solver::setup_output()
 }
 
 // qdd, lambda from the acceleration-level equations at (t, q, v) into out_qdd_, out_lambda_.
-ga_status Solver::consistent_output(double t, const Vec &q, const Vec &v, const char *purpose)
+ga_status Stepper::consistent_output(double t, const Vec &q, const Vec &v, const char *purpose)
 {
     if (!O_.ready())
         return diag.fail(GA_ERR_INTERNAL, "the workspace of consistent output was not set up");
@@ -53,7 +53,7 @@ ga_status Solver::consistent_output(double t, const Vec &q, const Vec &v, const 
     return st;
 }
 
-ga_status Solver::output_state(double *qdd, double *lambda)
+ga_status Stepper::output_state(double *qdd, double *lambda)
 {
     const State &x = accepted_;
     if (output != GA_OUTPUT_CONSISTENT) {
@@ -78,7 +78,7 @@ ga_status Solver::output_state(double *qdd, double *lambda)
 
 // Dense output (dense_output.hpp), with GA_OUTPUT_CONSISTENT's accelerations and multipliers
 // solved at the interpolated (q, v).
-ga_status Solver::interpolate(double t, double *q, double *v, double *qdd, double *lambda)
+ga_status Stepper::interpolate(double t, double *q, double *v, double *qdd, double *lambda)
 {
     double th = 0.0, h = 0.0;
     if (auto st = dense_.place(t, th, h, diag))

@@ -9,7 +9,7 @@
 #include <cmath>
 #include <limits>
 
-#include "solver.hpp"
+#include "stepper.hpp"
 
 namespace ga {
 
@@ -19,7 +19,7 @@ constexpr double kNewtonFloorUlps = 64.0;  // the Newton test's round-off floor 
 
 // After the step's Newton iteration converged: trial_ holds the step, J_ Phi_q at the last
 // iterate but one (within Newton's tolerance of q_{n+1}); tol: that iteration's tolerance.
-ga_status Solver::check_velocity_constraint(double h, double tol)
+ga_status Stepper::check_velocity_constraint(double h, double tol)
 {
     velocity_residual_ = 0.0;
     if (formulation != GA_INDEX3 || m_ == 0 || !(max_velocity_residual < kNoCheck))

@@ -10,7 +10,8 @@
 #include <cmath>
 #include <limits>
 
-#include "solver.hpp"
+#include "sensitivity.hpp"
+#include "stepper.hpp"
 
 namespace ga {
 
@@ -263,6 +264,30 @@ void ForwardSensitivity::on_undo()
 {
     if (sens.forward)
         sens.accepted.swap(sens.trial);
+}
+
+std::size_t ForwardSensitivity::checkpoint_size() const
+{
+    const std::size_t nv = static_cast<std::size_t>(k_.nv()), r = static_cast<std::size_t>(k_.r());
+    return static_cast<std::size_t>(sens.np) * (4 * nv + static_cast<std::size_t>(k_.m()) + 3 * r);
+}
+
+void ForwardSensitivity::save_checkpoint(double *p) const
+{
+    for (const StateDerivative &d : sens.accepted)
+        for (const Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a, &d.y, &d.ydot, &d.w}) {
+            Eigen::Map<Vec>(p, x->size()) = *x;
+            p += x->size();
+        }
+}
+
+void ForwardSensitivity::load_checkpoint(const double *p)
+{
+    for (StateDerivative &d : sens.accepted)
+        for (Vec *x : {&d.q, &d.v, &d.qdd, &d.lambda, &d.a, &d.y, &d.ydot, &d.w}) {
+            *x = Eigen::Map<const Vec>(p, x->size());
+            p += x->size();
+        }
 }
 
 // Before an attempt: the starts that are not the linear map of the step before -- a Taylor

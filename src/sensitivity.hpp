@@ -4,6 +4,7 @@
 // sensitivity.cpp), attached to the step transaction at its doors.
 #pragma once
 
+#include <cstddef>
 #include <utility>
 #include <vector>
 
@@ -79,7 +80,7 @@ struct Sensitivities {
     double extrapolated_increment(int j) const;
 };
 
-class Solver;
+class Stepper;
 
 // The forward sensitivities as a service of the step (docs/algorithms.md sec. 13): their start
 // at ga_init, the starts by differences before Taylor steps and fresh starts, the linear step
@@ -88,7 +89,7 @@ class Solver;
 // solver's kernel (`k_`): the start functions, the exact iteration matrix and its solves.
 class ForwardSensitivity {
 public:
-    explicit ForwardSensitivity(Solver &kernel) : k_(kernel) {}
+    explicit ForwardSensitivity(Stepper &kernel) : k_(kernel) {}
     ForwardSensitivity(const ForwardSensitivity &) = delete;
     ForwardSensitivity &operator=(const ForwardSensitivity &) = delete;
 
@@ -107,6 +108,10 @@ public:
     ga_status step(double h);  // after a step converged
     void on_commit();          // after the states' swap
     void on_undo();            // after undo_step's swaps
+    // Their tail of a checkpoint: d/dp_j of q, v, qdd, lambda, a, y, y', w for each j.
+    std::size_t checkpoint_size() const;
+    void save_checkpoint(double *p) const;
+    void load_checkpoint(const double *p);
 
     // d/dp_j of the residual and the constraints at a converged step x (into sens.rq, sens.ry,
     // sens.cq, cl, cv, cbt), and -d/dq (Phi_q^T eta) s: the forward step's and the adjoint's.
@@ -126,7 +131,7 @@ private:
     ga_status by_differences(const State &accepted, double h, bool taylor_step, bool restart_short);
 
     State scratch_;  // the accepted state moved along a derivative (by_differences)
-    Solver &k_;
+    Stepper &k_;
 };
 
 }  // namespace ga

@@ -1,142 +1,46 @@
-// ga::Solver: the state (t, q, v, qdd, lambda, a), the options, one step of Algorithm 1 (or of
-// its stabilized index-2 variant) with commit/rollback and the reuse of the iteration matrix.
-// The consistent start lives in init.cpp, the adaptive loop and its error estimate in
-// control.cpp, dense output in dense_output.hpp and output.cpp, the calls in transaction.cpp.
+// ga::Solver, the step transaction: it owns the step kernel (Stepper), the step-size
+// controller, and the services -- forward sensitivities, the adjoint, the event search, the
+// step hook -- and is the one place that knows their order (transaction.cpp). The kernel calls
+// the services only at its doors (StepDoors); the services after a commit see the step through
+// StepOutput.
 #pragma once
 
-#include <atomic>
-#include <limits>
 #include <cstddef>
 
-#include "diagnostics.hpp"
+#include "adjoint.hpp"
 #include "events.hpp"
-#include "linear/index2_matrix.hpp"
-#include "linear/iteration_matrix.hpp"
-#include "model.hpp"
-#include "newton.hpp"
-#include "params.hpp"
+#include "sensitivity.hpp"
 #include "step_controller.hpp"
+#include "step_doors.hpp"
 #include "step_hook.hpp"
 #include "step_output.hpp"
-#include "adjoint.hpp"
-#include "sensitivity.hpp"
-#include "step_plan.hpp"
-#include "dense_output.hpp"
-#include "state.hpp"
+#include "stepper.hpp"
 
 namespace ga {
 
-// The matrix and scratch of an acceleration-level solve (init.cpp): the step's own at the
-// consistent start, separate ones for consistent output, so that reading the output never
-// touches what the next step reuses.
-struct SaddleWorkspace {
-    IterationMatrix &K;
-    ModelMatrix &M, &J;
-    Vec &f, &c, &r;
-    bool mass_given = false;      // M holds the constant mass matrix already
-    bool mass_evaluated = false;  // set by the solve
-    double sigma = 1.0;           // set by the solve: the first block row's scaling
-};
-
-// Puts a value back when the scope ends, however it ends: options an attempt changes for
-// itself stay as they were when a C++ callback throws through it.
-template <class T>
-class Restore {
-public:
-    explicit Restore(T &x) : x_(x), value_(x) {}
-    ~Restore() { x_ = value_; }
-    Restore(const Restore &) = delete;
-    Restore &operator=(const Restore &) = delete;
-
-private:
-    T &x_;
-    T value_;
-};
-
-// The live run's kept iteration matrix (and the first-order blocks factorized with it),
-// set aside while a sweep recomputes segments in matrices of their own (adjoint.cpp).
-struct KeptMatrix {
-    IterationMatrix S;
-    Index2Matrix S2;
-    CouplingBlocks blocks;
-};
-
-class Solver : private StepOutput {
+class Solver : private StepOutput, private StepDoors {
 public:
     Solver(int n, int m);
-    Solver(const Solver &) = delete;  // (dense_ refers to its own states)
+    Solver(const Solver &) = delete;
     Solver &operator=(const Solver &) = delete;
 
-    int nq() const { return nq_; }  // q's coordinates
-    int nv() const { return nv_; }  // v's, and those of every increment of q
-    int m() const { return m_; }
-
-    // Options (validated by the C API before they get here).
-    Params params;
-    // Newton tolerance (ga_set_newton); 0 = automatic, see newton_tolerance().
-    double newton_tol = 0.0;
-    int max_iter = 20;
-    bool scaling = true;
-    ga_predictor predictor = GA_PREDICTOR_EXTRAPOLATE;
-    ga_init_mode init_mode = GA_INIT_PROJECT;
-    double init_tol = 1e-10;
-    ga_reuse_mode reuse = GA_REUSE_AUTO;
-    ga_linear_solver linear_solver = GA_LINEAR_AUTO;
-    ga_formulation formulation = GA_INDEX3;
-    ga_redundancy redundancy = GA_REDUNDANT_REFUSE;
-    ga_output output = GA_OUTPUT_CONSISTENT;
-    bool rescale_a = true;
-    bool corrected_start = true;
+    // The kernel: the options, the state, the output; and its model and diagnostics, which
+    // every call of the C API reaches.
+    Stepper &kernel() { return k_; }
+    const Stepper &kernel() const { return k_; }
+    Diagnostics &diag;
+    Model &model;
     StepController control;  // step sizes of adaptive mode (step_controller.hpp)
-    // First-order states: the method's parameters (from rho_inf, or from alpha_f after
-    // ga_set_params) and whether the coupling blocks are in the iteration matrix.
-    FirstOrderParams params1;
-    bool coupling_exact = true;
-    // ga_set_resolution_check: the index-3 step's largest velocity-constraint residual
-    // (resolution_check.cpp). Resolved runs stay below 3e-3 (the shipped scenes at every h where
-    // they converge at order 2, a pendulum up to 0.25 rad per step at every rho_inf); the
-    // rotating pendulum's energy was 7 % off when its residual crossed 0.02.
-    static constexpr double kNoCheck = std::numeric_limits<double>::infinity();
-    double max_velocity_residual = 0.02;
-    int r() const { return model.first_order_count(); }
-    // Declares r first-order states (before setup; allocates the states' vectors).
-    void set_first_order(int r);
-    // ga_init_y: ga_init with y0.
+
+    // ga_init, ga_init_y (init.cpp: the kernel's consistent start, with the doors).
+    ga_status init(double t0, const double *q0, const double *v0);
     ga_status init_y(double t0, const double *q0, const double *v0, const double *y0);
-    ga_status interpolate_y(double t, double *y, double *ydot);
-
-    Counters counters{};
-    Diagnostics diag;
-    Model model;
-
-    // Layout of the user's matrices (dense unless a pattern was declared); fixed at setup.
-    ModelMatrix &matrix(ga_matrix which);
-    bool setup_done() const { return workspace_ready_; }
-    // Allocates the stabilized index-2 system if the workspace exists and it does not yet;
-    // throws std::bad_alloc.
-    void setup_index2();
-    const char *linear_backend() const;
-
-    bool initialized() const { return initialized_; }
-    // Constraints in use (1) or dropped as redundant (0); all 1 unless GA_REDUNDANT_DROP.
-    bool constraint_active(int i) const { return active_.empty() || active_[i] != 0; }
-    const State &state() const { return accepted_; }
-
-    ga_status init(double t0, const double *q0, const double *v0);  // init.cpp
-    // One step of size h (transaction.cpp); with events GA_EVENT when a terminal one fired.
+    // One step of size h; with events GA_EVENT when a terminal one fired.
     ga_status step(double h);
-    // Adaptive mode (transaction.cpp): one controlled step, not beyond t_stop (landing on it
-    // exactly if it is reached); or steps until t_out exactly.
+    // Adaptive mode: one controlled step, not beyond t_stop (landing on it exactly if it is
+    // reached); or steps until t_out exactly.
     ga_status step_adaptive(double t_stop);
     ga_status advance(double t_out);
-    // Output (output.cpp): qdd and lambda at the accepted state, consistent with (q, v) or the
-    // step's own (ga_output); dense output inside the last step (any pointer may be null).
-    // They evaluate callbacks in GA_OUTPUT_CONSISTENT, and do not touch what steps reuse.
-    ga_status output_state(double *qdd, double *lambda);
-    ga_status interpolate(double t, double *q, double *v, double *qdd, double *lambda);
-    // Allocates the workspace of consistent output if the solver's workspace exists and it
-    // does not yet; throws std::bad_alloc.
-    void setup_output();
 
     // Forward sensitivities (ForwardSensitivity, sensitivity.cpp): the C API validated the
     // arguments; allocates (std::bad_alloc leaves the set before).
@@ -148,118 +52,57 @@ public:
     ga_status adjoint_gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, double *dJ);
     ga_status set_adjoint_checkpoints(long interval, long count);
 
-    // The step hook (ga_set_step_hook), called by step, step_adaptive and advance.
-    void set_step_hook(const StepHook &hook);  // transaction.cpp; throws std::bad_alloc
+    // The step hook (ga_set_step_hook), called by step, step_adaptive and advance; throws
+    // std::bad_alloc.
+    void set_step_hook(const StepHook &hook);
 
     // Events (events.cpp): the functions watched, where their search stands, the last log.
     EventSet &events() { return events_; }
     const EventSet &events() const { return events_; }
 
-    // Anything that changes the iteration matrix (options, callbacks) calls this.
-    void invalidate_jacobian() const
-    {
-        output_for_ = -1;
-        out_mass_valid_ = false;
-        jacobian_valid_ = false;
-        theta_prev_ = -1.0;
-        mass_valid_ = false;
-        refresh_steps_left_ = 0;
-        reuse_backoff_ = 1;
-        fd_tangents_ = false;
-    }
-
-    // An option or callback that shapes the tangents changed (ga_set_tangents,
-    // ga_set_tangent_mode, ga_set_constant_mass): a fresh matrix, and after setup the
-    // finite-difference scratch the new choice needs, allocated here rather than in a step.
-    // GA_ERR_ARG if the sparse path has no place for a tangent now needed; may throw
-    // std::bad_alloc. The caller puts its option back when this fails.
-    ga_status tangent_options_changed();
-
-    // For bench/: the unavoidable work of a step, done once at the current state -- one
-    // residual evaluation (callbacks and r^q, r^lambda) and one solve with the factorization
-    // at hand (made first if there is none). The per-step cost is measured against it.
-    ga_status unavoidable_work(double h);
-
-    double last_rcond() const;
-    int last_newton_iters() const { return last_newton_iters_; }
-    double last_newton_ratio() const { return convergence_.ratio(); }
-    double last_velocity_residual() const { return velocity_residual_; }
-    // derivative_check.cpp: ga_check_derivatives (the C API validated the pointers)
+    // ga_check_derivatives (derivative_check.cpp; the C API validated the pointers)
     ga_status check_derivatives(double t, const double *q, const double *v, const double *qdd,
-                                const double *lambda, const double *y, double tol,
-                                double *worst);
+                                const double *lambda, const double *y, double tol, double *worst);
 
-    // Checkpoint (checkpoint.cpp, layout 4): the state, the step-size control, and what
-    // rebuilds the kept iteration matrix and the pivots of every sparse LU bit for bit, so
-    // that taking one changes nothing and a restored run continues as the run it came from.
-    // Layout 2 (galpha 0.2: the state and the control only) is read as a restart, layout 3
-    // (no consistent accelerations for the index-3 error estimate) as a state without them.
+    // Checkpoint (checkpoint.cpp, layout 4): the kernel's share with the controller's
+    // entries, then the forward sensitivities' tail. internal: the adjoint sweep's own
+    // restores into a recorded run; keep_matrix (internal): the kept iteration matrix is the
+    // one of this checkpoint already (set aside and taken back): not rebuilt.
     std::size_t state_size() const;
-    std::size_t state_size_in(bool layout3) const;  // 4, or layout 3's
     void get_state(double *buf) const;
-    // internal: the adjoint sweep's own restores into a recorded run
-    // keep_matrix (internal): the kept iteration matrix is the one of this checkpoint already
-    // (set aside and taken back): not rebuilt
     ga_status set_state(const double *buf, std::size_t len, bool internal = false,
                         bool keep_matrix = false);
-    ga_status restore_state(const double *buf, std::size_t len, bool internal, bool keep_matrix);
 
 private:
-    // The first ga_init, ga_init_y or ga_set_state sets the solver up; when it fails (an
-    // exception included) it leaves it as before: not set up, so that what set-up fixes
-    // (patterns, first-order states, the linear solver, redundancy) can still be declared.
-    template <class Call>
-    ga_status undoing_a_first_setup(Call &&call)
-    {
-        struct Undo {
-            Solver &s;
-            bool was_set_up;
-            ~Undo()
-            {
-                if (!was_set_up && !s.initialized_)
-                    s.forget_setup();
-            }
-        } undo{*this, workspace_ready_};
-        return call();
-    }
-    void forget_setup();
+    // The doors (step_doors.hpp) and the two the transaction opens itself: an attempt that
+    // converged and passed the error test (a failure fails the step), an attempt rejected.
+    ga_status on_start(const State &x) override;
+    void on_started() override;
+    void on_setup() override;
+    ga_status before_attempt(const StepPlan &plan) override;
+    void on_commit() override;
+    void on_undo() override;
+    ga_status on_converged(double h);
+    void on_rejection();
 
-    ga_status setup();  // chooses the backend and allocates everything; throws std::bad_alloc
-    ga_status setup_workspace();  // the part every formulation and option needs
-    void setup_projection();
-    void prefactor_index2();
+    // Newton's tolerance: the option, or automatic (a fraction of the local tolerance).
     double newton_tolerance(bool adaptive) const;
-    // sliver_allowed: a step over kShortStepRatio times shorter than the one before is a
-    // Taylor step (sliver_step)
-    StepPlan plan_step(double h, double tol, bool sliver_allowed) const;
-    ga_status attempt_step(double h, double tol, bool sliver_allowed);
-    ga_status regular_step(const StepPlan &plan);
-    ga_status sliver_step(const State &from, double h);
-    // A step this many times shorter than the one before is a Taylor step that ends like a
-    // restart (sliver_step).
-    static constexpr double kShortStepRatio = 100.0;
-    ga_status newton(double h, double tol, bool refresh, bool &converged, bool &used_stale);
-    ga_status take_step(double h);               // ga_step's step, without events
-    ga_status adaptive_step(double t_stop);      // control.cpp: ga_step_adaptive's, likewise
+    ga_status take_step(double h);           // ga_step's step, without events
+    ga_status adaptive_step(double t_stop);  // ga_step_adaptive's, likewise
     // What a step changes besides the states, so that a step whose event search fails after
     // its commit can be undone (the controller's state only after an adaptive step).
     struct StepUndo {
         bool previous_valid, start_pending, adaptive;
     };
+    StepUndo undo_point(bool adaptive) const
+    {
+        return StepUndo{k_.previous_valid(), k_.start_pending(), adaptive};
+    }
     StepController undo_control_;  // the controller before the step (adaptive steps)
     void undo_step(const StepUndo &u);
-    // The doors of a step where the services that need its matrices attach (transaction.cpp)
-    ga_status on_start(const State &x);
-    void on_started();
-    void on_setup();
-    ga_status before_attempt(const StepPlan &plan);
-    ga_status on_converged(double h);
-    void on_rejection();
-    void on_commit();
-    void on_undo();
-    // transaction.cpp: a step (take_step(h), or adaptive_step(t_stop) if adaptive) with the
-    // event search after it; a failure of either leaves the solver as it was and the search
-    // as the caller saved it.
+    // A step (take_step(h), or adaptive_step(t_stop) if adaptive) with the event search after
+    // it; a failure of either leaves the solver as it was and the search as the caller saved
+    // it.
     ga_status step_with_events(bool adaptive, double h_or_t_stop);
     ga_status adaptive_step_with_events(double t_stop) { return step_with_events(true, t_stop); }
     ga_status watched_step(bool adaptive, double h_or_t_stop);
@@ -270,8 +113,10 @@ private:
     // multipliers or a throwing hook undoes that step.
     ga_status hooked(bool adaptive, double arg, ga_status (Solver::*step)(double));
     ga_status hooked_step(bool adaptive, double arg, ga_status (Solver::*step)(double));
-    StepHook hook_;
-    // What the services after a commit see (step_output.hpp, transaction.cpp)
+    ga_status restore_state(const double *buf, std::size_t len, bool internal, bool keep_matrix);
+    std::size_t sensitivity_tail() const;
+
+    // What the services after a commit see (step_output.hpp)
     double time() const override;
     const double *positions() const override;
     const double *velocities() const override;
@@ -280,169 +125,12 @@ private:
     ga_status interpolate_at(double t, double *q, double *v, double *lambda) override;
     ga_status interpolate_y_at(double t, double *y) override;
     Model &callbacks() override;
-    ga_status residual(double t, const State &x);
-    // first_order.cpp: the parts of a step that concern first-order states.
-    void first_order_start(const State &from, double h);
-    void predict_first_order(double h);
-    ga_status first_order_matrix(double t, const State &x, bool central = false);
-    // The mechanical update depends on dy: f_y is in the Newton system (Z = Sol(f_y) != 0).
-    bool forces_see_y() const { return coupling_exact && model.cb.force_y != nullptr; }
-    ga_status first_order_schur(double h, const NewtonCoefficients &c);
-    void first_order_correction(const NewtonCoefficients &c, Vec &dw);
-    void update_first_order(const NewtonCoefficients &c, double h, State &x, UpdateSizes &size);
-    void finish_first_order(State &x);
-    ga_status first_order_starting_values(const State &from, double h);
-    double first_order_error_sum(double h, double scale);
-    // The start of a step from `from` (a_start_, v_start_, qdd_start_, lambda_start_ and
-    // fresh_start_, which point into it): rescaled, corrected, or consistent again after
-    // short steps. `from` is accepted_, or a perturbed copy (sensitivity_by_differences).
-    ga_status prepare_start(const State &from, double h, bool restart_short);
-    static bool long_after_short(const State &from, double h)
-    {
-        return from.h_last > 0.0 && h > kShortStepRatio * from.h_last;
-    }
-    // M, f, Phi_q and every tangent at the converged step x (the user's callbacks whatever the
-    // tangent mode, or central differences), into M_, f_, J_, K_, C_, Z_; which tangents exist.
-    ga_status exact_tangents(double t, const State &x, bool &K, bool &C, bool &Z);
-    friend class ForwardSensitivity;
-    ForwardSensitivity forward_{*this};
-    friend class Adjoint;
-    Adjoint adjoint_{*this, forward_};
-    void set_aside_matrix(KeptMatrix &kept);  // allocates the replay's matrices
-    void take_back_matrix(KeptMatrix &kept);
-    Vec eta_total_;       // index 2: the converged step's eta_bar (sum of its increments)
-    ga_status factorize(double t, const State &x, double h, bool tangents_K, bool tangents_C,
-                        bool tangent_Z, int iter);
-    ga_status rebuild_matrix();  // checkpoint.cpp: the kept matrix again, from recipe_
-    ga_status evaluate_mass(double t, const Vec &q);
-    void commit(bool land_on, double t_land);
-    // control.cpp: the error norm of trial_ (a step of h ending at t_end)
-    ga_status error_norm(double h, double t_end, double &err);
-    bool consistent_estimate() const;
-    // the estimate from a (docs/algorithms.md sec. 1.5, (a) and (b)) of trial_, into e_q, e_v
-    void estimate_from_a(double h, Vec &e_q, Vec &e_v) const;
-    // noise_q, noise_v: absolute amounts of the estimates that are noise, added to the weights
-    double weighted_error_norm(const State &s, const State &x, const Vec &eq, const Vec &ev,
-                               double h, double noise_q = 0.0, double noise_v = 0.0);
-    // init.cpp
-    ga_status start(double t0, const double *q0, const double *v0);
-    void restore_active(const std::vector<unsigned char> &before);
-    ga_status project_positions(double t, Vec &q);
-    ga_status project_velocities(double t, const Vec &q, Vec &v);
-    ga_status correct_velocities(Vec &v, const char *what);
-    ga_status consistent_accelerations(double t, const Vec &q, const Vec &v, Vec &qdd,
-                                       Vec &lambda);
-    ga_status acceleration_level(double t, const Vec &q, const Vec &v, SaddleWorkspace &w,
-                                 Vec &qdd, Vec &lambda);
-    ga_status starting_values(const State &from, double h);
-    void explain_singular_saddle_point();
-    ga_status select_active_constraints(double t, const Vec &q);
-    const unsigned char *active_ptr() const { return active_.empty() ? nullptr : active_.data(); }
 
-    int nq_, nv_, m_;  // equal while the space is R^n (configuration_space.hpp)
-    std::vector<unsigned char> active_;  // GA_REDUNDANT_DROP: constraints in use
-    bool initialized_ = false;
-    bool workspace_ready_ = false;
-    bool sparse_backend_ = false;
-    int last_newton_iters_ = 0;
-
-    State accepted_;  // the last accepted step: never touched by a step that fails
-    State trial_;     // the step being computed
-    State previous_;  // the accepted step before (dense output)
-    bool previous_valid_ = false;
-    DenseOutput dense_{previous_, accepted_, previous_valid_, model.space};  // the last step
-    bool start_pending_ = false;  // first step after ga_init (or a restart): corrected start
-
-    // The start of the step being computed: a_n rescaled to h (docs/algorithms.md 1.2) and, in the
-    // first step, the corrected a_0 and v_0 (sec. 3.4-3.5).
-    Vec a_n_, v_n_;
-    // A step far longer than the one before starts from consistent accelerations and
-    // multipliers (as at ga_init): those of steps of 1e-8 in index 3 are known only to
-    // eps / (beta h^2), of the order of themselves.
-    Vec qdd_n_, lambda_n_;
-    // The a_n, v_n and qdd_n the step starts from: accepted_'s own, or the adjusted ones above
-    // (no copy of a vector the step only reads: at 100 000 chain links each costs 2.4 MB of
-    // memory traffic).
-    const Vec *a_start_ = nullptr, *v_start_ = nullptr, *qdd_start_ = nullptr,
-              *lambda_start_ = nullptr;
-    bool fresh_start_ = false;  // this step starts like a first one
-
-    // Reuse of the factorized iteration matrix across iterations and steps.
-    mutable bool jacobian_valid_ = false;
-    mutable double theta_prev_ = -1.0;   // contraction rate seen with the current matrix
-    mutable bool mass_valid_ = false;    // constant mass: M evaluated
-    mutable int refresh_steps_left_ = 0; // steps to start with a fresh matrix
-    mutable int reuse_backoff_ = 1;      // ... after the next failed attempt to reuse
-    bool reuse_attempted_ = false;       // this step started with an old matrix
-    double jacobian_h_ = 0.0;
-    // GA_TANGENT_AUTO with a tangent callback missing: finite differences for it only once a
-    // fresh matrix without it contracted slower than kDeferredTangentRate (or failed). The
-    // choice is made again whenever the matrix is dropped.
-    static constexpr double kDeferredTangentRate = 0.1;
-    mutable bool fd_tangents_ = false;
-    // A checkpoint of layout 2 was restored: the next step forgets the pivots (set_state).
-    bool pivots_forgotten_ = false;
-    void forget_pivots();  // of every sparse LU: the next factorizations choose them afresh
-    // What rebuilds the kept iteration matrix bit for bit (checkpoint): the time, iterate and
-    // h it was factorized at, the tangents it holds and, in index 2, the q_n of B = Phi_q(q_n).
-    struct MatrixRecipe {
-        double t = 0.0, h = 0.0, t_b = 0.0;
-        bool K = false, C = false, Z = false;
-        bool central = false;  // tangents by central differences (the sensitivities' matrix)
-        Vec q, v, qdd, lambda, q_b;
-        Vec y, ydot;  // first-order states
-    } recipe_;
-    double b_t_ = 0.0;            // where B_ was evaluated last (index 2)
-    const Vec *b_q_ = nullptr;
-    bool tangents_deferred_ = false;  // the last Newton iteration ran without them
-
-    // Consistent output (output.cpp): its own saddle-point matrix and scratch, and the
-    // accepted state its values belong to (state_id_ counts accepted states).
-    ga_status consistent_output(double t, const Vec &q, const Vec &v,
-                                const char *purpose = "output");
-    IterationMatrix O_;
-    ModelMatrix out_M_, out_J_;
-    Vec out_f_, out_c_, out_r_, out_q_, out_v_, out_qdd_, out_lambda_;
-    long long state_id_ = 0;
-    mutable long long output_for_ = -1;
-    mutable bool out_mass_valid_ = false;
-    double out_sigma_ = 1.0;  // O_'s scaling of its first block row (acceleration_level)
-
-    // Step workspace, sized once.
-    ModelMatrix M_, J_, K_, C_, B_;  // B_: index-2, Phi_q(q_n)
-    ModelMatrix Z_;                  // index-2: d(Phi_q v + Phi_t)/dq, layout of J_
-    Vec f_, phi_, phi_v_, rq_, dq_, dw_, dlambda_, deta_, c_, qdd_tmp_, lambda_tmp_;
-    Vec guard_q_, guard_v_;  // index-3 error estimate: the estimate from a (control.cpp)
-    bool estimate_is_output_ = false;  // its accelerations are the consistent output's
-    // resolution_check.cpp: the index-3 step's velocity constraint, and its largest ratio
-    ga_status check_velocity_constraint(double h, double tol);
-    Vec check_residual_, check_scale_, check_phi_t_;
-    double velocity_residual_ = 0.0;
-    IterationMatrix S_;
-    IterationMatrix P_;  // [I Phi_q^T; Phi_q 0]: tangent projection of error estimates
-    Index2Matrix S2_;
-    ConvergenceTest convergence_;
-
+    Stepper k_;
+    ForwardSensitivity forward_{k_};
+    Adjoint adjoint_{k_, forward_, *this};
     EventSet events_;
-
-    // First-order states (first_order.cpp): the coupling blocks (evaluated with the iteration
-    // matrix); the responses Z of the mechanical solve to the columns of f_y (dq, dw, dlambda,
-    // deta) and the Schur complement C = c1 I - g_y + G Z with its LU, valid for the kept
-    // matrix, its h and (index 2) its step's B; the residual r^y = y' - g and scratch. w_n_ is
-    // the w the step starts from when it is rescaled or corrected.
-    CouplingBlocks blocks_;
-    bool schur_valid_ = false;
-    double schur_h_ = 0.0;
-    Mat Zq_, Zw_, Zl_, Ze_, C1_, Cg_;
-    Eigen::PartialPivLU<Mat> C1_lu_;
-    Vec z_rhs_, z_zero_, z_d_, z_w_, z_l_, z_e_, z_y_;
-    Vec rate_, ry_, gx_, dy_, w_n_, y_tmp_;  // gx_: G x0, or scratch of the start
-    Vec ydot_n_;  // the start's y' as a fresh start's step uses it (first_order.cpp)
-    Vec out_y_;  // y at an interpolated time, for consistent output
-    const Vec *w_start_ = nullptr, *ydot_start_ = nullptr;
-    bool adaptive_attempt_ = false;  // the step being attempted is an adaptive one
-    StepReport step_report_;  // of the last attempt (attempt_step)
-    double Cg_q_norm_ = 0.0, Cg_v_norm_ = 0.0;  // |C^-1 g_q|, |C^-1 g_v| (convergence test)
+    StepHook hook_;
 };
 
 }  // namespace ga

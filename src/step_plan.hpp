@@ -1,4 +1,4 @@
-// What one attempt of a step is to be (Solver::plan_step, a pure decision) and how the step
+// What one attempt of a step is to be (Stepper::plan_step, a pure decision) and how the step
 // was attempted (the report attempt_step fills at each attempt, so that the accepted step's is
 // the last attempt's): the kernel's account of itself, which the adjoint's record copies to
 // repeat the step from a checkpoint.
@@ -7,7 +7,7 @@
 namespace ga {
 
 struct StepPlan {
-    // Sliver: a Taylor step (Solver::sliver_step); Regular: Algorithm 1 or its index-2 form
+    // Sliver: a Taylor step (Stepper::sliver_step); Regular: Algorithm 1 or its index-2 form
     enum Kind { Sliver, Regular };
     Kind kind = Regular;
     bool restart_short = false;  // Algorithm 1 afresh from what slivers left

@@ -1,10 +1,10 @@
-// Adaptive mode: local error estimate, step-size controller, landing on output times
-// (docs/algorithms.md sec. 1). Dense output is in output.cpp.
+// Adaptive mode's local error estimate of a step (docs/algorithms.md sec. 1), against the
+// step-size controller's tolerances; the adaptive loop is the transaction's (transaction.cpp).
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "solver.hpp"
+#include "stepper.hpp"
 
 namespace ga {
 
@@ -31,11 +31,6 @@ EstimateCoefficients estimate_coefficients(const Params &p, double h)
             1.0 / 12.0 - da * da + da * (p.alpha_m - 0.5)};
 }
 
-bool recoverable(ga_status st)
-{
-    return st == GA_ERR_NEWTON || st == GA_ERR_CALLBACK_RETRY || st == GA_ERR_NONFINITE ||
-           st == GA_ERR_SINGULAR || st == GA_ERR_UNRESOLVED;
-}
 }  // namespace
 
 // Index 3 with constraints and a multiplier transient damped at least as fast as at the default
@@ -44,7 +39,7 @@ bool recoverable(ga_status st)
 // 1 / (e (1 - rho_inf)) by the double root, moves q and v by more than the smooth estimate
 // sees, and differences of a, which carry it, keep the error at the tolerance
 // (design-notes.md, "Tolerance proportionality").
-bool Solver::consistent_estimate() const
+bool Stepper::consistent_estimate() const
 {
     constexpr double kMaxRoot = 0.9;
     const double alpha_f = params.alpha_f;
@@ -68,7 +63,8 @@ bool Solver::consistent_estimate() const
 // remove and that made index-3 steps three times shorter than index-2 ones for the same error.
 // But the transient, grown by changes of h, also moves q and v where c does not see it: the
 // error is the larger of the estimate from c and a tenth of that from a (sec. 1.5c).
-ga_status Solver::error_norm(double h, double t_end, double &err)
+ga_status Stepper::error_norm(double h, double t_end, const StepController &control,
+                             double &err)
 {
     const Params &p = params;
     const State &s = accepted_;
@@ -149,7 +145,9 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
         // link turned by whole turns at 2e6 rad/s passed the projected estimate). Then the
         // estimate from a counts unprojected too.
         const double err_unprojected =
-            convergence_.diverged() ? weighted_error_norm(s, x, gq, gv, h, noise_q, noise_v) : 0.0;
+            convergence_.diverged()
+                ? weighted_error_norm(s, x, gq, gv, h, control, noise_q, noise_v)
+                : 0.0;
         if (!estimate_is_output_) {
             // Onto null(Phi_q) with the step's factorization too: e - x with
             // S [x; y] = [0; Phi_q e] (along S_11^-1 Phi_q^T, as above)
@@ -171,8 +169,9 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
             }
         }
         const double err_a =
-            std::max(err_unprojected, weighted_error_norm(s, x, gq, gv, h, noise_q, noise_v));
-        err = std::max(weighted_error_norm(s, x, eq, ev, h), err_a / kTransientAllowance);
+            std::max(err_unprojected,
+                     weighted_error_norm(s, x, gq, gv, h, control, noise_q, noise_v));
+        err = std::max(weighted_error_norm(s, x, eq, ev, h, control), err_a / kTransientAllowance);
         return GA_OK;
     }
     estimate_from_a(h, eq, ev);
@@ -187,11 +186,11 @@ ga_status Solver::error_norm(double h, double t_end, double &err)
                 P_.solve(rq_, phi_, *e, lambda_tmp_);
             }
     }
-    err = weighted_error_norm(s, x, eq, ev, h);
+    err = weighted_error_norm(s, x, eq, ev, h, control);
     return GA_OK;
 }
 
-void Solver::estimate_from_a(double h, Vec &e_q, Vec &e_v) const
+void Stepper::estimate_from_a(double h, Vec &e_q, Vec &e_v) const
 {
     const State &s = accepted_, &x = trial_;
     const auto [cq, cv] = estimate_coefficients(params, h);
@@ -204,8 +203,9 @@ void Solver::estimate_from_a(double h, Vec &e_q, Vec &e_v) const
         e_v.setZero();
 }
 
-double Solver::weighted_error_norm(const State &s, const State &x, const Vec &eq, const Vec &ev,
-                                   double h, double noise_q, double noise_v)
+double Stepper::weighted_error_norm(const State &s, const State &x, const Vec &eq,
+                                    const Vec &ev, double h, const StepController &control,
+                                    double noise_q, double noise_v)
 {
     const double rtol = control.rtol, atol = control.atol;
     const double scale = control.calibration();
@@ -220,112 +220,8 @@ double Solver::weighted_error_norm(const State &s, const State &x, const Vec &eq
         sum += (eq[i] / wq) * (eq[i] / wq) + (ev[i] / wv) * (ev[i] / wv);
     }
     if (r() > 0)
-        return std::sqrt((sum + first_order_error_sum(h, scale)) / (2.0 * nv_ + r()));
+        return std::sqrt((sum + first_order_error_sum(h, scale, control)) / (2.0 * nv_ + r()));
     return std::sqrt(sum / (2.0 * nv_));
-}
-
-ga_status Solver::adaptive_step(double t_stop)
-{
-    // In index 3 every change of h starts a transient in qdd and lambda whose recursion has
-    // the double root -alpha_f/(1 - alpha_f) (docs/algorithms.md sec. 1.4, 6.2): -rho_inf, so at
-    // rho_inf = 1 (alpha_f = 1/2) it never decays, and every change of h adds to it. Even with
-    // an error estimate blind to it, such runs lose their accuracy and their steps
-    // (design-notes.md, "No adaptive steps in index 3 at rho_inf = 1"). Refused at once
-    // instead; a system without constraints has no such transient.
-    if (formulation == GA_INDEX3 && m_ > 0 && !(params.alpha_f < 0.5))
-        return diag.fail(GA_ERR_ARG,
-                         "adaptive steps in the index-3 formulation need rho_inf < 1 "
-                         "(alpha_f = %g): each change of h starts a transient of the "
-                         "multipliers that rho_inf = 1 never damps, and the run would lose its "
-                         "accuracy and its step size; use the stabilized index-2 formulation "
-                         "(ga_set_formulation) or rho_inf < 1",
-                         params.alpha_f);
-    if (consistent_estimate())
-        setup_output();
-    else
-        setup_projection();
-    const double t = accepted_.t;
-    const double remaining = t_stop - t;
-    if (!(remaining > 0.0))
-        return diag.fail(GA_ERR_ARG, "t_stop = %.17g is not after t = %.17g", t_stop, t);
-    double h = control.h_next;
-    if (!(h > 0.0)) {
-        // First step: the weighted RMS norms of qdd and v at the start (each coordinate
-        // against its calibrated atol + rtol |q_i|), from which the controller proposes.
-        const double scale = control.calibration();
-        double acc = 0.0, vel = 0.0;  // |qdd|_w^2, |v|_w^2
-        for (int i = 0; i < nv_; ++i) {
-            const double w =
-                scale * (control.atol + control.rtol * model.space.magnitude(accepted_.q, i));
-            acc += (accepted_.qdd[i] / w) * (accepted_.qdd[i] / w);
-            vel += (accepted_.v[i] / w) * (accepted_.v[i] / w);
-        }
-        acc = std::sqrt(acc / nv_);
-        vel = std::sqrt(vel / nv_);
-        h = control.first_step(acc, vel, remaining);
-    }
-    const double h_min = control.minimum_step(t);
-    h = control.bounded(h, h_min);
-    const double tol = newton_tolerance(true);
-    bool rejected = false;
-    // the last recoverable failure, said again if the steps shrink below h_min because of it
-    // (a failing callback ended in "step size fell below the minimum" alone)
-    char last_failure[Diagnostics::kSize] = "";
-    for (;;) {
-        bool land = false;
-        const double h_planned = h;
-        h = control.approach(h, remaining, rejected, land);
-        if (h < h_min && !land) {
-            diag.fail(GA_ERR_STEP_SIZE,
-                      "step size %g fell below the minimum %g at t = %.17g (last error "
-                      "estimate %.3g)",
-                      h, h_min, t, control.err_last);
-            if (last_failure[0] != '\0')
-                diag.append("; the last attempt failed: %s", last_failure);
-            return GA_ERR_STEP_SIZE;
-        }
-        // A sliver is a Taylor step (sliver_step) only when it lands on t_stop; retries after
-        // failures stay under error control.
-        ga_status st = GA_OK;
-        {
-            const Restore<bool> keep_mode(adaptive_attempt_);
-            adaptive_attempt_ = true;
-            st = attempt_step(h, tol, land);
-        }
-        double err = 0.0;
-        if (st == GA_OK)
-            st = error_norm(h, land ? t_stop : trial_.t, err);
-        if (st == GA_OK) {
-            control.err_last = err;
-            if (err <= 1.0) {
-                if (auto st2 = on_converged(h)) {  // of the accepted step only
-                    count(counters, GA_COUNT_FAILED_STEPS);
-                    invalidate_jacobian();
-                    return st2;
-                }
-                const double h_prev = accepted_.h_last;  // the accepted step before this one
-                commit(land, t_stop);
-                if (consistent_estimate() && estimate_is_output_)  // (they are the output)
-                    output_for_ = state_id_;
-                control.accept(err, h, h_planned, h_prev, land, rejected);
-                return GA_OK;
-            }
-            count(counters, GA_COUNT_REJECTED_STEPS);
-            last_failure[0] = '\0';
-            on_rejection();
-            h = StepController::after_rejection(h, err);
-        } else if (recoverable(st)) {
-            count(counters, GA_COUNT_FAILED_STEPS);
-            invalidate_jacobian();
-            diag.copy_to(last_failure);
-            h = StepController::after_failure(h);
-        } else {
-            count(counters, GA_COUNT_FAILED_STEPS);
-            invalidate_jacobian();
-            return st;
-        }
-        rejected = true;
-    }
 }
 
 }  // namespace ga
