@@ -54,7 +54,7 @@ void AdjointRecord::allocate_checkpointed(int nq_, int nv_, int m_, int r_, int 
 ga_status Adjoint::set_checkpoints(long interval, long count)
 {
     // (interval * count fits in a long: the C API checked it)
-    const std::size_t stride = AdjointRecord::stride_for(k_.nq_, k_.nv_, k_.m_, k_.r());
+    const std::size_t stride = AdjointRecord::stride_for(k_.nq(), k_.nv(), k_.m(), k_.r());
     if (interval > 0 && !fits_doubles(static_cast<std::size_t>(interval) + 1, stride))
         return k_.diag.fail(GA_ERR_NOMEM,
                             "an adjoint segment of interval = %ld steps (%zu doubles "
@@ -75,17 +75,17 @@ ga_status Adjoint::set_checkpoints(long interval, long count)
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
     record.max_steps = record_.max_steps;
     if (interval > 0)
-        record.allocate_checkpointed(k_.nq_, k_.nv_, k_.m_, k_.r(), forward_.sens.np, interval,
+        record.allocate_checkpointed(k_.nq(), k_.nv(), k_.m(), k_.r(), forward_.sens.np, interval,
                                      count, run_.state_size());
     else
-        record.allocate(k_.nq_, k_.nv_, k_.m_, k_.r(), forward_.sens.np, record_.max_steps);
+        record.allocate(k_.nq(), k_.nv(), k_.m(), k_.r(), forward_.sens.np, record_.max_steps);
     record_ = std::move(record);
     return GA_OK;
 }
 
 ga_status Adjoint::set_method(int methods, long max_steps)
 {
-    const std::size_t stride = AdjointRecord::stride_for(k_.nq_, k_.nv_, k_.m_, k_.r());
+    const std::size_t stride = AdjointRecord::stride_for(k_.nq(), k_.nv(), k_.m(), k_.r());
     if ((methods & GA_SENSITIVITY_ADJOINT) &&
         !fits_doubles(static_cast<std::size_t>(max_steps) + 1, stride))
         return k_.diag.fail(GA_ERR_NOMEM,
@@ -95,7 +95,7 @@ ga_status Adjoint::set_method(int methods, long max_steps)
                             max_steps, stride);
     AdjointRecord record;  // built aside: a failed allocation leaves the one before
     if (methods & GA_SENSITIVITY_ADJOINT)
-        record.allocate(k_.nq_, k_.nv_, k_.m_, k_.r(), forward_.sens.np, max_steps);
+        record.allocate(k_.nq(), k_.nv(), k_.m(), k_.r(), forward_.sens.np, max_steps);
     record_ = std::move(record);
     forward_.sens.forward = (methods & GA_SENSITIVITY_FORWARD) != 0;
     forward_.sens.adjoint = (methods & GA_SENSITIVITY_ADJOINT) != 0;
@@ -113,7 +113,7 @@ void put(const Vec &x, double *&out)
 // A step converged (before its commit): room for it, and how it began (on_commit logs it).
 ga_status Adjoint::on_converged(double h)
 {
-    const State &s = k_.accepted_;
+    const State &s = k_.state();
     AdjointRecord &r = record_;
     if (r.steps >= r.capacity && r.interval > 0)
         return k_.diag.fail(GA_ERR_NOMEM,
@@ -126,13 +126,13 @@ ga_status Adjoint::on_converged(double h)
                             "ga_set_sensitivity_method)",
                             r.capacity);
     r.pending_rho = 1.0;
-    if (forward_.sens.step_done || (forward_.sens.start_given && !k_.start_pending_)) {
+    if (forward_.sens.step_done || (forward_.sens.start_given && !k_.start_pending())) {
         r.pending_kind = AdjointRecord::Unsupported;
     } else if (forward_.sens.start_given) {
         r.pending_kind = AdjointRecord::First;
     } else {
         r.pending_kind = AdjointRecord::Regular;
-        if (k_.a_start_ != &s.a)
+        if (k_.step_start(s).a_rescaled)
             r.pending_rho = h / s.h_last;
     }
     return GA_OK;
@@ -141,7 +141,7 @@ ga_status Adjoint::on_converged(double h)
 void Adjoint::started()
 {
     AdjointRecord &r = record_;
-    const State &x = k_.accepted_;
+    const State &x = k_.state();
     r.steps = 0;
     r.base = 0;
     r.unsupported_at = -1;
@@ -153,8 +153,8 @@ void Adjoint::started()
     e += 4;
     for (const Vec *v : {&x.q, &x.v, &x.qdd, &x.lambda})
         put(*v, e);
-    Eigen::Map<Vec>(e, k_.m_).setZero();
-    e += k_.m_;
+    Eigen::Map<Vec>(e, k_.m()).setZero();
+    e += k_.m();
     put(x.y, e);
     put(x.ydot, e);
     for (int j = 0; j < forward_.sens.np; ++j) {
@@ -174,7 +174,7 @@ void Adjoint::started()
 void Adjoint::on_commit()
 {
     AdjointRecord &r = record_;
-    const State &x = k_.accepted_;
+    const State &x = k_.state();
     const long k = ++r.steps;
     if (r.interval > 0 && k - r.base > r.interval) {  // a new segment starts at step k - 1
         std::copy_n(r.entry(k - 1), r.stride(), r.data.data());
@@ -188,7 +188,7 @@ void Adjoint::on_commit()
     if (r.interval > 0) {
         double *l = r.log_entry(k);
         std::copy_n(e, 4, l);
-        const StepReport &report = k_.step_report_;  // of the attempt accepted
+        const StepReport &report = k_.last_report();  // of the attempt accepted
         l[4] = report.plan.tol;
         l[5] = (report.plan.sliver_allowed ? 1.0 : 0.0) + (report.adaptive ? 2.0 : 0.0);
         std::copy_n(report.reuse_before, kReuseStateSize, l + 6);
@@ -197,10 +197,10 @@ void Adjoint::on_commit()
     for (const Vec *v : {&x.q, &x.v, &x.qdd, &x.lambda})
         put(*v, e);
     if (k_.formulation == GA_INDEX2_STABILIZED)
-        Eigen::Map<Vec>(e, k_.m_) = k_.eta_total_;
+        Eigen::Map<Vec>(e, k_.m()) = k_.eta_bar();
     else
-        Eigen::Map<Vec>(e, k_.m_).setZero();
-    e += k_.m_;
+        Eigen::Map<Vec>(e, k_.m()).setZero();
+    e += k_.m();
     put(x.y, e);
     put(x.ydot, e);
     if (r.pending_kind == AdjointRecord::First)
@@ -306,7 +306,7 @@ ga_status Adjoint::step_back(long k, Work &w)
     const AdjointRecord &r = record_;
     const Params &p = k_.params;
     const bool index2 = k_.formulation == GA_INDEX2_STABILIZED;
-    const int nq = k_.nq_, n = k_.nv_, m = k_.m_;  // (n: the linear algebra's, nv)
+    const int nq = k_.nq(), n = k_.nv(), m = k_.m();  // (n: the linear algebra's, nv)
     const double *e0 = r.entry(k), *e1 = r.entry(k + 1);
     const double h = e1[1], rho = e1[2];
     const auto kind = static_cast<AdjointRecord::Kind>(e1[3]);
@@ -330,13 +330,11 @@ ga_status Adjoint::step_back(long k, Work &w)
     bool K = false, C = false, Z = false;
     ga_status st = k_.exact_tangents(t1, x, K, C, Z);
     if (!st && R > 0) {  // the coupling blocks at the recorded state (f_ and g there)
-        st = k_.model.rate(t1, x.q, x.v, x.y, k_.rate_);
-        if (!st)
-            st = k_.first_order_matrix(t1, x, true);
+        st = k_.coupling_at(t1, x);
     }
     const Vec q_n = Eigen::Map<const Vec>(e0 + 4, nq);
     if (!st && index2 && m > 0)
-        st = k_.model.jacobian(e0[0], q_n, k_.B_);
+        st = k_.evaluate_B(e0[0], q_n);
     if (st)
         return st;
 
@@ -350,12 +348,12 @@ ga_status Adjoint::step_back(long k, Work &w)
     const double c1 = R > 0 ? first_order_newton_coefficient(p1, h) : 0.0;
     Mat Fy, Gw, Ge, Gy;
     if (R > 0) {
-        const CouplingBlocks &b = k_.blocks_;
+        const CouplingBlocks &b = k_.coupling();
         Fy = -bh2 * b.f_y;
         Gw = -(b.g_q + c.gamma_prime * b.g_v);
         Gy = c1 * Mat::Identity(R, R) - b.g_y;
         if (index2 && m > 0) {
-            dense_of(k_.B_, w.Bd);
+            dense_of(k_.B_matrix(), w.Bd);
             Ge = b.g_q * w.Bd.transpose();
         }
     }
@@ -366,22 +364,22 @@ ga_status Adjoint::step_back(long k, Work &w)
     };
     count(k_.counters, GA_COUNT_FACTORIZATIONS);
     bool singular = false;
-    if (k_.sparse_backend_) {
-        const Sparse Ms = to_sparse(k_.M_), Js = to_sparse(k_.J_);
+    if (k_.sparse()) {
+        const Sparse Ms = to_sparse(k_.mass_matrix()), Js = to_sparse(k_.jacobian_matrix());
         Sparse A = (bh2 * c.beta_prime) * Ms;
         if (K)
-            A += bh2 * to_sparse(k_.K_);
+            A += bh2 * to_sparse(k_.stiffness_matrix());
         if (C)
-            A += (bh2 * c.gamma_prime) * to_sparse(k_.C_);
+            A += (bh2 * c.gamma_prime) * to_sparse(k_.damping_matrix());
         w.entries.clear();
         add_block(w.entries, A, 1.0, 0, 0);
         add_block(w.entries, Js, 1.0, 0, n, true);
         add_block(w.entries, Js, 1.0, n, 0);
         if (index2 && m > 0) {
-            const Sparse Zs = to_sparse(k_.Z_);
-            const Sparse BT = to_sparse(k_.B_).transpose();
+            const Sparse Zs = to_sparse(k_.Z_matrix());
+            const Sparse BT = to_sparse(k_.B_matrix()).transpose();
             if (K)
-                add_block(w.entries, Sparse(to_sparse(k_.K_) * BT), -bh2, 0, n + m);
+                add_block(w.entries, Sparse(to_sparse(k_.stiffness_matrix()) * BT), -bh2, 0, n + m);
             add_block(w.entries, Sparse(Js * BT), -1.0, n, n + m);
             add_block(w.entries, Zs, s3, n + m, 0);
             add_block(w.entries, Js, 1.0, n + m, 0);
@@ -419,22 +417,22 @@ ga_status Adjoint::step_back(long k, Work &w)
     } else {
         Mat &D = w.D;
         D.setZero(N + R, N + R);
-        dense_of(k_.M_, w.Md);
-        dense_of(k_.J_, w.Jd);
+        dense_of(k_.mass_matrix(), w.Md);
+        dense_of(k_.jacobian_matrix(), w.Jd);
         D.topLeftCorner(n, n) = (bh2 * c.beta_prime) * w.Md;
         if (K) {
-            dense_of(k_.K_, w.Kd);
+            dense_of(k_.stiffness_matrix(), w.Kd);
             D.topLeftCorner(n, n) += bh2 * w.Kd;
         }
         if (C) {
-            dense_of(k_.C_, w.Cd);
+            dense_of(k_.damping_matrix(), w.Cd);
             D.topLeftCorner(n, n) += (bh2 * c.gamma_prime) * w.Cd;
         }
         D.block(0, n, n, m) = w.Jd.transpose();
         D.block(n, 0, m, n) = w.Jd;
         if (index2 && m > 0) {
-            dense_of(k_.B_, w.Bd);
-            dense_of(k_.Z_, w.Zd);
+            dense_of(k_.B_matrix(), w.Bd);
+            dense_of(k_.Z_matrix(), w.Zd);
             if (K)
                 D.block(0, n + m, n, m) = -bh2 * (w.Kd * w.Bd.transpose());
             D.block(n, n + m, m, m) = -(w.Jd * w.Bd.transpose());
@@ -471,7 +469,7 @@ ga_status Adjoint::step_back(long k, Work &w)
         y.head(n) = w.tmp + w.mq;  // d = w - B^T e
         y.segment(n, m) = w.ml / bh2;
         w.ye.setZero();
-        k_.B_.multiply_add(-1.0, w.mq, w.ye);
+        k_.B_matrix().multiply_add(-1.0, w.mq, w.ye);
         y.segment(n + m, m) = w.ye;
     } else {
         y.head(n) = w.tmp + w.mq;
@@ -480,7 +478,7 @@ ga_status Adjoint::step_back(long k, Work &w)
     // S^{-T}; the right-hand side was -(rows' scales) (r, r_lambda, r_v)
     Eigen::VectorXd z;
 #ifdef GALPHA_HAVE_KLU
-    if (k_.sparse_backend_) {
+    if (k_.sparse()) {
         z = y;
         w.klu->solve_transpose(z.data());
     } else
@@ -498,16 +496,16 @@ ga_status Adjoint::step_back(long k, Work &w)
     w.qp = w.mq;
     w.vp = w.mv;
     if (K)
-        k_.K_.multiply_transpose_add(1.0, w.rr, w.qp);
+        k_.stiffness_matrix().multiply_transpose_add(1.0, w.rr, w.qp);
     if (C)
-        k_.C_.multiply_transpose_add(1.0, w.rr, w.vp);
-    k_.J_.multiply_transpose_add(1.0, w.rl, w.qp);
+        k_.damping_matrix().multiply_transpose_add(1.0, w.rr, w.vp);
+    k_.jacobian_matrix().multiply_transpose_add(1.0, w.rl, w.qp);
     if (index2 && m > 0) {
-        k_.Z_.multiply_transpose_add(1.0, w.rv, w.qp);
-        k_.J_.multiply_transpose_add(1.0, w.rv, w.vp);
+        k_.Z_matrix().multiply_transpose_add(1.0, w.rv, w.qp);
+        k_.jacobian_matrix().multiply_transpose_add(1.0, w.rv, w.vp);
     }
     if (R > 0) {  // r^q sees y_p through -f_y; r^y = y'_p - g_q q_p - g_v v_p - g_y y_p
-        const CouplingBlocks &b = k_.blocks_;
+        const CouplingBlocks &b = k_.coupling();
         w.qp.noalias() -= b.g_q.transpose() * w.ry;
         w.vp.noalias() -= b.g_v.transpose() * w.ry;
         w.yp = w.my;
@@ -590,22 +588,17 @@ ga_status Adjoint::replay_segment(long s)
         return st;
     r.base = first;
     double *e = r.entry(first);
-    e[0] = k_.accepted_.t;
+    e[0] = k_.state().t;
     e += 4;
-    for (const Vec *v : {&k_.accepted_.q, &k_.accepted_.v, &k_.accepted_.qdd, &k_.accepted_.lambda})
+    for (const Vec *v : {&k_.state().q, &k_.state().v, &k_.state().qdd, &k_.state().lambda})
         put(*v, e);
-    e += k_.m_;
-    put(k_.accepted_.y, e);
-    put(k_.accepted_.ydot, e);
+    e += k_.m();
+    put(k_.state().y, e);
+    put(k_.state().ydot, e);
     for (long k = first + 1; k <= last; ++k) {
         const double *l = r.log_entry(k);
         const double h = l[1];
-        if (l[6] == 0.0)  // the matrix the attempt began with, and its reuse state
-            k_.invalidate_jacobian();
-        k_.theta_prev_ = l[7];
-        k_.refresh_steps_left_ = static_cast<int>(l[8]);
-        k_.reuse_backoff_ = static_cast<int>(l[9]);
-        k_.fd_tangents_ = l[10] != 0.0;
+        k_.restore_reuse(l + 6);  // the matrix the attempt began with, and its reuse state
         // the kernel and the forward sensitivities' linear step, not the doors after it: a
         // replay records nothing (its entries are written below); adaptive or not as recorded
         // (a fresh start: its first-order states' start)
@@ -618,22 +611,20 @@ ga_status Adjoint::replay_segment(long s)
         }
         if (forward_.sens.forward)
             forward_.sens.accepted.swap(forward_.sens.trial);
-        k_.accepted_.swap(k_.trial_);
-        k_.accepted_.t = l[0];
-        k_.start_pending_ = false;
+        k_.accept_replayed(l[0]);
         double *x = r.entry(k);
         std::copy_n(l, 4, x);
         x += 4;
         for (const Vec *v :
-             {&k_.accepted_.q, &k_.accepted_.v, &k_.accepted_.qdd, &k_.accepted_.lambda})
+             {&k_.state().q, &k_.state().v, &k_.state().qdd, &k_.state().lambda})
             put(*v, x);
         if (k_.formulation == GA_INDEX2_STABILIZED)
-            Eigen::Map<Vec>(x, k_.m_) = k_.eta_total_;
+            Eigen::Map<Vec>(x, k_.m()) = k_.eta_bar();
         else
-            Eigen::Map<Vec>(x, k_.m_).setZero();
-        x += k_.m_;
-        put(k_.accepted_.y, x);
-        put(k_.accepted_.ydot, x);
+            Eigen::Map<Vec>(x, k_.m()).setZero();
+        x += k_.m();
+        put(k_.state().y, x);
+        put(k_.state().ydot, x);
     }
     return GA_OK;
 }
@@ -642,7 +633,7 @@ ga_status Adjoint::gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, 
 {
     if (record_.interval == 0) {
         const ga_status st = sweep(running, terminal, J, dJ);
-        k_.model.y_now = &k_.accepted_.y;  // (the sweep pointed the forces at recorded states)
+        k_.forces_see_accepted();  // (the sweep pointed the forces at recorded states)
         return st;
     }
     // The sweep recomputes segments in place: the run is restored afterwards as it was --
@@ -650,10 +641,9 @@ ga_status Adjoint::gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, 
     AdjointRecord &r = record_;
     std::vector<double> here(run_.state_size());
     run_.get_state(here.data());
-    const State previous = k_.previous_;
-    const bool previous_valid = k_.previous_valid_, start_pending = k_.start_pending_;
+    const Stepper::RunPoint point = k_.run_point();
     const EventSet events = run_.events();
-    const long state_id = k_.state_id_, base = r.base;
+    const long base = r.base;
     const std::vector<double> segment = r.data;
     // The segments are computed in matrices of their own, the run's kept one set aside: it
     // comes back as it was, without callbacks (one failing while it was rebuilt made the run
@@ -663,13 +653,8 @@ ga_status Adjoint::gradient(ga_cost_fn running, ga_cost_fn terminal, double *J, 
     const auto restore = [&] {
         k_.take_back_matrix(kept);
         const ga_status back = run_.set_state(here.data(), here.size(), true, true);
-        k_.previous_ = previous;
-        k_.previous_valid_ = previous_valid;
-        k_.start_pending_ = start_pending;
+        k_.restore_run_point(point);
         run_.events() = events;
-        k_.model.y_now = &k_.accepted_.y;
-        k_.state_id_ = state_id;
-        k_.output_for_ = -1;  // (its buffers may hold a recomputed step's output now)
         r.data = segment;
         r.base = base;
         return back;
@@ -701,17 +686,17 @@ ga_status Adjoint::sweep(ga_cost_fn running, ga_cost_fn terminal, double *J, dou
                             "the recorded run has a step the adjoint sweep does not cover (step "
                             "%ld: a Taylor step, or a fresh start after short steps)",
                             r.unsupported_at);
-    if (k_.redundancy == GA_REDUNDANT_DROP && k_.m_ > 0)
+    if (k_.redundancy == GA_REDUNDANT_DROP && k_.m() > 0)
         return k_.diag.fail(GA_ERR_STATE, "the adjoint sweep with dropped redundant constraints is "
                                           "not built");
     Work w;
-    w.allocate(k_.nq_, k_.nv_, k_.m_, k_.r(), forward_.sens.np);
+    w.allocate(k_.nq(), k_.nv(), k_.m(), k_.r(), forward_.sens.np);
     const long N = r.steps;
     // Cost terms at a recorded state k: its value into `value`, weight times its gradient
     // into the adjoint variables (and into dJ/dp).
     const auto cost = [&](ga_cost_fn fn, long k, double weight, double &total) {
         const double *e = r.entry(k);
-        const double *q = e + 4, *v = q + k_.nq_, *qdd = v + k_.nv_, *lambda = qdd + k_.nv_;
+        const double *q = e + 4, *v = q + k_.nq(), *qdd = v + k_.nv(), *lambda = qdd + k_.nv();
         double value = 0.0;
         if (auto st =
                 k_.model.cost(fn, e[0], q, v, qdd, lambda, value, w.cq, w.cv, w.cqdd, w.cl, w.cp))

@@ -114,9 +114,7 @@ ga_status ForwardSensitivity::start(const State &x)
 {
     // Exact derivatives need every tangent in the matrix (sensitivity_step): on the sparse
     // path a tangent without a pattern has no place there.
-    const bool damped = k_.model.has_force() || k_.model.cb.damping;
-    if (k_.sparse_backend_ &&
-        ((!k_.K_.zero() && k_.K_.dense()) || (damped && !k_.C_.zero() && k_.C_.dense())))
+    if (!k_.exact_tangents_fit())
         return k_.diag.fail(GA_ERR_ARG,
                             "sensitivities on the sparse path need the patterns of K_t "
                             "and C_t (ga_set_pattern; an empty pattern declares a zero matrix)");
@@ -129,7 +127,7 @@ ga_status ForwardSensitivity::start(const State &x)
         s.q = z.seed_q[j];
         s.v = z.seed_v[j];
         const bool moves = (z.depends & GA_DEPENDS_CONSTRAINT) != 0;
-        if (k_.m_ > 0 && (moves || !s.q.isZero(0.0) || !s.v.isZero(0.0)))
+        if (k_.m() > 0 && (moves || !s.q.isZero(0.0) || !s.v.isZero(0.0)))
             if (auto st = project_seeds(x, j, s)) {
                 k_.diag.append(" (the start's derivative in parameter %d)", j);
                 return st;
@@ -142,10 +140,9 @@ ga_status ForwardSensitivity::start(const State &x)
             z.xv = x.v + shift * s.v;
         };
         const auto evaluate = [&](int side) {
-            SaddleWorkspace w{k_.S_, k_.M_, k_.J_, k_.f_, k_.c_, k_.rq_};
             Vec &qdd = side == 0 ? s.qdd : z.d;
             Vec &lambda = side == 0 ? s.lambda : z.dl;
-            ga_status st = k_.acceleration_level(x.t, z.xq, z.xv, w, qdd, lambda);
+            ga_status st = k_.start_accelerations(x.t, z.xq, z.xv, qdd, lambda);
             if (!st && k_.r() > 0)  // y'_0 = g(t0, q0, v0, y0), y0 independent of p
                 st = k_.model.rate(x.t, z.xq, z.xv, x.y, side == 0 ? z.rate_plus : z.rate_minus);
             return st;
@@ -168,8 +165,7 @@ ga_status ForwardSensitivity::start(const State &x)
             s.v.swap(z.wide.v);
             st = pass(0.5 * e);
         }
-        k_.jacobian_valid_ = false;  // S_ holds another matrix now
-        k_.mass_valid_ = false;      // and M_ was evaluated with p perturbed
+        k_.drop_step_matrix(true);  // another matrix, and a mass evaluated with p perturbed
         if (st) {
             k_.diag.append(" (sensitivity of the consistent start to parameter %d)", j);
             return st;
@@ -195,18 +191,17 @@ ga_status ForwardSensitivity::project_seeds(const State &x, int j, StateDerivati
     Sensitivities &z = sens;
     if (auto st = constraint_parameter_terms(j, x.t, x, true, false, x.t, x.q, x.lambda))
         return st;
-    if (auto st = k_.model.jacobian(x.t, x.q, k_.J_))
-        return st;
-    count(k_.counters, GA_COUNT_FACTORIZATIONS);
-    k_.jacobian_valid_ = false;  // S_ holds another matrix now
-    if (!k_.S_.factorize_projection(k_.J_))
+    if (auto st = k_.factorize_tangent_projection(x.t, x.q)) {
+        if (st != GA_ERR_SINGULAR)
+            return st;
         return k_.diag.fail(GA_ERR_SINGULAR,
                             "cannot project the start's derivative: Phi_q is rank "
                             "deficient (rcond of [I Phi_q^T; Phi_q 0] = %.3g)",
-                            k_.S_.rcond());
+                            k_.step_matrix_rcond());
+    }
     z.rq = -s.q;
     z.rl = z.cl;
-    k_.S_.solve(z.rq, z.rl, z.d, z.dl);
+    k_.solve_tangent_projection(z.rq, z.rl, z.d, z.dl);
     s.q = z.d;
     z.rl = z.cv;
     const double s_max = s.q.lpNorm<Eigen::Infinity>();
@@ -224,7 +219,7 @@ ga_status ForwardSensitivity::project_seeds(const State &x, int j, StateDerivati
         }
     }
     z.rq = -s.v;
-    k_.S_.solve(z.rq, z.rl, z.d, z.dl);
+    k_.solve_tangent_projection(z.rq, z.rl, z.d, z.dl);
     s.v = z.d;
     return GA_OK;
 }
@@ -303,7 +298,7 @@ ga_status ForwardSensitivity::before_attempt(const StepPlan &plan, const State &
         return GA_OK;
     }
     sens.start_given = false;
-    if (plan.fresh && (sens.forward || k_.start_pending_))
+    if (plan.fresh && (sens.forward || k_.start_pending()))
         return by_differences(accepted, plan.h, false, plan.restart_short);
     if (plan.fresh)
         sens.start_given = true;  // (adjoint only: recorded as a start not covered)
@@ -337,23 +332,25 @@ ga_status ForwardSensitivity::by_differences(const State &accepted, double h, bo
                     to -= from;
             };
             if (taylor_step) {
-                take(out.q, k_.trial_.q);
-                take(out.v, k_.trial_.v);
-                take(out.qdd, k_.trial_.qdd);
-                take(out.lambda, k_.trial_.lambda);
-                take(out.a, k_.trial_.a);
+                const State &trial = k_.trial();
+                take(out.q, trial.q);
+                take(out.v, trial.v);
+                take(out.qdd, trial.qdd);
+                take(out.lambda, trial.lambda);
+                take(out.a, trial.a);
                 if (k_.r() > 0) {
-                    take(out.y, k_.trial_.y);
-                    take(out.ydot, k_.trial_.ydot);
-                    take(out.w, k_.trial_.w);
+                    take(out.y, trial.y);
+                    take(out.ydot, trial.ydot);
+                    take(out.w, trial.w);
                 }
             } else {
-                take(out.v, *k_.v_start_);
-                take(out.a, *k_.a_start_);
-                take(out.qdd, *k_.qdd_start_);
+                const Stepper::StepStart start = k_.step_start(scratch_);
+                take(out.v, *start.v);
+                take(out.a, *start.a);
+                take(out.qdd, *start.qdd);
                 if (k_.r() > 0) {
-                    take(out.w, *k_.w_start_);
-                    take(out.ydot, *k_.ydot_start_);
+                    take(out.w, *start.w);
+                    take(out.ydot, *start.ydot);
                 }
             }
             return GA_OK;
@@ -478,7 +475,7 @@ ga_status ForwardSensitivity::constraint_parameter_terms(int j, double t, const 
                                                          const Vec &q_n, const Vec &eta)
 {
     Sensitivities &z = sens;
-    if (!(z.depends & GA_DEPENDS_CONSTRAINT) || k_.m_ == 0)
+    if (!(z.depends & GA_DEPENDS_CONSTRAINT) || k_.m() == 0)
         return GA_OK;
     for (Vec *c : {&z.cq, &z.cl, &z.cv, &z.cbt})
         c->setZero();
@@ -565,8 +562,8 @@ ga_status ForwardSensitivity::step(double h)
 {
     if (!sens.active() || !sens.forward || sens.step_done)
         return GA_OK;
-    const State &s = k_.accepted_;
-    const State &x = k_.trial_;
+    const State &s = k_.state();
+    const State &x = k_.trial();
     const Params &p = k_.params;
     const NewtonCoefficients c = newton_coefficients(p, h);
     const bool index2 = k_.formulation == GA_INDEX2_STABILIZED;
@@ -577,19 +574,12 @@ ga_status ForwardSensitivity::step(double h)
     // at full size; a kept matrix is of an older iterate). The next step's Newton iteration
     // starts with it.
     bool K = false, C = false, Z = false;
-    ga_status st = k_.exact_tangents(t1, x, K, C, Z);
-    if (!st && k_.r() > 0)  // the coupling blocks likewise, and the Schur complement on y
-        st = k_.first_order_matrix(t1, x, true);
-    if (!st)
-        st = k_.factorize(t1, x, h, K, C, Z, 0);
-    k_.recipe_.central = !st;
-    if (!st && k_.r() > 0)
-        st = k_.first_order_schur(h, c);
+    ga_status st = k_.factorize_exact(x, h, K, C, Z);
     if (st) {
         k_.diag.append(" (the exact iteration matrix for the sensitivities)");
         return st;
     }
-    const double row_scale = step_row_scale(p, h, k_.scaling);
+    const Stepper::StepStart start = k_.step_start(s);
     Sensitivities &z = sens;
     for (int j = 0; j < z.np; ++j) {
         const StateDerivative &sn = z.accepted[j];
@@ -600,7 +590,7 @@ ga_status ForwardSensitivity::step(double h)
         const Vec *sa = &sn.a;
         if (z.start_given) {
             sa = &z.start[j].a;
-        } else if (k_.a_start_ != &s.a) {  // a_n rescaled to h
+        } else if (start.a_rescaled) {  // a_n rescaled to h
             z.a0 = sn.qdd + (h / s.h_last) * (sn.a - sn.qdd);
             sa = &z.a0;
         }
@@ -611,7 +601,7 @@ ga_status ForwardSensitivity::step(double h)
         if (k_.r() > 0) {
             if (z.start_given) {
                 sw = &z.start[j].w;
-            } else if (k_.w_start_ != &s.w) {  // w_n rescaled to h (first_order_start)
+            } else if (start.w_rescaled) {  // w_n rescaled to h (first_order_start)
                 z.w0 = sn.ydot + (h / s.h_last) * (sn.w - sn.ydot);
                 sw = &z.w0;
             }
@@ -626,13 +616,13 @@ ga_status ForwardSensitivity::step(double h)
         s1.q = sn.q + h * sv + (h * h) * ((0.5 - p.beta) * *sa + p.beta * s1.a);
         s1.v = sv + h * ((1.0 - p.gamma) * *sa + p.gamma * s1.a);
         // the constraints' parameter terms (zero unless they depend on p)
-        if ((st = constraint_parameter_terms(j, t1, x, index2, index2, k_.b_t_, s.q,
-                                             k_.eta_total_))) {
+        if ((st = constraint_parameter_terms(j, t1, x, index2, index2, k_.B_time(), s.q,
+                                             k_.eta_bar()))) {
             k_.diag.append(" (derivative of the constraints in parameter %d)", j);
             return st;
         }
-        if (index2 && k_.m_ > 0) {
-            if ((st = correction_derivative(k_.b_t_, s.q, k_.eta_total_, sn.q, z.bt)))
+        if (index2 && k_.m() > 0) {
+            if ((st = correction_derivative(k_.B_time(), s.q, k_.eta_bar(), sn.q, z.bt)))
                 return st;
             s1.q += z.bt;
             s1.q += z.cbt;
@@ -644,40 +634,33 @@ ga_status ForwardSensitivity::step(double h)
             return st;
         }
         if (K)
-            k_.K_.multiply_add(1.0, s1.q, z.rq);
+            k_.stiffness_matrix().multiply_add(1.0, s1.q, z.rq);
         if (C)
-            k_.C_.multiply_add(1.0, s1.v, z.rq);
+            k_.damping_matrix().multiply_add(1.0, s1.v, z.rq);
+        const CouplingBlocks &b = k_.coupling();
         if (k_.r() > 0) {  // r^q sees y through f; r^y = y' - g(t, q, v, y)
-            z.rq.noalias() -= k_.blocks_.f_y * s1.y;
+            z.rq.noalias() -= b.f_y * s1.y;
             z.ry = s1.ydot;
-            z.ry.noalias() -= k_.blocks_.g_q * s1.q;
-            z.ry.noalias() -= k_.blocks_.g_v * s1.v;
-            z.ry.noalias() -= k_.blocks_.g_y * s1.y;
+            z.ry.noalias() -= b.g_q * s1.q;
+            z.ry.noalias() -= b.g_v * s1.v;
+            z.ry.noalias() -= b.g_y * s1.y;
             if ((st = rate_parameter_residual(j, t1, x)))
                 return st;
         }
         z.rl = z.cl;
-        k_.J_.multiply_add(1.0, s1.q, z.rl);
+        k_.jacobian_matrix().multiply_add(1.0, s1.q, z.rl);
         if (index2) {
             z.rv = z.cv;
             if (Z)
-                k_.Z_.multiply_add(1.0, s1.q, z.rv);
-            k_.J_.multiply_add(1.0, s1.v, z.rv);
-            k_.S2_.solve(z.rq, z.rl, z.rv, p, h, k_.B_, z.d, z.w, z.dl, z.e);
-        } else {
-            k_.S_.solve(z.rq, z.rl, z.d, z.dl, row_scale);
+                k_.Z_matrix().multiply_add(1.0, s1.q, z.rv);
+            k_.jacobian_matrix().multiply_add(1.0, s1.v, z.rv);
         }
+        k_.solve_step_matrix(z.rq, z.rl, z.rv, h, z.d, z.w, z.dl, z.e);
         if (k_.r() > 0) {  // elimination onto y (first_order.cpp): dy, then x0 - Z dy
             z.gy = -z.ry;
-            z.gy.noalias() += k_.blocks_.g_q * z.d;
-            z.gy.noalias() += c.gamma_prime * (k_.blocks_.g_v * (index2 ? z.w : z.d));
-            z.dy = k_.C1_lu_.solve(z.gy);
-            if (k_.forces_see_y()) {
-                z.d.noalias() -= k_.Zq_ * z.dy;
-                z.dl.noalias() -= k_.Zl_ * z.dy;
-                if (index2)
-                    z.w.noalias() -= k_.Zw_ * z.dy;
-            }
+            z.gy.noalias() += b.g_q * z.d;
+            z.gy.noalias() += c.gamma_prime * (b.g_v * (index2 ? z.w : z.d));
+            k_.eliminate_first_order(z.gy, z.dy, z.d, z.dl, z.w);
             s1.y += z.dy;
             s1.ydot = first_order_newton_coefficient(p1, h) * z.dy;
             s1.w = (p1.alpha_f * sydot - p1.alpha_m * *sw + (1.0 - p1.alpha_f) * s1.ydot) /

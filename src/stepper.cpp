@@ -704,6 +704,83 @@ ga_status Stepper::exact_tangents(double t, const State &x, bool &K, bool &C, bo
     return st;
 }
 
+ga_status Stepper::factorize_exact(const State &x, double h, bool &K, bool &C, bool &Z)
+{
+    const double t = x.t;
+    ga_status st = exact_tangents(t, x, K, C, Z);
+    if (!st && r() > 0)  // the coupling blocks likewise, and the Schur complement on y
+        st = first_order_matrix(t, x, true);
+    if (!st)
+        st = factorize(t, x, h, K, C, Z, 0);
+    recipe_.central = !st;
+    if (!st && r() > 0)
+        st = first_order_schur(h, newton_coefficients(params, h));
+    return st;
+}
+
+ga_status Stepper::coupling_at(double t, const State &x)
+{
+    if (auto st = model.rate(t, x.q, x.v, x.y, rate_))
+        return st;
+    return first_order_matrix(t, x, true);
+}
+
+ga_status Stepper::factorize_tangent_projection(double t, const Vec &q)
+{
+    if (auto st = model.jacobian(t, q, J_))
+        return st;
+    count(counters, GA_COUNT_FACTORIZATIONS);
+    jacobian_valid_ = false;  // S_ holds another matrix now
+    return S_.factorize_projection(J_) ? GA_OK : GA_ERR_SINGULAR;
+}
+
+void Stepper::solve_step_matrix(const Vec &rq, const Vec &rl, const Vec &rv, double h, Vec &d,
+                                Vec &w, Vec &dl, Vec &e)
+{
+    if (formulation == GA_INDEX2_STABILIZED)
+        S2_.solve(rq, rl, rv, params, h, B_, d, w, dl, e);
+    else
+        S_.solve(rq, rl, d, dl, step_row_scale(params, h, scaling));
+}
+
+void Stepper::eliminate_first_order(const Vec &gy, Vec &dy, Vec &d, Vec &dl, Vec &w) const
+{
+    dy = C1_lu_.solve(gy);
+    if (forces_see_y()) {
+        d.noalias() -= Zq_ * dy;
+        dl.noalias() -= Zl_ * dy;
+        if (formulation == GA_INDEX2_STABILIZED)
+            w.noalias() -= Zw_ * dy;
+    }
+}
+
+void Stepper::restore_reuse(const double *reuse)
+{
+    if (reuse[0] == 0.0)
+        invalidate_jacobian();
+    theta_prev_ = reuse[1];
+    refresh_steps_left_ = static_cast<int>(reuse[2]);
+    reuse_backoff_ = static_cast<int>(reuse[3]);
+    fd_tangents_ = reuse[4] != 0.0;
+}
+
+void Stepper::accept_replayed(double t)
+{
+    accepted_.swap(trial_);
+    accepted_.t = t;
+    start_pending_ = false;
+}
+
+void Stepper::restore_run_point(const RunPoint &point)
+{
+    previous_ = point.previous;
+    previous_valid_ = point.previous_valid;
+    start_pending_ = point.start_pending;
+    model.y_now = &accepted_.y;
+    state_id_ = point.state_id;
+    output_for_ = -1;  // (its buffers may hold a recomputed step's output now)
+}
+
 ga_status Stepper::factorize(double t, const State &x, double h, bool tangents_K,
                             bool tangents_C, bool tangent_Z, int iter)
 {

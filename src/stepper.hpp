@@ -230,6 +230,110 @@ public:
             output_for_ = state_id_;
     }
 
+    // ---- the linearization services (ForwardSensitivity, Adjoint) ----
+    // The start of the attempt just prepared (prepare_start) from `from`: v_n, a_n, qdd_n and,
+    // with first-order states, w_n and y'_n (null without them); a_n and w_n rescaled to h
+    // unless they are from's own.
+    struct StepStart {
+        const Vec *v, *a, *qdd, *w, *ydot;
+        bool a_rescaled, w_rescaled;
+    };
+    StepStart step_start(const State &from) const
+    {
+        return {v_start_, a_start_, qdd_start_, w_start_, ydot_start_, a_start_ != &from.a,
+                w_start_ != &from.w};
+    }
+    // A Taylor step from `from`; the start of a step from it (a_start_, v_start_, qdd_start_,
+    // lambda_start_ and fresh_start_, which point into it): rescaled, corrected, or consistent
+    // again after short steps. `from` is the accepted state, or a perturbed copy (the
+    // sensitivities' differences).
+    ga_status sliver_step(const State &from, double h);
+    ga_status prepare_start(const State &from, double h, bool restart_short);
+    // The acceleration-level solve of the start (init.cpp) at (t, q, v) with the step's own
+    // matrix and scratch; the kept matrix is gone afterwards, and with mass_changed so is a
+    // constant mass evaluated.
+    ga_status start_accelerations(double t, const Vec &q, const Vec &v, Vec &qdd, Vec &lambda)
+    {
+        SaddleWorkspace w{S_, M_, J_, f_, c_, rq_};
+        return acceleration_level(t, q, v, w, qdd, lambda);
+    }
+    void drop_step_matrix(bool mass_changed)
+    {
+        jacobian_valid_ = false;
+        if (mass_changed)
+            mass_valid_ = false;
+    }
+    // [I Phi_q^T; Phi_q 0] at (t, q) in the step's matrix (a callback's status, or
+    // GA_ERR_SINGULAR without a message: the caller says what it projected), and its solves.
+    ga_status factorize_tangent_projection(double t, const Vec &q);
+    void solve_tangent_projection(const Vec &rq, const Vec &rl, Vec &d, Vec &dl)
+    {
+        S_.solve(rq, rl, d, dl);
+    }
+    double step_matrix_rcond() const { return S_.rcond(); }
+    // Whether every tangent an exact matrix needs has a place on the sparse path.
+    bool exact_tangents_fit() const
+    {
+        const bool damped = model.has_force() || model.cb.damping;
+        return !(sparse_backend_ &&
+                 ((!K_.zero() && K_.dense()) || (damped && !C_.zero() && C_.dense())));
+    }
+    // M, f, Phi_q and every tangent at the converged step x (the user's callbacks whatever the
+    // tangent mode, or central differences), into the step's matrices; which tangents exist.
+    ga_status exact_tangents(double t, const State &x, bool &K, bool &C, bool &Z);
+    // The exact iteration matrix at the converged step x (those tangents, the coupling blocks
+    // by central differences, the Schur complement on y), factorized: the next step's Newton
+    // iteration starts with it.
+    ga_status factorize_exact(const State &x, double h, bool &K, bool &C, bool &Z);
+    // The coupling blocks at a recorded state x (its rate g first), by central differences.
+    ga_status coupling_at(double t, const State &x);
+    // Index 2: B = Phi_q(q_n) evaluated at (t, q) into the step's B; where the step's B and
+    // eta_bar belong (the converged step's).
+    ga_status evaluate_B(double t, const Vec &q) { return model.jacobian(t, q, B_); }
+    double B_time() const { return b_t_; }
+    const Vec &eta_bar() const { return eta_total_; }
+    // The step's matrices as last evaluated: M, Phi_q, K_t, C_t, B, Z = d(Phi_q v + Phi_t)/dq,
+    // and the first-order coupling blocks.
+    const ModelMatrix &mass_matrix() const { return M_; }
+    const ModelMatrix &jacobian_matrix() const { return J_; }
+    const ModelMatrix &stiffness_matrix() const { return K_; }
+    const ModelMatrix &damping_matrix() const { return C_; }
+    const ModelMatrix &B_matrix() const { return B_; }
+    const ModelMatrix &Z_matrix() const { return Z_; }
+    const CouplingBlocks &coupling() const { return blocks_; }
+    bool sparse() const { return sparse_backend_; }
+    // Solves with the factorized step matrix, scaled as Newton's (index 3: rv, w and e unused),
+    // and the first-order states' elimination after it: dy from gy, then d, dl (and w) less
+    // their responses to dy.
+    void solve_step_matrix(const Vec &rq, const Vec &rl, const Vec &rv, double h, Vec &d, Vec &w,
+                           Vec &dl, Vec &e);
+    void eliminate_first_order(const Vec &gy, Vec &dy, Vec &d, Vec &dl, Vec &w) const;
+    // The report of the last attempt (attempt_step) and the reuse state an attempt began
+    // with, given back (kReuseStateSize entries, as StepReport::reuse_before): a replay
+    // attempts a recorded step as it was.
+    const StepReport &last_report() const { return step_report_; }
+    void restore_reuse(const double *reuse);
+    // A replayed step accepted: the trial state is the state, at t exactly; no undo point.
+    void accept_replayed(double t);
+    // What a sweep of replays changes besides the state a checkpoint restores, and its
+    // restoration.
+    struct RunPoint {
+        State previous;
+        bool previous_valid, start_pending;
+        long long state_id;
+    };
+    RunPoint run_point() const
+    {
+        return {previous_, previous_valid_, start_pending_, state_id_};
+    }
+    void restore_run_point(const RunPoint &point);
+    // The forces read the first-order states of the accepted state (not a recorded one).
+    void forces_see_accepted() { model.y_now = &accepted_.y; }
+    // KeptMatrix: the live matrices set aside while a sweep recomputes segments in matrices of
+    // their own, and taken back (stepper.cpp).
+    void set_aside_matrix(KeptMatrix &kept);  // allocates the replay's matrices
+    void take_back_matrix(KeptMatrix &kept);
+
 private:
     void forget_setup();
 
@@ -242,7 +346,6 @@ private:
     StepPlan plan_step(double h, double tol, bool sliver_allowed) const;
     ga_status attempt_step(double h, double tol, bool sliver_allowed);
     ga_status regular_step(const StepPlan &plan);
-    ga_status sliver_step(const State &from, double h);
     // A step this many times shorter than the one before is a Taylor step that ends like a
     // restart (sliver_step).
     static constexpr double kShortStepRatio = 100.0;
@@ -260,21 +363,10 @@ private:
     void finish_first_order(State &x);
     ga_status first_order_starting_values(const State &from, double h);
     double first_order_error_sum(double h, double scale, const StepController &control);
-    // The start of a step from `from` (a_start_, v_start_, qdd_start_, lambda_start_ and
-    // fresh_start_, which point into it): rescaled, corrected, or consistent again after
-    // short steps. `from` is accepted_, or a perturbed copy (sensitivity_by_differences).
-    ga_status prepare_start(const State &from, double h, bool restart_short);
     static bool long_after_short(const State &from, double h)
     {
         return from.h_last > 0.0 && h > kShortStepRatio * from.h_last;
     }
-    // M, f, Phi_q and every tangent at the converged step x (the user's callbacks whatever the
-    // tangent mode, or central differences), into M_, f_, J_, K_, C_, Z_; which tangents exist.
-    ga_status exact_tangents(double t, const State &x, bool &K, bool &C, bool &Z);
-    friend class ForwardSensitivity;
-    friend class Adjoint;
-    void set_aside_matrix(KeptMatrix &kept);  // allocates the replay's matrices
-    void take_back_matrix(KeptMatrix &kept);
     Vec eta_total_;       // index 2: the converged step's eta_bar (sum of its increments)
     ga_status factorize(double t, const State &x, double h, bool tangents_K, bool tangents_C,
                         bool tangent_Z, int iter);

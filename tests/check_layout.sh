@@ -19,6 +19,12 @@ if [ -n "$kernel_services" ]; then
     echo "the step kernel names a service or the transaction (use a door, step_doors.hpp):"
     echo "$kernel_services"; status=1
 fi
+# (and grants no service a friend's access: they use its public doors and services)
+friends=$(grep -nE '^\s*friend\b' "$src/stepper.hpp" "$src/solver.hpp" || true)
+if [ -n "$friends" ]; then
+    echo "the kernel or the transaction grants a friend's access (give it a narrow door):"
+    echo "$friends"; status=1
+fi
 members=$(grep -nE '^[A-Za-z_:<>*& ]*\bSolver::' "$src"/*.cpp | grep -vE '^[^:]*/(solver|transaction)\.cpp:' || true)
 if [ -n "$members" ]; then
     echo "a capability defines members of Solver (only solver.cpp and transaction.cpp do):"
