@@ -224,6 +224,7 @@ struct Adjoint::Work {
     Vec cq, cv, cqdd, cl, cp;     // a cost term's gradient
     Vec yq, yl, ye, zq, zl, ze;   // right-hand side and solution of S^T z = y
     Vec rr, rl, rv, qp, vp, tmp;  // adjoints of the linearized residual and the predictor
+    Vec qpt, mqt;                 // qp and mq through the transposed tangent operator
     Vec eta;
     Vec my, mydot, mw, ry, yp;  // first-order states (r): adjoints of y, y', w; r^y, y_p
     std::vector<double> dJ;
@@ -243,7 +244,8 @@ struct Adjoint::Work {
     {
         for (Vec *v : {&my, &mydot, &mw, &ry, &yp})
             v->setZero(r);
-        for (Vec *v : {&mq, &mv, &mqdd, &ma, &cq, &cv, &cqdd, &yq, &zq, &rr, &qp, &vp, &tmp})
+        for (Vec *v : {&mq, &mv, &mqdd, &ma, &cq, &cv, &cqdd, &yq, &zq, &rr, &qp, &vp, &tmp, &qpt,
+                       &mqt})
             v->setZero(n);
         for (Vec *v : {&ml, &cl, &yl, &ye, &zl, &ze, &rl, &rv, &eta})
             v->setZero(m);
@@ -333,6 +335,7 @@ ga_status Adjoint::step_back(long k, Work &w)
         st = k_.coupling_at(t1, x);
     }
     const Vec q_n = Eigen::Map<const Vec>(e0 + 4, nq);
+    const ConfigurationSpace &space = k_.model.space;
     if (!st && index2 && m > 0)
         st = k_.evaluate_B(e0[0], q_n);
     if (st)
@@ -465,14 +468,17 @@ ga_status Adjoint::step_back(long k, Work &w)
     const double am1 = p1.alpha_m, af1 = p1.alpha_f;
     if (R > 0)
         y.tail(R) = w.my + c1 * (w.mydot + ((1.0 - af1) / (1.0 - am1)) * w.mw);
+    // d enters q_{n+1} through the space's tangent operator (an identity in R^n)
+    w.mqt = w.mq;
+    space.tangent_transpose(q_n, x.q, w.mqt);
     if (index2 && m > 0) {
-        y.head(n) = w.tmp + w.mq;  // d = w - B^T e
+        y.head(n) = w.tmp + w.mqt;  // d = w - B^T e
         y.segment(n, m) = w.ml / bh2;
         w.ye.setZero();
         k_.B_matrix().multiply_add(-1.0, w.mq, w.ye);
         y.segment(n + m, m) = w.ye;
     } else {
-        y.head(n) = w.tmp + w.mq;
+        y.head(n) = w.tmp + w.mqt;
         y.segment(n, m) = w.ml / bh2;
     }
     // S^{-T}; the right-hand side was -(rows' scales) (r, r_lambda, r_v)
@@ -512,6 +518,9 @@ ga_status Adjoint::step_back(long k, Work &w)
         w.yp.noalias() -= b.f_y.transpose() * w.rr;
         w.yp.noalias() -= b.g_y.transpose() * w.ry;
     }
+    // q_p's increment part and the index-2 correction reach it through T, s_q by transport
+    w.qpt = w.qp;
+    space.tangent_transpose(q_n, x.q, w.qpt);
     for (int j = 0; j < w.np; ++j) {
         Sensitivities &z = forward_.sens;
         if ((st = forward_.constraint_parameter_terms(j, t1, x, index2, index2, e0[0], q_n, w.eta)))
@@ -519,7 +528,7 @@ ga_status Adjoint::step_back(long k, Work &w)
         z.rq = z.cq;
         if ((st = forward_.parameter_residual(j, t1, x)))
             return st;
-        w.dJ[j] += w.rr.dot(z.rq) + w.rl.dot(z.cl) + w.qp.dot(z.cbt);
+        w.dJ[j] += w.rr.dot(z.rq) + w.rl.dot(z.cl) + w.qpt.dot(z.cbt);
         if (index2 && m > 0)
             w.dJ[j] += w.rv.dot(z.cv);
         if (R > 0) {
@@ -541,14 +550,15 @@ ga_status Adjoint::step_back(long k, Work &w)
     // P^T: a_p = (af sqdd - am sa) / (1 - am), q_p = s_q + h sv + h^2 ((1/2 - beta) sa + beta a_p)
     // (- in index 2 the derivative of B^T eta_bar along s_q), v_p = sv + h ((1 - gamma) sa +
     // gamma a_p)
-    const Vec map = (h * h * p.beta) * w.qp + (h * p.gamma) * w.vp;
-    const Vec msv = h * w.qp + w.vp;
-    const Vec msa = (h * h * (0.5 - p.beta)) * w.qp + (h * (1.0 - p.gamma)) * w.vp -
+    const Vec map = (h * h * p.beta) * w.qpt + (h * p.gamma) * w.vp;
+    const Vec msv = h * w.qpt + w.vp;
+    const Vec msa = (h * h * (0.5 - p.beta)) * w.qpt + (h * (1.0 - p.gamma)) * w.vp -
                     (am / (1.0 - am)) * (map + w.ma);
     const Vec msqdd = (af / (1.0 - am)) * (map + w.ma);
     Vec msq = w.qp;
+    space.transport_transpose(q_n, x.q, msq);
     if (index2 && m > 0) {
-        if ((st = forward_.correction_derivative(e0[0], q_n, w.eta, w.qp, w.tmp)))
+        if ((st = forward_.correction_derivative(e0[0], q_n, w.eta, w.qpt, w.tmp)))
             return st;
         msq += w.tmp;
     }

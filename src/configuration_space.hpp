@@ -86,6 +86,30 @@ public:
         return std::fabs(q1[i] - q0[i]);
     }
 
+    // ---- tangent vectors across a step from q_n to q_n1 (docs/algorithms.md sec. 14) ----
+    // The derivatives of the discrete map (the forward sensitivities' linear step and,
+    // transposed, the adjoint's): on a group, with xi = log(q_n^-1 q_n1), a tangent vector at
+    // q_n reaches q_n1 transported by the adjoint representation of exp(-xi), and an increment
+    // of xi enters through the tangent operator T(xi); in R^n both are identities.
+    // The derivative of eq. (4) along a derivative of the state: s_q transported, plus
+    // h s_v + h^2 ((1/2 - beta) s_a + beta s_a1) through T.
+    void newmark_derivative(const Vec & /*q_n*/, const Vec & /*q_n1*/, const Vec &s_q,
+                            const Vec &s_v, const Vec &s_a, const Vec &s_a1, double h,
+                            double beta, Vec &out) const
+    {
+        out = s_q + h * s_v + (h * h) * ((0.5 - beta) * s_a + beta * s_a1);
+    }
+    // s_q += T(xi) d: an increment of the step's xi added to a derivative of q_n1
+    void tangent_increment(const Vec & /*q_n*/, const Vec & /*q_n1*/, const Vec &d,
+                           Vec &s_q) const
+    {
+        s_q += d;
+    }
+    // The transposes, in place on an adjoint variable at q_n1: of the transport (to q_n) and
+    // of T(xi).
+    void transport_transpose(const Vec & /*q_n*/, const Vec & /*q_n1*/, Vec & /*m*/) const {}
+    void tangent_transpose(const Vec & /*q_n*/, const Vec & /*q_n1*/, Vec & /*m*/) const {}
+
 private:
     Eigen::Index nq_, nv_;
 };

@@ -613,7 +613,8 @@ ga_status ForwardSensitivity::step(double h)
         s1.qdd.setZero();
         s1.lambda.setZero();
         s1.a = (p.alpha_f * sqdd - p.alpha_m * *sa) / (1.0 - p.alpha_m);
-        s1.q = sn.q + h * sv + (h * h) * ((0.5 - p.beta) * *sa + p.beta * s1.a);
+        const ConfigurationSpace &space = k_.model.space;
+        space.newmark_derivative(s.q, x.q, sn.q, sv, *sa, s1.a, h, p.beta, s1.q);
         s1.v = sv + h * ((1.0 - p.gamma) * *sa + p.gamma * s1.a);
         // the constraints' parameter terms (zero unless they depend on p)
         if ((st = constraint_parameter_terms(j, t1, x, index2, index2, k_.B_time(), s.q,
@@ -624,8 +625,8 @@ ga_status ForwardSensitivity::step(double h)
         if (index2 && k_.m() > 0) {
             if ((st = correction_derivative(k_.B_time(), s.q, k_.eta_bar(), sn.q, z.bt)))
                 return st;
-            s1.q += z.bt;
-            s1.q += z.cbt;
+            space.tangent_increment(s.q, x.q, z.bt, s1.q);
+            space.tangent_increment(s.q, x.q, z.cbt, s1.q);
         }
         // the residual linearized at the converged step
         z.rq = z.cq;
@@ -667,7 +668,7 @@ ga_status ForwardSensitivity::step(double h)
                    (1.0 - p1.alpha_m);
         }
         const Vec &dw = index2 ? z.w : z.d;
-        s1.q += z.d;
+        space.tangent_increment(s.q, x.q, z.d, s1.q);
         s1.v += c.gamma_prime * dw;
         s1.qdd += c.beta_prime * dw;
         s1.lambda = z.dl;
