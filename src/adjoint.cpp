@@ -315,7 +315,7 @@ ga_status Adjoint::step_back(long k, Work &w)
     const NewtonCoefficients c = newton_coefficients(p, h);
     const double bh2 = p.beta * h * h, t1 = e1[0];
 
-    // the converged step and its exact iteration matrix (as sensitivity_step builds it)
+    // the converged step and its exact iteration matrix (as factorize_exact builds it)
     State &x = w.x;
     const double *src = e1 + 4;
     x.q = Eigen::Map<const Vec>(src, nq);

@@ -348,7 +348,7 @@ ga_status Stepper::rebuild_matrix()
     }
     const ga_tangent_mode mode = model.tangent_mode;
     const Restore<ga_tangent_mode> keep_mode(model.tangent_mode);
-    if (r.central)  // the matrix of the sensitivities (sensitivity_step)
+    if (r.central)  // the exact matrix of the sensitivities (factorize_exact)
         model.tangent_mode = GA_TANGENT_AUTO;
     if (!st && r.K)
         st = model.stiffness(r.t, x.q, x.v, x.qdd, x.lambda, rq_, M_, K_, r.central);

@@ -232,7 +232,7 @@ void Stepper::finish_first_order(State &x)
 //     C_y = ((1 - gamma1) delta^2 + gamma1 (1 + delta)^2) / 2 + kappa - 1/6
 // (0.084 at rho_inf = 0.9, 1/3 at 0; checked against the scheme run on y' = cos t), with y'''
 // from the divided differences of w over the last two steps, as e_v is from those of a
-// (control.cpp; none in the first step). The sum of the squared weighted errors.
+// (error_estimate.cpp; none in the first step). The sum of the squared weighted errors.
 double Stepper::first_order_error_sum(double h, double scale, const StepController &control)
 {
     const State &s = accepted_, &x = trial_;

@@ -112,7 +112,7 @@ ga_status ForwardSensitivity::central_difference(int j, Perturb &&perturb, Evalu
 // that solve along (dq0, dv0) and p_j: it is linear in p, and cheap once).
 ga_status ForwardSensitivity::start(const State &x)
 {
-    // Exact derivatives need every tangent in the matrix (sensitivity_step): on the sparse
+    // Exact derivatives need every tangent in the matrix (step): on the sparse
     // path a tangent without a pattern has no place there.
     if (!k_.exact_tangents_fit())
         return k_.diag.fail(GA_ERR_ARG,

@@ -15,7 +15,7 @@ struct State {
     double sliver_span = 0.0;
     Vec q, v, qdd, lambda, a;
     Vec a_prev;           // a of the state before (variable-step error estimate)
-    // Index-3 adaptive steps (control.cpp): qdd consistent with (q, v) here (c) and at the
+    // Index-3 adaptive steps (error_estimate.cpp): qdd consistent with (q, v) here (c) and at the
     // state before (c_prev), c_dt apart; c_count of them known (0-2; 0 after a fixed step).
     Vec c, c_prev;
     double c_dt = 0.0;

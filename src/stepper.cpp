@@ -818,7 +818,7 @@ ga_status Stepper::factorize(double t, const State &x, double h, bool tangents_K
     r.K = tangents_K;
     r.C = tangents_C;
     r.Z = tangent_Z;
-    r.central = false;  // (sensitivity_step says otherwise after its factorization)
+    r.central = false;  // (factorize_exact says otherwise after its factorization)
     r.q = x.q;
     r.v = x.v;
     r.qdd = x.qdd;

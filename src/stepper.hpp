@@ -467,7 +467,7 @@ private:
     ModelMatrix M_, J_, K_, C_, B_;  // B_: index-2, Phi_q(q_n)
     ModelMatrix Z_;                  // index-2: d(Phi_q v + Phi_t)/dq, layout of J_
     Vec f_, phi_, phi_v_, rq_, dq_, dw_, dlambda_, deta_, c_, qdd_tmp_, lambda_tmp_;
-    Vec guard_q_, guard_v_;  // index-3 error estimate: the estimate from a (control.cpp)
+    Vec guard_q_, guard_v_;  // index-3 error estimate: the estimate from a (error_estimate.cpp)
     bool estimate_is_output_ = false;  // its accelerations are the consistent output's
     // resolution_check.cpp: the index-3 step's velocity constraint, and its largest ratio
     ga_status check_velocity_constraint(double h, double tol);
