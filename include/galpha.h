@@ -1119,6 +1119,41 @@ GA_API ga_status ga_check_derivatives(ga_solver *s, double t, const double *q, c
 GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value);
 /**@}*/
 
+/** @name Rotations: SO(3) as unit quaternions
+ *  The rotation group's maps, for models whose rotations are rotation vectors or quaternions,
+ *  so that their constraint gradients and tangents follow one convention:
+ *  - a quaternion is (w, x, y, z), w the scalar part; R(q) x = q x q^-1 maps body to space;
+ *  - increments are right (body-frame): q o exp(psi) is q turned by |psi| about psi / |psi| in
+ *    its body frame;
+ *  - the tangent operator T(psi) is the right-trivialized derivative of exp:
+ *    exp(psi + d) = exp(psi) o exp(T(psi) d + O(|d|^2)),
+ *    T(psi) = I + ((cos t - 1) / t^2) psi~ + ((t - sin t) / t^3) psi~^2, t = |psi|, psi~ x =
+ *    psi cross x (docs/algorithms.md sec. 15).
+ *
+ *  Each function maps `count` items at once (count >= 0): arrays of count consecutive
+ *  3-vectors, quaternions (4 doubles) or 3 x 3 matrices (9, column-major). An output may be
+ *  the same array as an input of its shape (in place). They need no solver and touch no state.
+ *  Errors (nothing is written): GA_ERR_ARG for count < 0 or too large for its arrays' lengths,
+ *  a NULL array with count > 0, a value that is not finite, a quaternion whose norm is not 1
+ *  within 1e-6 (ga_so3_log, ga_so3_matrix), and |psi| >= 2 pi in ga_so3_tangent_inverse
+ *  (T is singular there); ga_strerror names the status. */
+/**@{*/
+/** q_i = exp(psi_i): the unit quaternion (cos(t/2), sin(t/2) psi_i / t), t = |psi_i|. */
+GA_API ga_status ga_so3_exp(long count, const double *psi, double *q);
+/** psi_i = log(q_i): the rotation vector with exp(psi_i) = +-q_i and |psi_i| <= pi (q and -q
+ *  are the same rotation); q_i is normalized first. */
+GA_API ga_status ga_so3_log(long count, const double *q, double *psi);
+/** ab_i = a_i o b_i, the quaternion product (first b_i, then a_i, as rotations). */
+GA_API ga_status ga_so3_compose(long count, const double *a, const double *b, double *ab);
+/** R_i = R(q_i), the 3 x 3 rotation matrix (column-major); q_i is normalized first. */
+GA_API ga_status ga_so3_matrix(long count, const double *q, double *R);
+/** T_i = T(psi_i), column-major. */
+GA_API ga_status ga_so3_tangent(long count, const double *psi, double *T);
+/** T_i = T(psi_i)^-1 = I + (1/2) psi~ + (1/t^2 - cot(t/2) / (2 t)) psi~^2, column-major
+ *  (|psi_i| < 2 pi). */
+GA_API ga_status ga_so3_tangent_inverse(long count, const double *psi, double *T);
+/**@}*/
+
 #ifdef __cplusplus
 } /* extern "C" */
 #endif

@@ -605,6 +605,43 @@ module galpha
        type(c_funptr), value :: running, terminal
        real(c_double), intent(out) :: J, dJ_dp(*)
      end function ga_adjoint_gradient
+     ! SO(3) as unit quaternions (w, x, y, z); matrices column-major, as Fortran stores them
+     integer(c_int) function ga_so3_exp(count, psi, q) bind(C, name="ga_so3_exp")
+       import :: c_int, c_long, c_double
+       integer(c_long), value :: count
+       real(c_double), intent(in) :: psi(*)
+       real(c_double), intent(out) :: q(*)
+     end function ga_so3_exp
+     integer(c_int) function ga_so3_log(count, q, psi) bind(C, name="ga_so3_log")
+       import :: c_int, c_long, c_double
+       integer(c_long), value :: count
+       real(c_double), intent(in) :: q(*)
+       real(c_double), intent(out) :: psi(*)
+     end function ga_so3_log
+     integer(c_int) function ga_so3_compose(count, a, b, ab) bind(C, name="ga_so3_compose")
+       import :: c_int, c_long, c_double
+       integer(c_long), value :: count
+       real(c_double), intent(in) :: a(*), b(*)
+       real(c_double), intent(out) :: ab(*)
+     end function ga_so3_compose
+     integer(c_int) function ga_so3_matrix(count, q, R) bind(C, name="ga_so3_matrix")
+       import :: c_int, c_long, c_double
+       integer(c_long), value :: count
+       real(c_double), intent(in) :: q(*)
+       real(c_double), intent(out) :: R(*)
+     end function ga_so3_matrix
+     integer(c_int) function ga_so3_tangent(count, psi, T) bind(C, name="ga_so3_tangent")
+       import :: c_int, c_long, c_double
+       integer(c_long), value :: count
+       real(c_double), intent(in) :: psi(*)
+       real(c_double), intent(out) :: T(*)
+     end function ga_so3_tangent
+     integer(c_int) function ga_so3_tangent_inverse(count, psi, T) bind(C, name="ga_so3_tangent_inverse")
+       import :: c_int, c_long, c_double
+       integer(c_long), value :: count
+       real(c_double), intent(in) :: psi(*)
+       real(c_double), intent(out) :: T(*)
+     end function ga_so3_tangent_inverse
      function c_strlen(p) bind(C, name="strlen")
        import :: c_ptr, c_size_t
        type(c_ptr), value :: p
@@ -632,7 +669,8 @@ module galpha
        ga_set_constraint_parameter_derivative, &
        ga_set_sensitivity_start, ga_get_sensitivity_y, &
        ga_set_sensitivity_method, ga_adjoint_gradient, ga_set_adjoint_checkpoints, &
-       ga_set_step_hook
+       ga_set_step_hook, ga_so3_exp, ga_so3_log, ga_so3_compose, ga_so3_matrix, ga_so3_tangent, &
+       ga_so3_tangent_inverse
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
@@ -778,6 +816,8 @@ module galpha
      procedure :: adjoint_gradient => solver_adjoint_gradient
   end type galpha_solver
   public :: galpha_strerror, galpha_version, galpha_version_number
+  public :: galpha_so3_exp, galpha_so3_log, galpha_so3_compose, galpha_so3_matrix, &
+       galpha_so3_tangent, galpha_so3_tangent_inverse
 
 contains
 
@@ -813,6 +853,82 @@ contains
   integer function galpha_version_number()
     galpha_version_number = int(ga_version_number())
   end function galpha_version_number
+
+  ! The rotation maps over whole arrays: count = size(input) / its item's width (3 for psi,
+  ! 4 for a quaternion); the output holds count items (4, 3 or 9 each, matrices column-major).
+  ! GA_ERR_ARG also when an array is not whole items or the output too short.
+  integer(c_int) function galpha_so3_exp(psi, q) result(status)
+    real(c_double), intent(in) :: psi(:)
+    real(c_double), intent(out) :: q(:)
+    integer(c_long) :: count
+    count = int(size(psi) / 3, c_long)
+    if (mod(size(psi), 3) /= 0 .or. size(q) < 4 * count) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_so3_exp(count, psi, q)
+  end function galpha_so3_exp
+
+  integer(c_int) function galpha_so3_log(q, psi) result(status)
+    real(c_double), intent(in) :: q(:)
+    real(c_double), intent(out) :: psi(:)
+    integer(c_long) :: count
+    count = int(size(q) / 4, c_long)
+    if (mod(size(q), 4) /= 0 .or. size(psi) < 3 * count) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_so3_log(count, q, psi)
+  end function galpha_so3_log
+
+  integer(c_int) function galpha_so3_compose(a, b, ab) result(status)
+    real(c_double), intent(in) :: a(:)
+    real(c_double), intent(in) :: b(:)
+    real(c_double), intent(out) :: ab(:)
+    integer(c_long) :: count
+    count = int(size(a) / 4, c_long)
+    if (mod(size(a), 4) /= 0 .or. size(b) /= size(a) .or. size(ab) < 4 * count) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_so3_compose(count, a, b, ab)
+  end function galpha_so3_compose
+
+  integer(c_int) function galpha_so3_matrix(q, R) result(status)
+    real(c_double), intent(in) :: q(:)
+    real(c_double), intent(out) :: R(:)
+    integer(c_long) :: count
+    count = int(size(q) / 4, c_long)
+    if (mod(size(q), 4) /= 0 .or. size(R) < 9 * count) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_so3_matrix(count, q, R)
+  end function galpha_so3_matrix
+
+  integer(c_int) function galpha_so3_tangent(psi, T) result(status)
+    real(c_double), intent(in) :: psi(:)
+    real(c_double), intent(out) :: T(:)
+    integer(c_long) :: count
+    count = int(size(psi) / 3, c_long)
+    if (mod(size(psi), 3) /= 0 .or. size(T) < 9 * count) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_so3_tangent(count, psi, T)
+  end function galpha_so3_tangent
+
+  integer(c_int) function galpha_so3_tangent_inverse(psi, T) result(status)
+    real(c_double), intent(in) :: psi(:)
+    real(c_double), intent(out) :: T(:)
+    integer(c_long) :: count
+    count = int(size(psi) / 3, c_long)
+    if (mod(size(psi), 3) /= 0 .or. size(T) < 9 * count) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_so3_tangent_inverse(count, psi, T)
+  end function galpha_so3_tangent_inverse
 
   integer(c_int) function solver_create(this, n, m) result(status)
     class(galpha_solver), intent(inout) :: this

@@ -101,13 +101,14 @@ inline Mat3 tangent(const Vec3 &psi)
     return detail::one_plus(psi, c1, c2);
 }
 
-// T(psi)^-1 = I + (1/2) psi~ + (1 / theta^2 - (1 + cos theta) / (2 theta sin theta)) psi~^2
-// (for theta < 2 pi; the increments of a step are far below)
+// T(psi)^-1 = I + (1/2) psi~ + (1 / theta^2 - cot(theta/2) / (2 theta)) psi~^2 (for
+// theta < 2 pi; the increments of a step are far below). cot(theta/2), not
+// (1 + cos theta) / sin theta: the same value, without 0/0 at theta = pi.
 inline Mat3 tangent_inverse(const Vec3 &psi)
 {
-    const double th = norm(psi), t2 = th * th;
+    const double th = norm(psi), t2 = th * th, h = 0.5 * th;
     const double c2 = th < 1e-4 ? 1.0 / 12.0 + t2 / 720.0
-                                : 1.0 / t2 - (1.0 + std::cos(th)) / (2.0 * th * std::sin(th));
+                                : 1.0 / t2 - std::cos(h) / (2.0 * th * std::sin(h));
     return detail::one_plus(psi, 0.5, c2);
 }
 

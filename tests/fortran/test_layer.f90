@@ -170,6 +170,7 @@ contains
 end module layer_events
 
 program test_layer
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use galpha
   use params_model
   use layer_events
@@ -441,6 +442,32 @@ program test_layer
   end do
   stiffness(1) = 4.0d0
   call expect(r%adjoint_gradient(x, q2(1:1)) == GA_ERR_ARG, 'adjoint_gradient needs a cost')
+
+  ! the rotation maps: a quarter turn about z takes the body's x axis to space y (R(:, 1) =
+  ! e_y, Fortran's column-major), its logarithm gives the turn back, a NaN is refused
+  block
+    real(c_double) :: psi(3), qz(4), rz(9), back3(3), tz(9), ti(9), two(8), prod(8)
+    psi = [0.0d0, 0.0d0, 2.0d0 * atan(1.0d0)]
+    call ok(galpha_so3_exp(psi, qz), 'so3_exp')
+    call ok(galpha_so3_matrix(qz, rz), 'so3_matrix')
+    call expect(abs(rz(1)) < 1d-15 .and. abs(rz(2) - 1.0d0) < 1d-15 .and. abs(rz(3)) < 1d-15, &
+                'so3_matrix column-major')
+    call ok(galpha_so3_log(qz, back3), 'so3_log')
+    call expect(maxval(abs(back3 - psi)) < 1d-15, 'so3_log inverts so3_exp')
+    call ok(galpha_so3_tangent(psi, tz), 'so3_tangent')
+    call expect(abs(tz(1) - sin(psi(3)) / psi(3)) < 1d-15, 'so3_tangent T(1, 1)')
+    call ok(galpha_so3_tangent_inverse(psi, ti), 'so3_tangent_inverse')
+    call expect(abs(sum(reshape(tz, [3, 3]) * transpose(reshape(ti, [3, 3]))) - 3.0d0) < 1d-14, &
+                'so3_tangent_inverse: trace of T T^-1')
+    ! two quarter turns about z in one call each: their product is a half turn
+    two = [qz, qz]
+    call ok(galpha_so3_compose(two(1:4), two(5:8), prod(1:4)), 'so3_compose')
+    call expect(abs(prod(1)) < 1d-15 .and. abs(abs(prod(4)) - 1.0d0) < 1d-15, 'so3_compose')
+    call expect(galpha_so3_compose(two, two(1:4), prod) == GA_ERR_ARG, 'so3_compose sizes')
+    call expect(galpha_so3_exp(psi(1:2), qz) == GA_ERR_ARG, 'so3_exp: not whole items')
+    psi(2) = ieee_value(psi(2), ieee_quiet_nan)
+    call expect(ga_so3_exp(1_c_long, psi, qz) == GA_ERR_ARG, 'so3_exp refuses a NaN')
+  end block
 
   call s%free()
   call r%free()

@@ -32,6 +32,7 @@ from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceErr
                      StepSizeError, UnresolvedError)
 from .integrate import IntegrateResult, OdeSolution, integrate  # noqa: F401
 from .solver import Sensitivity, Solver  # noqa: F401
+from . import so3  # noqa: F401,E402
 
 
 def __getattr__(name):

@@ -244,6 +244,12 @@ _SIGNATURES = {
     "ga_set_sensitivity_method": (_I, [_S, _I, ctypes.c_long]),
     "ga_set_adjoint_checkpoints": (_I, [_S, ctypes.c_long, ctypes.c_long]),
     "ga_adjoint_gradient": (_I, [_S, COST_FN, COST_FN, c_double_p, c_double_p]),
+    "ga_so3_exp": (_I, [ctypes.c_long, c_double_p, c_double_p]),
+    "ga_so3_log": (_I, [ctypes.c_long, c_double_p, c_double_p]),
+    "ga_so3_compose": (_I, [ctypes.c_long, c_double_p, c_double_p, c_double_p]),
+    "ga_so3_matrix": (_I, [ctypes.c_long, c_double_p, c_double_p]),
+    "ga_so3_tangent": (_I, [ctypes.c_long, c_double_p, c_double_p]),
+    "ga_so3_tangent_inverse": (_I, [ctypes.c_long, c_double_p, c_double_p]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():

@@ -1,0 +1,136 @@
+// The rotation group's maps in the C API (ga_so3_*): src/lie/so3.hpp over arrays of items,
+// with the checks of the header's contract; matrices leave column-major.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <initializer_list>
+
+#include "galpha.h"
+#include "lie/so3.hpp"
+
+namespace {
+
+namespace so3 = ga::so3;
+
+// count items of `width` doubles each: count >= 0, the arrays' lengths representable, and an
+// array given whenever there is an item
+bool valid(long count, std::size_t width, std::initializer_list<const void *> arrays)
+{
+    if (count < 0 || static_cast<unsigned long>(count) > PTRDIFF_MAX / (width * sizeof(double)))
+        return false;
+    if (count == 0)
+        return true;
+    for (const void *a : arrays)
+        if (!a)
+            return false;
+    return true;
+}
+
+bool finite(const double *x, std::size_t n)
+{
+    for (std::size_t i = 0; i < n; ++i)
+        if (!std::isfinite(x[i]))
+            return false;
+    return true;
+}
+
+// Every input item checked before the first output is written: a failed call writes nothing.
+template <std::size_t In, class Check> bool all_items(long count, const double *x, Check &&check)
+{
+    for (long i = 0; i < count; ++i) {
+        const double *xi = x + static_cast<std::size_t>(i) * In;
+        if (!finite(xi, In) || !check(xi))
+            return false;
+    }
+    return true;
+}
+
+double length(const double *q)
+{
+    return std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+}
+// a quaternion within 1e-6 of unit norm, as a unit one
+bool near_unit(const double *q) { return std::fabs(length(q) - 1.0) <= 1e-6; }
+so3::Quat unit(const double *q)
+{
+    const double n = length(q);
+    return {q[0] / n, q[1] / n, q[2] / n, q[3] / n};
+}
+
+so3::Vec3 vec3(const double *x) { return {x[0], x[1], x[2]}; }
+
+void put(const so3::Mat3 &A, double *out)  // row-major in, column-major out
+{
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            out[i + 3 * j] = A[3 * i + j];
+}
+
+template <std::size_t N> void put(const std::array<double, N> &x, double *out)
+{
+    for (std::size_t i = 0; i < N; ++i)
+        out[i] = x[i];
+}
+
+const auto any = [](const double *) { return true; };
+
+}  // namespace
+
+GA_API ga_status ga_so3_exp(long count, const double *psi, double *q)
+{
+    if (!valid(count, 4, {psi, q}) || !all_items<3>(count, psi, any))
+        return GA_ERR_ARG;
+    for (long i = 0; i < count; ++i)
+        put(so3::exp(vec3(psi + 3 * i)), q + 4 * i);
+    return GA_OK;
+}
+
+GA_API ga_status ga_so3_log(long count, const double *q, double *psi)
+{
+    if (!valid(count, 4, {q, psi}) || !all_items<4>(count, q, near_unit))
+        return GA_ERR_ARG;
+    for (long i = 0; i < count; ++i)
+        put(so3::log(unit(q + 4 * i)), psi + 3 * i);
+    return GA_OK;
+}
+
+GA_API ga_status ga_so3_compose(long count, const double *a, const double *b, double *ab)
+{
+    if (!valid(count, 4, {a, b, ab}) || !all_items<4>(count, a, any) ||
+        !all_items<4>(count, b, any))
+        return GA_ERR_ARG;
+    for (long i = 0; i < count; ++i) {
+        const double *x = a + 4 * i, *y = b + 4 * i;
+        put(so3::compose({x[0], x[1], x[2], x[3]}, {y[0], y[1], y[2], y[3]}), ab + 4 * i);
+    }
+    return GA_OK;
+}
+
+GA_API ga_status ga_so3_matrix(long count, const double *q, double *R)
+{
+    if (!valid(count, 9, {q, R}) || !all_items<4>(count, q, near_unit))
+        return GA_ERR_ARG;
+    for (long i = 0; i < count; ++i)
+        put(so3::matrix(unit(q + 4 * i)), R + 9 * i);
+    return GA_OK;
+}
+
+GA_API ga_status ga_so3_tangent(long count, const double *psi, double *T)
+{
+    if (!valid(count, 9, {psi, T}) || !all_items<3>(count, psi, any))
+        return GA_ERR_ARG;
+    for (long i = 0; i < count; ++i)
+        put(so3::tangent(vec3(psi + 3 * i)), T + 9 * i);
+    return GA_OK;
+}
+
+GA_API ga_status ga_so3_tangent_inverse(long count, const double *psi, double *T)
+{
+    constexpr double kTwoPi = 6.283185307179586;
+    const auto invertible = [](const double *p) { return so3::norm(vec3(p)) < kTwoPi; };
+    if (!valid(count, 9, {psi, T}) || !all_items<3>(count, psi, invertible))
+        return GA_ERR_ARG;
+    for (long i = 0; i < count; ++i)
+        put(so3::tangent_inverse(vec3(psi + 3 * i)), T + 9 * i);
+    return GA_OK;
+}
