@@ -636,7 +636,8 @@ module galpha
        real(c_double), intent(in) :: psi(*)
        real(c_double), intent(out) :: T(*)
      end function ga_so3_tangent
-     integer(c_int) function ga_so3_tangent_inverse(count, psi, T) bind(C, name="ga_so3_tangent_inverse")
+     integer(c_int) function ga_so3_tangent_inverse(count, psi, T) &
+          bind(C, name="ga_so3_tangent_inverse")
        import :: c_int, c_long, c_double
        integer(c_long), value :: count
        real(c_double), intent(in) :: psi(*)
