@@ -19,6 +19,10 @@
 namespace ga {
 
 class Solver : private StepOutput, private StepDoors {
+    // First: the references below and the services are bound to it, which is defined only
+    // once it is constructed.
+    Stepper k_;
+
 public:
     Solver(int n, int m);
     Solver(const Solver &) = delete;
@@ -126,7 +130,6 @@ private:
     ga_status interpolate_y_at(double t, double *y) override;
     Model &callbacks() override;
 
-    Stepper k_;
     ForwardSensitivity forward_{k_};
     Adjoint adjoint_{k_, forward_, *this};
     EventSet events_;
