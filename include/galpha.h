@@ -1150,7 +1150,9 @@ GA_API ga_status ga_so3_matrix(long count, const double *q, double *R);
 /** T_i = T(psi_i), column-major. */
 GA_API ga_status ga_so3_tangent(long count, const double *psi, double *T);
 /** T_i = T(psi_i)^-1 = I + (1/2) psi~ + (1/t^2 - cot(t/2) / (2 t)) psi~^2, column-major
- *  (|psi_i| < 2 pi). */
+ *  (|psi_i| < 2 pi). T is singular at |psi| = 2 pi: the entries grow like 1 / (2 pi - |psi|)
+ *  and carry a relative error of about eps / (2 pi - |psi|) there (the increments of a step
+ *  stay far below pi). */
 GA_API ga_status ga_so3_tangent_inverse(long count, const double *psi, double *T);
 /**@}*/
 

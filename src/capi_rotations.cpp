@@ -1,5 +1,6 @@
 // The rotation group's maps in the C API (ga_so3_*): src/lie/so3.hpp over arrays of items,
 // with the checks of the header's contract; matrices leave column-major.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -74,24 +75,29 @@ template <std::size_t N> void put(const std::array<double, N> &x, double *out)
 
 const auto any = [](const double *) { return true; };
 
+// out_i = f(in_i) for count items of In doubles in and Out out, each input accepted by `check`
+// before the first output is written
+template <std::size_t In, std::size_t Out, class Check, class Map>
+ga_status map_items(long count, const double *in, double *out, Check &&check, Map &&f)
+{
+    if (!valid(count, std::max(In, Out), {in, out}) || !all_items<In>(count, in, check))
+        return GA_ERR_ARG;
+    for (long i = 0; i < count; ++i)
+        put(f(in + In * i), out + Out * i);
+    return GA_OK;
+}
+
 }  // namespace
 
 GA_API ga_status ga_so3_exp(long count, const double *psi, double *q)
 {
-    if (!valid(count, 4, {psi, q}) || !all_items<3>(count, psi, any))
-        return GA_ERR_ARG;
-    for (long i = 0; i < count; ++i)
-        put(so3::exp(vec3(psi + 3 * i)), q + 4 * i);
-    return GA_OK;
+    return map_items<3, 4>(count, psi, q, any, [](const double *p) { return so3::exp(vec3(p)); });
 }
 
 GA_API ga_status ga_so3_log(long count, const double *q, double *psi)
 {
-    if (!valid(count, 4, {q, psi}) || !all_items<4>(count, q, near_unit))
-        return GA_ERR_ARG;
-    for (long i = 0; i < count; ++i)
-        put(so3::log(unit(q + 4 * i)), psi + 3 * i);
-    return GA_OK;
+    return map_items<4, 3>(count, q, psi, near_unit,
+                           [](const double *x) { return so3::log(unit(x)); });
 }
 
 GA_API ga_status ga_so3_compose(long count, const double *a, const double *b, double *ab)
@@ -108,29 +114,20 @@ GA_API ga_status ga_so3_compose(long count, const double *a, const double *b, do
 
 GA_API ga_status ga_so3_matrix(long count, const double *q, double *R)
 {
-    if (!valid(count, 9, {q, R}) || !all_items<4>(count, q, near_unit))
-        return GA_ERR_ARG;
-    for (long i = 0; i < count; ++i)
-        put(so3::matrix(unit(q + 4 * i)), R + 9 * i);
-    return GA_OK;
+    return map_items<4, 9>(count, q, R, near_unit,
+                           [](const double *x) { return so3::matrix(unit(x)); });
 }
 
 GA_API ga_status ga_so3_tangent(long count, const double *psi, double *T)
 {
-    if (!valid(count, 9, {psi, T}) || !all_items<3>(count, psi, any))
-        return GA_ERR_ARG;
-    for (long i = 0; i < count; ++i)
-        put(so3::tangent(vec3(psi + 3 * i)), T + 9 * i);
-    return GA_OK;
+    return map_items<3, 9>(count, psi, T, any,
+                           [](const double *p) { return so3::tangent(vec3(p)); });
 }
 
 GA_API ga_status ga_so3_tangent_inverse(long count, const double *psi, double *T)
 {
     constexpr double kTwoPi = 6.283185307179586;
     const auto invertible = [](const double *p) { return so3::norm(vec3(p)) < kTwoPi; };
-    if (!valid(count, 9, {psi, T}) || !all_items<3>(count, psi, invertible))
-        return GA_ERR_ARG;
-    for (long i = 0; i < count; ++i)
-        put(so3::tangent_inverse(vec3(psi + 3 * i)), T + 9 * i);
-    return GA_OK;
+    return map_items<3, 9>(count, psi, T, invertible,
+                           [](const double *p) { return so3::tangent_inverse(vec3(p)); });
 }

@@ -858,12 +858,20 @@ contains
   ! The rotation maps over whole arrays: count = size(input) / its item's width (3 for psi,
   ! 4 for a quaternion); the output holds count items (4, 3 or 9 each, matrices column-major).
   ! GA_ERR_ARG also when an array is not whole items or the output too short.
+
+  ! n_in doubles of items w_in wide, into n_out of items w_out wide: count, whole items, room
+  logical function whole_items(n_in, w_in, n_out, w_out, count)
+    integer, intent(in) :: n_in, w_in, n_out, w_out
+    integer(c_long), intent(out) :: count
+    count = int(n_in / w_in, c_long)
+    whole_items = mod(n_in, w_in) == 0 .and. n_out >= w_out * count
+  end function whole_items
+
   integer(c_int) function galpha_so3_exp(psi, q) result(status)
     real(c_double), intent(in) :: psi(:)
     real(c_double), intent(out) :: q(:)
     integer(c_long) :: count
-    count = int(size(psi) / 3, c_long)
-    if (mod(size(psi), 3) /= 0 .or. size(q) < 4 * count) then
+    if (.not. whole_items(size(psi), 3, size(q), 4, count)) then
        status = GA_ERR_ARG
        return
     end if
@@ -874,8 +882,7 @@ contains
     real(c_double), intent(in) :: q(:)
     real(c_double), intent(out) :: psi(:)
     integer(c_long) :: count
-    count = int(size(q) / 4, c_long)
-    if (mod(size(q), 4) /= 0 .or. size(psi) < 3 * count) then
+    if (.not. whole_items(size(q), 4, size(psi), 3, count)) then
        status = GA_ERR_ARG
        return
     end if
@@ -887,8 +894,7 @@ contains
     real(c_double), intent(in) :: b(:)
     real(c_double), intent(out) :: ab(:)
     integer(c_long) :: count
-    count = int(size(a) / 4, c_long)
-    if (mod(size(a), 4) /= 0 .or. size(b) /= size(a) .or. size(ab) < 4 * count) then
+    if (size(b) /= size(a) .or. .not. whole_items(size(a), 4, size(ab), 4, count)) then
        status = GA_ERR_ARG
        return
     end if
@@ -899,8 +905,7 @@ contains
     real(c_double), intent(in) :: q(:)
     real(c_double), intent(out) :: R(:)
     integer(c_long) :: count
-    count = int(size(q) / 4, c_long)
-    if (mod(size(q), 4) /= 0 .or. size(R) < 9 * count) then
+    if (.not. whole_items(size(q), 4, size(R), 9, count)) then
        status = GA_ERR_ARG
        return
     end if
@@ -911,8 +916,7 @@ contains
     real(c_double), intent(in) :: psi(:)
     real(c_double), intent(out) :: T(:)
     integer(c_long) :: count
-    count = int(size(psi) / 3, c_long)
-    if (mod(size(psi), 3) /= 0 .or. size(T) < 9 * count) then
+    if (.not. whole_items(size(psi), 3, size(T), 9, count)) then
        status = GA_ERR_ARG
        return
     end if
@@ -923,8 +927,7 @@ contains
     real(c_double), intent(in) :: psi(:)
     real(c_double), intent(out) :: T(:)
     integer(c_long) :: count
-    count = int(size(psi) / 3, c_long)
-    if (mod(size(psi), 3) /= 0 .or. size(T) < 9 * count) then
+    if (.not. whole_items(size(psi), 3, size(T), 9, count)) then
        status = GA_ERR_ARG
        return
     end if
