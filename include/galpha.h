@@ -180,6 +180,41 @@ typedef int (*ga_event_fn)(double t, const double *q, const double *v, const dou
  *  Errors: GA_ERR_ARG (out NULL, n < 1, m < 0, m > n), GA_ERR_NOMEM. */
 GA_API ga_status ga_create(int n, int m, ga_solver **out);
 
+/** Kinds of block of a configuration space (ga_create_space). */
+typedef enum {
+    GA_SPACE_VECTOR = 0,         /**< coordinates of R^k, in q and in v alike */
+    GA_SPACE_SO3_QUATERNION = 1, /**< rotations, each 4 numbers (w, x, y, z) in q, 3 in v */
+    GA_SPACE_SO3_MATRIX = 2      /**< rotations, each 9 numbers in q (the rotation matrix,
+                                      column-major), 3 in v */
+} ga_space_kind;
+
+/** Create a solver whose configuration is a product of blocks, block i of kind kinds[i]
+ *  holding counts[i] coordinates (GA_SPACE_VECTOR) or counts[i] rotations in a row (the
+ *  SO(3) kinds), and m constraints. Rotations move on the group, by right increments with
+ *  body-frame angular velocities, q_{n+1} = q_n o exp(xi) (the conventions of the rotation
+ *  maps below; docs/algorithms.md sec. 14): no unit-norm constraint, and no Euler parameters'
+ *  velocities.
+ *
+ *  Storage and algebra: q (ga_init's q0, ga_get_q, ga_interpolate, every callback's q) holds
+ *  nq numbers, the blocks' storage in order; v, qdd, a, f and everything shaped like them hold
+ *  nv, 3 per rotation (the body-frame angular velocity and its rate). So do the rows of M, C_t
+ *  and K_t and the columns of Phi_q: K_t and Phi_q are derivatives along right increments,
+ *  d/de of f(q o exp(e w)) and Phi(q o exp(e w)) at e = 0 (on a vector block the ordinary
+ *  ones); build them with the maps below. ga_get_size's n is nv; ga_get_space_size gives both.
+ *
+ *  A space of vector blocks only is R^n and the solver is exactly that of ga_create(n, m).
+ *  With rotations, in this version: the index-3 formulation, fixed and adaptive steps,
+ *  dense output and events, on the dense linear solver; ga_set_formulation(index 2),
+ *  ga_set_pattern, the sparse solver, first-order states and sensitivities return
+ *  GA_ERR_ARG, saying so. q0 of ga_init must hold rotations (a quaternion's norm, a matrix's
+ *  orthonormality within 1e-6, det > 0), else GA_ERR_ARG names the block.
+ *  Errors: GA_ERR_ARG (out, kinds or counts NULL with count > 0, count < 1, an unknown kind, a
+ *  count < 1, nq or nv above INT_MAX, m < 0 or m > nv), GA_ERR_NOMEM. */
+GA_API ga_status ga_create_space(int count, const int *kinds, const int *counts, int m,
+                                 ga_solver **out);
+/** The number of q's coordinates (storage) and of v's (nv, ga_get_size's n). */
+GA_API ga_status ga_get_space_size(const ga_solver *s, int *nq, int *nv);
+
 /** Free a solver and everything it owns. ga_free(NULL) does nothing. Must not be called from
  *  one of the solver's own callbacks. */
 GA_API void ga_free(ga_solver *s);

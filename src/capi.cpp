@@ -279,6 +279,67 @@ GA_API ga_status ga_create(int n, int m, ga_solver **out)
     return GA_OK;
 }
 
+GA_API ga_status ga_create_space(int count, const int *kinds, const int *counts, int m,
+                                 ga_solver **out)
+{
+    if (!out)
+        return GA_ERR_ARG;
+    *out = nullptr;
+    if (count < 1 || !kinds || !counts || m < 0)
+        return GA_ERR_ARG;
+    using Space = ga::ConfigurationSpace;
+    try {
+        std::vector<Space::Block> blocks;
+        long long nq = 0, nv = 0;
+        for (int i = 0; i < count; ++i) {
+            if (counts[i] < 1)
+                return GA_ERR_ARG;
+            const long long c = counts[i];
+            switch (kinds[i]) {
+            case GA_SPACE_VECTOR:
+                blocks.push_back({Space::Kind::Vector, counts[i]});
+                nq += c;
+                nv += c;
+                break;
+            case GA_SPACE_SO3_QUATERNION:
+            case GA_SPACE_SO3_MATRIX: {
+                const bool quaternion = kinds[i] == GA_SPACE_SO3_QUATERNION;
+                nq += (quaternion ? 4 : 9) * c;
+                nv += 3 * c;
+                if (nq > INT_MAX)  // (before a count of blocks that large is made)
+                    return GA_ERR_ARG;
+                for (int k = 0; k < counts[i]; ++k)
+                    blocks.push_back(
+                        {quaternion ? Space::Kind::Quaternion : Space::Kind::Matrix, 3});
+                break;
+            }
+            default: return GA_ERR_ARG;
+            }
+            if (nq > INT_MAX || nv > INT_MAX)
+                return GA_ERR_ARG;
+        }
+        if (m > nv || nv > INT_MAX - m)
+            return GA_ERR_ARG;
+        *out = new ga_solver(Space(blocks), m);
+    } catch (const std::bad_alloc &) {
+        return GA_ERR_NOMEM;
+    } catch (...) {
+        return GA_ERR_INTERNAL;
+    }
+    return GA_OK;
+}
+
+GA_API ga_status ga_get_space_size(const ga_solver *s, int *nq, int *nv)
+{
+    return reading(s, "ga_get_space_size", "nq or nv is NULL", [&](const ga::Solver &c) {
+        if (!nq || !nv)
+            return GA_ERR_ARG;
+        *nq = c.kernel().nq();
+        *nv = c.kernel().nv();
+        return GA_OK;
+    });
+}
+
 GA_API void ga_free(ga_solver *s)
 {
     if (!s || s->busy)  // freeing a solver from its own callback would pull the floor away
@@ -291,7 +352,7 @@ GA_API ga_status ga_get_size(const ga_solver *s, int *n, int *m)
     return reading(s, "ga_get_size", "n or m is NULL", [&](const ga::Solver &c) {
         if (!n || !m)
             return GA_ERR_ARG;
-        *n = c.kernel().nv();  // (ga_create's n: nq = nv)
+        *n = c.kernel().nv();  // (ga_create's n; ga_create_space's nv)
         *m = c.kernel().m();
         return GA_OK;
     });
@@ -444,9 +505,20 @@ GA_API ga_status ga_set_constant_mass(ga_solver *s, int on)
 }
 
 namespace {
+// What a space with rotations does not offer yet (ga_create_space): refused with its name.
+ga_status refuse_on_rotations(ga::Solver &c, const char *what)
+{
+    return c.diag.fail(GA_ERR_ARG,
+                       "%s is not available on a configuration space with rotations "
+                       "(ga_create_space) in this version",
+                       what);
+}
+
 // The checks and the declaration shared by both forms of ga_set_pattern.
 ga_status declare_pattern(ga::Solver &c, int which, int nnz, const int *rows, const int *cols)
 {
+    if (!c.model.space.euclidean())
+        return refuse_on_rotations(c, "a sparsity pattern (the sparse path)");
     if (which < GA_MATRIX_MASS || which > GA_MATRIX_DAMPING)
         return c.diag.fail(GA_ERR_ARG, "unknown matrix %d", which);
     if (c.kernel().setup_done())
@@ -500,6 +572,8 @@ GA_API ga_status ga_set_linear_solver(ga_solver *s, int solver)
     return guarded(s, [&](ga::Solver &c) {
         if (solver < GA_LINEAR_AUTO || solver > GA_LINEAR_DENSE_UNBLOCKED)
             return c.diag.fail(GA_ERR_ARG, "unknown linear solver %d", solver);
+        if (solver == GA_LINEAR_SPARSE && !c.model.space.euclidean())
+            return refuse_on_rotations(c, "the sparse linear solver");
         if (c.kernel().setup_done())
             return c.diag.fail(GA_ERR_STATE, "the linear solver is chosen before ga_init");
         c.kernel().linear_solver = static_cast<ga_linear_solver>(solver);
@@ -758,6 +832,8 @@ GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga
             return c.diag.fail(GA_ERR_ARG, "r = %d first-order states: must be >= 0", r);
         if (r > 0 && !rate)
             return c.diag.fail(GA_ERR_ARG, "r = %d > 0: the rate callback is required", r);
+        if (r > 0 && !c.model.space.euclidean())
+            return refuse_on_rotations(c, "first-order states");
         if (c.kernel().setup_done())
             return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after the solver was set up "
                                "(ga_init or ga_set_state): declare the states before");
@@ -839,6 +915,8 @@ GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const doubl
             return c.diag.fail(GA_ERR_ARG, "np = %d parameters: must be >= 0", np);
         if (np > 0 && !p)
             return c.diag.fail(GA_ERR_ARG, "np = %d parameters and p is NULL", np);
+        if (np > 0 && !c.model.space.euclidean())
+            return refuse_on_rotations(c, "sensitivity analysis");
         if ((depends & ~(GA_DEPENDS_FORCE | GA_DEPENDS_MASS | GA_DEPENDS_RATE |
                          GA_DEPENDS_CONSTRAINT)) != 0)
             return c.diag.fail(GA_ERR_ARG, "unknown dependence flags 0x%x", static_cast<unsigned>(depends));

@@ -8,6 +8,7 @@
 
 struct ga_solver {
     ga_solver(int n, int m) : core(n, m) {}
+    ga_solver(const ga::ConfigurationSpace &space, int m) : core(space, m) {}
     ga::Solver core;
     // true while a call on this solver runs (and so inside its callbacks); atomic, so that a
     // second thread calling the same solver (not allowed) is refused, not let in

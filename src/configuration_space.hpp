@@ -1,19 +1,27 @@
 // ga::ConfigurationSpace: the one place that knows how q moves. Every site that updates,
 // interpolates, perturbs or measures q goes through it, so that a q that is not a vector of
-// v's length (a Lie group, docs/algorithms.md sec. 14) changes this file and the matrix
-// assembly, not the step, the error control, the sensitivities or the adjoint.
+// v's length changes this file and the matrix assembly, not the step, the error control, the
+// sensitivities or the adjoint.
 //
-// Today the space is one block R^n: each body below is the expression the solver had inline at
-// its site, verbatim and evaluated in the same order, so that every result is bit for bit the
-// same (test_golden). The segment forms serve the step's fused kBlock loops; they take Eigen
-// segments and build the same expression trees the loops built.
+// The space of ga_create is one block R^n: each body below is then the expression the solver
+// had inline at its site, verbatim and evaluated in the same order, so that every result is
+// bit for bit the same (test_golden). The segment forms serve the step's fused kBlock loops;
+// they take Eigen segments and build the same expression trees the loops built.
+//
+// The space of ga_create_space is a product of blocks: R^k, and rotations SO(3) stored as unit
+// quaternions (4 numbers) or rotation matrices (9, column-major), with right increments and
+// body-frame velocities, q o exp(psi) (docs/algorithms.md sec. 14). Its bodies are in
+// configuration_space.cpp; the step takes per-block paths for it (no fused loops: q and v
+// are not indexed alike).
 //
 // Vocabulary: q has nq() coordinates; v, qdd, a, f, the rows of M, C, K and the columns of
 // Phi_q, and every increment of q (Newton's dq, a projection's step, a difference's direction,
 // a sensitivity's s_q) have nv(). In R^n, nq() == nv().
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "types.hpp"
 
@@ -21,11 +29,49 @@ namespace ga {
 
 class ConfigurationSpace {
 public:
+    enum class Kind : unsigned char { Vector, Quaternion, Matrix };
+    struct Block {
+        Kind kind;
+        Eigen::Index nv;  // v's coordinates: 3 for a rotation
+    };
+    // Storage of one block's q
+    static Eigen::Index stored(const Block &b)
+    {
+        return b.kind == Kind::Vector ? b.nv : b.kind == Kind::Quaternion ? 4 : 9;
+    }
+
     explicit ConfigurationSpace(Eigen::Index n) : nq_(n), nv_(n) {}
+    // The product of the blocks in order; of vector blocks only, R^n (the space above).
+    explicit ConfigurationSpace(const std::vector<Block> &blocks);
 
     Eigen::Index nq() const { return nq_; }
     Eigen::Index nv() const { return nv_; }
-    bool euclidean() const { return true; }
+    bool euclidean() const { return parts_.empty(); }
+    Eigen::Index rotations() const { return rotations_; }
+
+    // ---- group blocks (configuration_space.cpp); never called on R^n ----
+    // xi = h v_n + h^2 ((1/2 - beta) a_n + beta a): eq. (4)'s increment, on a segment of v
+    template <class Out, class V, class A0, class A1>
+    static void newmark_increment(Out &&xi, const V &v_n, const A0 &a_n, const A1 &a, double h,
+                                  double beta)
+    {
+        xi = h * v_n + (h * h) * ((0.5 - beta) * a_n + beta * a);
+    }
+    // q = q_n (+) xi, block by block (q_n o exp(xi) on a rotation): the step's q from its
+    // increment, recomputed at every iterate (composing Newton's corrections one by one would
+    // add the tangent operator's error to each)
+    void step_to(const Vec &q_n, const Vec &xi, Vec &q) const;
+    // A <- A T(xi) on the columns of the rotations (rows x nv, column-major with leading
+    // dimension ld): the q-columns of K_t and Phi_q in the iteration matrix (sec. 14)
+    void right_multiply_tangent(const Vec &xi, double *A, Eigen::Index rows,
+                                Eigen::Index ld) const;
+    // Z <- Z + J ad(., v) on the rotations' columns (J, Z: rows x nv, column-major, ld =
+    // rows): Z w += J [w, v] with [w, v] = w x v on each rotation
+    void add_bracket(const Vec &v, const double *J, Eigen::Index rows, double *Z) const;
+    // The first rotation block whose storage is not a rotation (a quaternion's norm, a
+    // matrix's orthonormality or determinant off by more than 1e-6), as the index of its
+    // first coordinate in q; -1 if none.
+    Eigen::Index invalid_rotation(const double *q) const;
 
     // eq. (4) on a segment: q = q_n + h v_n + h^2 ((1/2 - beta) a_n + beta a)
     template <class Out, class Q, class V, class A0, class A1>
@@ -41,49 +87,79 @@ public:
     {
         q += dq;
     }
+    void increment(Vec &q, const Vec &dq) const
+    {
+        if (euclidean())
+            q += dq;
+        else
+            group_retract(q, 1.0, dq, q);
+    }
 
     // out = q (+) (h v + h^2/2 qdd): the Taylor steps (slivers, starting values)
     void taylor(const Vec &q, const Vec &v, const Vec &qdd, double h, Vec &out) const
     {
-        out = q + h * v + (0.5 * h * h) * qdd;
+        if (euclidean())
+            out = q + h * v + (0.5 * h * h) * qdd;
+        else
+            group_taylor(q, v, qdd, h, out);
     }
 
     // out = q (+) e w: a directional difference's point
-    template <class Out>
-    void shifted(const Vec &q, double e, const Vec &w, Out &out) const
+    void shifted(const Vec &q, double e, const Vec &w, Vec &out) const
     {
-        out = q + e * w;
+        if (euclidean())
+            out = q + e * w;
+        else
+            group_retract(q, e, w, out);
     }
     // q_pert = q (+) e e_j in coordinate j, and back: column differences (q_pert == q outside j)
+    // (On a rotation, q_pert's block o exp(e e_j): shifts of a group compose; restoring
+    // copies the whole block back.)
     void shift_coordinate(Vec &q_pert, const Vec &q, Eigen::Index j, double e) const
     {
-        q_pert[j] = q[j] + e;
+        if (euclidean())
+            q_pert[j] = q[j] + e;
+        else
+            group_shift(q_pert, q, j, e);
     }
     void restore_coordinate(Vec &q_pert, const Vec &q, Eigen::Index j) const
     {
-        q_pert[j] = q[j];
+        if (euclidean())
+            q_pert[j] = q[j];
+        else
+            group_restore(q_pert, q, j);
     }
 
     // cubic Hermite interpolation of q over a step of length h from (q_a, v_a) to (q_b, v_b),
-    // with the basis values h00, h10, h01, h11 at the point
+    // with the basis values h00, h10, h01, h11 at the point; on a rotation, q_a o exp(p) with
+    // p the Hermite curve in the algebra from 0 to xi = log(q_a^-1 q_b), p' = h v_a at the
+    // start and h T(xi)^-1 v_b at the end (sec. 14)
     void hermite(const Vec &q_a, const Vec &v_a, const Vec &q_b, const Vec &v_b, double h,
                  double h00, double h10, double h01, double h11, Vec &out) const
     {
-        out = h00 * q_a + (h10 * h) * v_a + h01 * q_b + (h11 * h) * v_b;
+        if (euclidean())
+            out = h00 * q_a + (h10 * h) * v_a + h01 * q_b + (h11 * h) * v_b;
+        else
+            group_hermite(q_a, v_a, q_b, v_b, h, h00, h10, h01, h11, out);
     }
 
     // The size of q where tolerances and round-off floors scale with it: per increment
     // coordinate i, and the largest (0 for an empty q)
-    double magnitude(const Vec &q, Eigen::Index i) const { return std::fabs(q[i]); }
+    // (a rotation's coordinates: 1, the radian its angles are measured against)
+    double magnitude(const Vec &q, Eigen::Index i) const
+    {
+        return euclidean() ? std::fabs(q[i]) : group_magnitude(q, i);
+    }
     template <class Q>
     double max_magnitude(const Q &q) const
     {
-        return q.size() == 0 ? 0.0 : q.cwiseAbs().maxCoeff();
+        const double top = q.size() == 0 ? 0.0 : q.cwiseAbs().maxCoeff();
+        return rotations_ > 0 ? std::max(top, 1.0) : top;
     }
-    // |q_1 (-) q_0| in increment coordinate i
+    // |q_1 (-) q_0| in increment coordinate i (on a rotation, of log(q_0^-1 q_1))
     double distance(const Vec &q1, const Vec &q0, Eigen::Index i) const
     {
-        return std::fabs(q1[i] - q0[i]);
+        return euclidean() ? std::fabs(q1[i] - q0[i]) : group_distance(q1, q0, i);
     }
 
     // ---- tangent vectors across a step from q_n to q_n1 (docs/algorithms.md sec. 14) ----
@@ -111,7 +187,25 @@ public:
     void tangent_transpose(const Vec & /*q_n*/, const Vec & /*q_n1*/, Vec & /*m*/) const {}
 
 private:
+    // A block placed: its kind and where its coordinates start in q and in v
+    struct Part {
+        Kind kind;
+        Eigen::Index q0, v0, nv;
+    };
+    void group_retract(const Vec &q, double e, const Vec &w, Vec &out) const;
+    void group_taylor(const Vec &q, const Vec &v, const Vec &qdd, double h, Vec &out) const;
+    void group_shift(Vec &q_pert, const Vec &q, Eigen::Index j, double e) const;
+    void group_restore(Vec &q_pert, const Vec &q, Eigen::Index j) const;
+    void group_hermite(const Vec &q_a, const Vec &v_a, const Vec &q_b, const Vec &v_b, double h,
+                       double h00, double h10, double h01, double h11, Vec &out) const;
+    double group_magnitude(const Vec &q, Eigen::Index i) const;
+    double group_distance(const Vec &q1, const Vec &q0, Eigen::Index i) const;
+    const Part &part_of(Eigen::Index i) const { return parts_[part_of_[i]]; }
+
     Eigen::Index nq_, nv_;
+    Eigen::Index rotations_ = 0;
+    std::vector<Part> parts_;     // empty: R^n
+    std::vector<int> part_of_;    // v coordinate -> its part (group spaces only)
 };
 
 }  // namespace ga

@@ -98,6 +98,11 @@ ga_status Stepper::start(double t0, const double *q0, const double *v0)
     x.v = Eigen::Map<const Vec>(v0, nv_);
     if (!all_finite(x.q) || !all_finite(x.v))
         return diag.fail(GA_ERR_ARG, "q0 or v0 contains NaN or Inf");
+    if (const Eigen::Index bad = model.space.invalid_rotation(x.q.data()); bad >= 0)
+        return diag.fail(GA_ERR_ARG,
+                         "q0[%ld..] is not a rotation (a unit quaternion, or an orthonormal "
+                         "matrix with det 1, within 1e-6)",
+                         static_cast<long>(bad));
 
     if (redundancy == GA_REDUNDANT_DROP && m_ > 0)
         if (auto st = select_active_constraints(t0, x.q))

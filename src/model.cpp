@@ -100,8 +100,8 @@ void ColumnGroups::build(const ModelMatrix &A)
     *this = std::move(built);
 }
 
-Model::Model(int n, int m, Counters &counters, Diagnostics &diag)
-    : space(n), nv_(n), m_(m), counters_(counters), diag_(diag)
+Model::Model(const ConfigurationSpace &space_, int m, Counters &counters, Diagnostics &diag)
+    : space(space_), nv_(static_cast<int>(space_.nv())), m_(m), counters_(counters), diag_(diag)
 {
 }
 
@@ -327,6 +327,10 @@ ga_status Model::velocity_constraint_tangent(double t, const Vec &q, const Vec &
     double *z = Z.data();
     for (Eigen::Index k = 0; k < Z.size(); ++k)
         z[k] = (z[k] - j[k]) / span;
+    // The difference is the derivative of Phi_q w along v; Z w differentiates Phi_q v along
+    // w. In R^n they are equal; on a group they differ by Phi_q [w, v] (sec. 14).
+    if (!space.euclidean())
+        space.add_bracket(v, J.data(), J.rows(), Z.data());
     return GA_OK;
 }
 

@@ -62,7 +62,7 @@ struct ColumnGroups {
 
 class Model {
 public:
-    Model(int n, int m, Counters &counters, Diagnostics &diag);
+    Model(const ConfigurationSpace &space, int m, Counters &counters, Diagnostics &diag);
 
     // The problem's q: where it lives and how it moves (configuration_space.hpp)
     const ConfigurationSpace space;

@@ -7,7 +7,11 @@
 
 namespace ga {
 
-Solver::Solver(int n, int m) : k_(n, m), diag(k_.diag), model(k_.model) { k_.attach(*this); }
+Solver::Solver(const ConfigurationSpace &space, int m)
+    : k_(space, m), diag(k_.diag), model(k_.model)
+{
+    k_.attach(*this);
+}
 
 ga_status Solver::init(double t0, const double *q0, const double *v0)
 {

@@ -24,7 +24,8 @@ class Solver : private StepOutput, private StepDoors {
     Stepper k_;
 
 public:
-    Solver(int n, int m);
+    Solver(int n, int m) : Solver(ConfigurationSpace(n), m) {}
+    Solver(const ConfigurationSpace &space, int m);
     Solver(const Solver &) = delete;
     Solver &operator=(const Solver &) = delete;
 

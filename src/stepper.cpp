@@ -48,9 +48,11 @@ DenseKind dense_kind(ga_linear_solver choice)
 // show: the iterate needs no check of its own.
 constexpr Eigen::Index kBlock = 512;
 
+// On a group space the increment goes into the step's xi and q is q_n (+) xi (xi: null on
+// R^n).
 void apply_update(const ConfigurationSpace &space, const Vec &dq, const Vec &dw,
                   const Vec &dlambda, double gamma_prime, double beta_prime, State &x,
-                  UpdateSizes &size)
+                  UpdateSizes &size, const Vec &q_n, Vec *xi)
 {
     const bool separate_dw = &dw != &dq;
     double v_max = 0.0;
@@ -58,18 +60,27 @@ void apply_update(const ConfigurationSpace &space, const Vec &dq, const Vec &dw,
     for (Eigen::Index i = 0; i < dq.size(); i += kBlock) {
         const Eigen::Index len = std::min(kBlock, dq.size() - i);
         const auto d = dq.segment(i, len), w = dw.segment(i, len);
-        auto q = x.q.segment(i, len), v = x.v.segment(i, len), qdd = x.qdd.segment(i, len);
+        auto v = x.v.segment(i, len), qdd = x.qdd.segment(i, len);
         size.increments_finite = size.increments_finite && all_finite(d.data(), len) &&
                                  (!separate_dw || all_finite(w.data(), len));
-        space.increment(q, d);
+        if (xi) {
+            xi->segment(i, len) += d;
+        } else {
+            auto q = x.q.segment(i, len);
+            space.increment(q, d);
+            size.q = std::max(size.q, space.max_magnitude(q));
+        }
         v += gamma_prime * w;
         qdd += beta_prime * w;
         size.dq = std::max(size.dq, d.cwiseAbs().maxCoeff());
         if (separate_dw)
             size.dw = std::max(size.dw, w.cwiseAbs().maxCoeff());
-        size.q = std::max(size.q, space.max_magnitude(q));
         v_max = std::max(v_max, v.cwiseAbs().maxCoeff());
         size.qdd = std::max(size.qdd, qdd.cwiseAbs().maxCoeff());
+    }
+    if (xi) {
+        space.step_to(q_n, *xi, x.q);
+        size.q = space.max_magnitude(x.q);
     }
     if (!separate_dw)
         size.dw = size.dq;
@@ -132,10 +143,13 @@ void State::swap(State &other)
     w_prev.swap(other.w_prev);
 }
 
-Stepper::Stepper(int n, int m)
+Stepper::Stepper(const ConfigurationSpace &space, int m)
     : params(params_from_rho_inf(0.9)), params1(first_order_params_from_rho_inf(0.9)),
-      model(n, m, counters, diag), nq_(n), nv_(n), m_(m)  // (ga_create: one block R^n)
+      model(space, m, counters, diag), nq_(static_cast<int>(space.nq())),
+      nv_(static_cast<int>(space.nv())), m_(m)
 {
+    if (!space.euclidean())
+        xi_.setZero(nv_);
     accepted_.allocate(nq_, nv_, m);
     trial_.allocate(nq_, nv_, m);
     previous_.allocate(nq_, nv_, m);
@@ -222,6 +236,11 @@ ga_status Stepper::setup_workspace()
     }
     M_.allocate();
     J_.allocate();
+    if (!model.space.euclidean()) {  // (dense: group spaces take no patterns)
+        KT_.copy_layout(K_);
+        JT_.copy_layout(J_);
+        ZT_.copy_layout(J_);
+    }
     // On the sparse path a tangent without a pattern is one that is not needed (neglected, or
     // C_t without forces): no dense n x n for it (1.5 GB at n = 10^4).
     if (!sparse || !K_.dense())
@@ -787,9 +806,29 @@ ga_status Stepper::factorize(double t, const State &x, double h, bool tangents_K
     count(counters, GA_COUNT_FACTORIZATIONS);
     jacobian_valid_ = false;
     const ModelMatrix *C = tangents_C ? &C_ : nullptr, *K = tangents_K ? &K_ : nullptr;
+    const ModelMatrix *J_low = nullptr, *Z = tangent_Z ? &Z_ : nullptr;
+    if (!model.space.euclidean() && &x == &trial_) {
+        // q = q_n o exp(xi): the q-columns of K_t and of the constraint rows take T(xi) as a
+        // right factor, Phi_q^T stays (sec. 14). (At the accepted state xi = 0, T = I.)
+        if (K) {
+            std::copy(K_.data(), K_.data() + K_.size(), KT_.data());
+            model.space.right_multiply_tangent(xi_, KT_.data(), nv_, nv_);
+            K = &KT_;
+        }
+        if (m_ > 0) {
+            std::copy(J_.data(), J_.data() + J_.size(), JT_.data());
+            model.space.right_multiply_tangent(xi_, JT_.data(), m_, m_);
+            J_low = &JT_;
+        }
+        if (Z) {  // index 2: the velocity constraint's curvature, through q as well
+            std::copy(Z_.data(), Z_.data() + Z_.size(), ZT_.data());
+            model.space.right_multiply_tangent(xi_, ZT_.data(), m_, m_);
+            Z = &ZT_;
+        }
+    }
     const bool ok = formulation == GA_INDEX2_STABILIZED
-                        ? S2_.factorize(M_, C, K, J_, B_, tangent_Z ? &Z_ : nullptr, params, h)
-                        : S_.factorize_step(M_, C, K, J_, params, h, scaling);
+                        ? S2_.factorize(M_, C, K, J_, B_, Z, params, h, J_low)
+                        : S_.factorize_step(M_, C, K, J_, params, h, scaling, J_low);
     if (!ok) {
         diag.fail(GA_ERR_SINGULAR,
                   "iteration matrix S_t%s is singular (rcond = %.3g) in Newton iteration %d of "
@@ -865,11 +904,11 @@ ga_status Stepper::newton(double h, double tol, bool refresh, bool &converged, b
     // qdd(t_n + h) = qdd_n + (h / h_last) (a_n - qdd_n) / delta_alpha + O(h^2).
     const double slope = start == Extrapolate ? h / (s.h_last * delta_alpha) : 0.0;
     bool finite = true;
+    const bool group = !model.space.euclidean();
     for (Eigen::Index i = 0; i < nv_; i += kBlock) {  // blocks in L1: one trip to memory
         const Eigen::Index len = std::min(kBlock, nv_ - i);
         const auto qdd_n = qdd_start_->segment(i, len), an = a_n.segment(i, len);
-        auto qdd = x.qdd.segment(i, len), a = x.a.segment(i, len), q = x.q.segment(i, len),
-             v = x.v.segment(i, len);
+        auto qdd = x.qdd.segment(i, len), a = x.a.segment(i, len), v = x.v.segment(i, len);
         if (start == Zero)
             qdd.setZero();
         else if (start == Extrapolate)
@@ -877,11 +916,21 @@ ga_status Stepper::newton(double h, double tol, bool refresh, bool &converged, b
         else
             qdd = (an - p.alpha_f * qdd_n) / (1.0 - p.alpha_f);
         a = (p.alpha_f * qdd_n - p.alpha_m * an + (1.0 - p.alpha_f) * qdd) / (1.0 - p.alpha_m);
-        model.space.newmark(q, s.q.segment(i, len), v_n.segment(i, len), an, a, h, p.beta);  // (4)
+        if (group) {  // q from xi below
+            auto xi = xi_.segment(i, len);
+            ConfigurationSpace::newmark_increment(xi, v_n.segment(i, len), an, a, h, p.beta);
+            finite = finite && all_finite(xi.data(), len);
+        } else {
+            auto q = x.q.segment(i, len);
+            model.space.newmark(q, s.q.segment(i, len), v_n.segment(i, len), an, a, h,
+                                p.beta);  // (4)
+            finite = finite && all_finite(q.data(), len);
+        }
         v = v_n.segment(i, len) + h * ((1.0 - p.gamma) * an + p.gamma * a);            // eq. (5)
-        finite = finite && all_finite(q.data(), len) && all_finite(v.data(), len) &&
-                 all_finite(qdd.data(), len);
+        finite = finite && all_finite(v.data(), len) && all_finite(qdd.data(), len);
     }
+    if (group)
+        model.space.step_to(s.q, xi_, x.q);  // eq. (4) on the group: q_n o exp(xi)
     if (start == Zero)
         x.lambda.setZero();
     else
@@ -975,7 +1024,8 @@ ga_status Stepper::newton(double h, double tol, bool refresh, bool &converged, b
             first_order_correction(c, index2 ? dw_ : dq_);
         count(counters, GA_COUNT_NEWTON_ITERS);
         UpdateSizes size;
-        apply_update(model.space, dq_, *dw, dlambda_, c.gamma_prime, c.beta_prime, x, size);
+        apply_update(model.space, dq_, *dw, dlambda_, c.gamma_prime, c.beta_prime, x, size, s.q,
+                     model.space.euclidean() ? nullptr : &xi_);
         if (r() > 0)
             update_first_order(c, h, x, size);
         if (!size.increments_finite || !size.iterate_finite)

@@ -61,7 +61,8 @@ struct KeptMatrix {
 
 class Stepper {
 public:
-    Stepper(int n, int m);
+    Stepper(int n, int m) : Stepper(ConfigurationSpace(n), m) {}
+    Stepper(const ConfigurationSpace &space, int m);  // (ga_create_space)
     void attach(StepDoors &doors) { doors_ = &doors; }  // (the transaction, before any call)
     Stepper(const Stepper &) = delete;  // (dense_ refers to its own states)
     Stepper &operator=(const Stepper &) = delete;
@@ -393,7 +394,7 @@ private:
     ga_status select_active_constraints(double t, const Vec &q);
     const unsigned char *active_ptr() const { return active_.empty() ? nullptr : active_.data(); }
 
-    int nq_, nv_, m_;  // equal while the space is R^n (configuration_space.hpp)
+    int nq_, nv_, m_;  // equal when the space is R^n (configuration_space.hpp)
     StepDoors *doors_ = nullptr;  // the transaction's (attach)
     std::vector<unsigned char> active_;  // GA_REDUNDANT_DROP: constraints in use
     bool initialized_ = false;
@@ -465,6 +466,10 @@ private:
 
     // Step workspace, sized once.
     ModelMatrix M_, J_, K_, C_, B_;  // B_: index-2, Phi_q(q_n)
+    // On a group space: the step's increment xi (q = q_n (+) xi, sec. 14), and K_t T(xi),
+    // Phi_q T(xi), Z T(xi) for the iteration matrix (empty on R^n)
+    Vec xi_;
+    ModelMatrix KT_, JT_, ZT_;
     ModelMatrix Z_;                  // index-2: d(Phi_q v + Phi_t)/dq, layout of J_
     Vec f_, phi_, phi_v_, rq_, dq_, dw_, dlambda_, deta_, c_, qdd_tmp_, lambda_tmp_;
     Vec guard_q_, guard_v_;  // index-3 error estimate: the estimate from a (error_estimate.cpp)

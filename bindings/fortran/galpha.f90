@@ -34,6 +34,8 @@ module galpha
        GA_LINEAR_SPARSE = 2, GA_LINEAR_DENSE_LAPACK = 3, GA_LINEAR_DENSE_EIGEN = 4, &
        GA_LINEAR_DENSE_UNBLOCKED = 5
   integer(c_int), parameter, public :: GA_INDEX3 = 0, GA_INDEX2_STABILIZED = 1
+  integer(c_int), parameter, public :: GA_SPACE_VECTOR = 0, GA_SPACE_SO3_QUATERNION = 1, &
+       GA_SPACE_SO3_MATRIX = 2
   integer(c_int), parameter, public :: GA_REDUNDANT_REFUSE = 0, GA_REDUNDANT_DROP = 1
   integer(c_int), parameter, public :: GA_INIT_PROJECT = 0, GA_INIT_REFUSE = 1
   integer(c_int), parameter, public :: GA_OUTPUT_CONSISTENT = 0, GA_OUTPUT_STEP = 1
@@ -187,6 +189,18 @@ module galpha
        integer(c_int), value :: n, m
        type(c_ptr), intent(out) :: out
      end function ga_create
+     integer(c_int) function ga_create_space(count, kinds, counts, m, out) &
+          bind(C, name="ga_create_space")
+       import :: c_int, c_ptr
+       integer(c_int), value :: count, m
+       integer(c_int), intent(in) :: kinds(*), counts(*)
+       type(c_ptr), intent(out) :: out
+     end function ga_create_space
+     integer(c_int) function ga_get_space_size(s, nq, nv) bind(C, name="ga_get_space_size")
+       import :: c_int, c_ptr
+       type(c_ptr), value :: s
+       integer(c_int), intent(out) :: nq, nv
+     end function ga_get_space_size
      subroutine ga_free(s) bind(C, name="ga_free")
        import :: c_ptr
        type(c_ptr), value :: s
@@ -650,6 +664,7 @@ module galpha
      end function c_strlen
   end interface
   public :: ga_version, ga_version_number, ga_strerror, ga_last_error, ga_create, ga_free, &
+       ga_create_space, ga_get_space_size, &
        ga_get_size, ga_set_callbacks, ga_set_tangents, ga_set_tangent_mode, &
        ga_set_constraint_accel, ga_set_constraint_dt, ga_set_rho_inf, ga_set_params, &
        ga_get_params, ga_set_newton, &
@@ -677,8 +692,11 @@ module galpha
   type, public :: galpha_solver
      type(c_ptr) :: handle = c_null_ptr
      integer :: n = 0, m = 0, r = 0, np = 0
+     integer :: nq = 0  !< q's length: n, or the storage of ga_create_space's blocks
    contains
      procedure :: create => solver_create
+     !> create_space(kinds, counts, m): a product of blocks (ga_create_space); n = nv
+     procedure :: create_space => solver_create_space
      procedure :: free => solver_free
      procedure, private :: solver_set_callbacks, solver_set_callbacks_funptr
      !> set_callbacks(mass, force, constraint, jacobian, user): either Fortran procedures with
@@ -940,9 +958,27 @@ contains
     status = ga_create(int(n, c_int), int(m, c_int), this%handle)
     if (status == GA_OK) then
        this%n = n
+       this%nq = n
        this%m = m
     end if
   end function solver_create
+
+  integer(c_int) function solver_create_space(this, kinds, counts, m) result(status)
+    class(galpha_solver), intent(inout) :: this
+    integer, intent(in) :: kinds(:), counts(:), m
+    integer(c_int) :: nq, nv
+    if (size(kinds) /= size(counts)) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_create_space(int(size(kinds), c_int), int(kinds, c_int), int(counts, c_int), &
+                             int(m, c_int), this%handle)
+    if (status /= GA_OK) return
+    status = ga_get_space_size(this%handle, nq, nv)
+    this%nq = nq
+    this%n = nv
+    this%m = m
+  end function solver_create_space
 
   subroutine solver_free(this)
     class(galpha_solver), intent(inout) :: this
@@ -1117,7 +1153,7 @@ contains
   integer(c_int) function solver_init_y(this, t0, q0, v0, y0) result(status)
     class(galpha_solver), intent(inout) :: this
     real(c_double), intent(in) :: t0, q0(:), v0(:), y0(:)
-    if (size(q0) < this%n .or. size(v0) < this%n .or. size(y0) < this%r) then
+    if (size(q0) < this%nq .or. size(v0) < this%n .or. size(y0) < this%r) then
        status = GA_ERR_ARG
        return
     end if
@@ -1275,7 +1311,7 @@ contains
   integer(c_int) function solver_init(this, t0, q0, v0) result(status)
     class(galpha_solver), intent(inout) :: this
     real(c_double), intent(in) :: t0, q0(:), v0(:)
-    if (size(q0) /= this%n .or. size(v0) /= this%n) then
+    if (size(q0) /= this%nq .or. size(v0) /= this%n) then
        status = GA_ERR_ARG
        return
     end if
@@ -1410,7 +1446,7 @@ contains
     real(c_double), intent(out), optional :: q(:), v(:), lambda(:)
     status = GA_ERR_ARG
     if (present(q)) then
-       if (size(q) < this%n) return
+       if (size(q) < this%nq) return
     end if
     if (present(v)) then
        if (size(v) < this%n) return
@@ -1466,7 +1502,7 @@ contains
   integer(c_int) function solver_get_q(this, q) result(status)
     class(galpha_solver), intent(in) :: this
     real(c_double), intent(out) :: q(:)
-    status = copy_out(this, ga_get_q, q, this%n)
+    status = copy_out(this, ga_get_q, q, this%nq)
   end function solver_get_q
 
   integer(c_int) function solver_get_v(this, v) result(status)

@@ -39,6 +39,9 @@ struct SaddleBlocks {
     const ModelMatrix *K = nullptr;  // null: neglected
     double cK = 0.0;
     const ModelMatrix *J = nullptr;
+    // The lower-left block where it is not J (dense only): Phi_q T(xi) on a group space,
+    // where the upper-right block stays Phi_q^T (docs/algorithms.md sec. 14)
+    const ModelMatrix *J_low = nullptr;
     const unsigned char *active = nullptr;  // m flags; null: every constraint active
 };
 

@@ -66,6 +66,14 @@ public:
                 for (int i = 0; i < n_; ++i)
                     S[static_cast<std::ptrdiff_t>(n_ + j) * N + i] =
                         S[static_cast<std::ptrdiff_t>(i) * N + n_ + j];
+            if (b.J_low) {  // a lower block of its own (Phi_q T on a group space)
+                S_.block(n_, 0, m_, n_).setZero();
+                add_block(S, N, n_, 0, 1.0, *b.J_low);
+                if (b.active)
+                    for (int i = 0; i < m_; ++i)
+                        if (!b.active[i])
+                            S_.row(n_ + i).head(n_).setZero();
+            }
         }
         rcond_valid_ = false;
         unblocked_ = kind_ == DenseKind::Unblocked ||

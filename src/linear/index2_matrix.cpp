@@ -260,7 +260,7 @@ std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
 
 bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,
                              const ModelMatrix &J, const ModelMatrix &B, const ModelMatrix *Z,
-                             const Params &p, double h)
+                             const Params &p, double h, const ModelMatrix *J_low)
 {
     const double cZ = p.beta * h / p.gamma;
     const double cM = mass_factor(p);
@@ -341,6 +341,10 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
     d.S.block(0, n, n, m) = Jd.transpose();
     d.S.block(n + m, 0, m, n) = Jd;
     d.S.block(n + m, n + m, m, m).noalias() = Jd * d.Bd.transpose();
+    if (J_low) {
+        Jd.setZero();
+        add_block(d.S.data(), N, n, 0, 1.0, *J_low);
+    }
     if (Z)
         add_block(d.S.data(), N, n + m, 0, cZ, *Z);
     if (active_)

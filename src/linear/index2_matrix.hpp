@@ -56,9 +56,12 @@ public:
     // sparse, in the reduced (n + 2m) form (else the augmented one, or dense)
     bool sparse_reduced() const;
     // false if singular or numerically singular. Z (layout of J) may be null: left out.
+    // J_low (dense only), when given, is the position constraint's row block in place of J:
+    // Phi_q T(xi) on a group space, where Phi_q^T and the velocity rows keep J (K and Z
+    // come with their T already).
     bool factorize(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,
                    const ModelMatrix &J, const ModelMatrix &B, const ModelMatrix *Z,
-                   const Params &p, double h);
+                   const Params &p, double h, const ModelMatrix *J_low = nullptr);
     // (d, dlambda, eta_bar) in natural units of d and lambda, and the Newmark part of the
     // update, w = d + B^T eta_bar.
     void solve(const Vec &rq, const Vec &phi, const Vec &phi_v, const Params &p, double h,

@@ -16,13 +16,14 @@ void IterationMatrix::setup(std::unique_ptr<LinearBackend> backend, int n, int m
 
 bool IterationMatrix::factorize_step(const ModelMatrix &M, const ModelMatrix *C,
                                      const ModelMatrix *K, const ModelMatrix &J, const Params &p,
-                                     double h, bool scaled)
+                                     double h, bool scaled, const ModelMatrix *J_low)
 {
     SaddleBlocks b;
     b.M = &M;
     b.C = C;
     b.K = K;
     b.J = &J;
+    b.J_low = J_low;
     b.active = active_;
     if (scaled) {
         // D_L S_t D_R with D_L = diag(beta h^2 I, I), D_R = diag(I, I/(beta h^2)) (eq. 10):

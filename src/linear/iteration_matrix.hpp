@@ -21,9 +21,11 @@ public:
     const char *backend_name() const { return backend_ ? backend_->name() : "none"; }
     const LinearBackend *backend() const { return backend_.get(); }
 
-    // S_t at step size h, scaled by (10) when `scaled`. C and K may be null (neglected).
+    // S_t at step size h, scaled by (10) when `scaled`. C and K may be null (neglected);
+    // J_low, when given, is the lower-left block in place of J (SaddleBlocks).
     bool factorize_step(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,
-                        const ModelMatrix &J, const Params &p, double h, bool scaled);
+                        const ModelMatrix &J, const Params &p, double h, bool scaled,
+                        const ModelMatrix *J_low = nullptr);
     // [sigma M, Phi_q^T; Phi_q, 0] (sigma balances the blocks; see init.cpp).
     bool factorize_kkt(const ModelMatrix &M, double sigma, const ModelMatrix &J);
     // [I, Phi_q^T; Phi_q, 0]: minimum-norm corrections.

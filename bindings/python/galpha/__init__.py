@@ -23,7 +23,8 @@ from ._ffi import (GA_DEPENDS_CONSTRAINT, GA_DEPENDS_FORCE, GA_DEPENDS_MASS,  # 
                    GA_OUTPUT_CONSISTENT, GA_OUTPUT_STEP,
                    GA_PREDICTOR_CONSTANT_A, GA_PREDICTOR_EXTRAPOLATE, GA_PREDICTOR_ZERO,
                    GA_REDUNDANT_DROP, GA_REDUNDANT_REFUSE,
-                   GA_REUSE_AUTO, GA_REUSE_NEVER, GA_TANGENT_AUTO, GA_TANGENT_FD,
+                   GA_REUSE_AUTO, GA_REUSE_NEVER, GA_SPACE_SO3_MATRIX, GA_SPACE_SO3_QUATERNION,
+                   GA_SPACE_VECTOR, GA_TANGENT_AUTO, GA_TANGENT_FD,
                    GA_TANGENT_NEGLECT)
 from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceError,  # noqa: F401
                      DerivativeError,

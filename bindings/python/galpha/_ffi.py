@@ -148,6 +148,7 @@ GA_MATRIX_MASS, GA_MATRIX_JACOBIAN, GA_MATRIX_STIFFNESS, GA_MATRIX_DAMPING = 0, 
 (GA_LINEAR_AUTO, GA_LINEAR_DENSE, GA_LINEAR_SPARSE, GA_LINEAR_DENSE_LAPACK,
  GA_LINEAR_DENSE_EIGEN, GA_LINEAR_DENSE_UNBLOCKED) = 0, 1, 2, 3, 4, 5
 GA_INDEX3, GA_INDEX2_STABILIZED = 0, 1
+GA_SPACE_VECTOR, GA_SPACE_SO3_QUATERNION, GA_SPACE_SO3_MATRIX = 0, 1, 2
 GA_REDUNDANT_REFUSE, GA_REDUNDANT_DROP = 0, 1
 GA_INIT_PROJECT, GA_INIT_REFUSE = 0, 1
 GA_OUTPUT_CONSISTENT, GA_OUTPUT_STEP = 0, 1
@@ -172,6 +173,8 @@ _SIGNATURES = {
     "ga_strerror": (ctypes.c_char_p, [_I]),
     "ga_last_error": (ctypes.c_char_p, [_S]),
     "ga_create": (_I, [_I, _I, _P(_S)]),
+    "ga_create_space": (_I, [_I, _P(_I), _P(_I), _I, _P(_S)]),
+    "ga_get_space_size": (_I, [_S, _P(_I), _P(_I)]),
     "ga_free": (None, [_S]),
     "ga_get_size": (_I, [_S, _P(_I), _P(_I)]),
     "ga_set_callbacks": (_I, [_S, MASS_FN, FORCE_FN, CONSTRAINT_FN, JACOBIAN_FN, ctypes.c_void_p]),

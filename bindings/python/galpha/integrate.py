@@ -141,7 +141,11 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
     if t_eval is not None and any(not t0 <= float(t) <= t1 for t in t_eval):
         raise ValueError("t_eval: every time must lie in t_span = [%g, %g]" % (t0, t1))
     q0 = np.asarray(q0, dtype=float)
-    n = q0.size
+    n, nq = np.asarray(v0).size, q0.size  # (nq != n on a space with rotations)
+    if dense_output and nq != n:
+        raise ValueError("dense_output: the whole run's interpolant is a polynomial in q, "
+                         "not defined on a space with rotations; use t_eval (galpha's own "
+                         "dense output on the group) instead")
     if m is None:
         if constraint is not None:
             raise ValueError("constraint callbacks given without m: say how many constraints "
@@ -332,7 +336,7 @@ def integrate(mass, force, constraint, jacobian, t_span, q0, v0, h=None, *, m=No
         if with_states:
             result["states_events"] = [np.array(x).reshape(len(x), len(np.atleast_1d(y0)))
                                        for x in x_ev]
-        result["q_events"] = [np.array(x).reshape(len(x), n) for x in q_ev]
+        result["q_events"] = [np.array(x).reshape(len(x), nq) for x in q_ev]
         result["v_events"] = [np.array(x).reshape(len(x), n) for x in v_ev]
         result["lam_events"] = [np.array(x).reshape(len(x), m) for x in l_ev]
         result["y_events"] = [np.hstack([a, b]) for a, b in

@@ -196,6 +196,33 @@ def _serialized(method):
     return locked
 
 
+_SPACE_KINDS = {"vector": _ffi.GA_SPACE_VECTOR, "so3": _ffi.GA_SPACE_SO3_QUATERNION,
+                "so3_matrix": _ffi.GA_SPACE_SO3_MATRIX}
+_SPACE_SIZES = {"vector": (1, 1), "so3": (4, 3), "so3_matrix": (9, 3)}  # (nq, nv) per count
+
+
+def _space_blocks(space):
+    """(kinds, counts, nq, nv) of Solver's space=[(kind, count), ...]."""
+    kinds, counts, nq, nv = [], [], 0, 0
+    for block in space:
+        try:
+            kind, count = block
+        except (TypeError, ValueError):
+            raise ValueError(f"space: each block is a (kind, count) pair, not {block!r}")
+        if kind not in _SPACE_KINDS:
+            raise ValueError(f"space: unknown kind {kind!r} (one of {', '.join(_SPACE_KINDS)})")
+        count = int(count)
+        if count < 1:
+            raise ValueError(f"space: block {block!r} needs a count >= 1")
+        kinds.append(_SPACE_KINDS[kind])
+        counts.append(count)
+        nq += count * _SPACE_SIZES[kind][0]
+        nv += count * _SPACE_SIZES[kind][1]
+    if not kinds:
+        raise ValueError("space: at least one block")
+    return kinds, counts, nq, nv
+
+
 class Solver:
     """A galpha solver for n coordinates and m constraints.
 
@@ -254,6 +281,15 @@ class Solver:
         Checkpointing for records that do not fit (ga_set_adjoint_checkpoints): one segment
         of `interval` steps kept, a checkpoint after every interval-th step, runs of up to
         interval * count steps; adjoint_gradient() computes earlier segments again.
+    space : sequence of (kind, count), optional
+        A configuration space that is a product of blocks (ga_create_space): kind "vector"
+        (count coordinates), "so3" (count rotations stored as unit quaternions (w, x, y, z))
+        or "so3_matrix" (count rotation matrices, 9 numbers column-major each). Rotations
+        move on the group with body-frame angular velocities: q has nq numbers (4 or 9 per
+        rotation), v and everything shaped like it n (3 per rotation), and n must be that
+        number. Phi_q and K_t are derivatives along right increments (galpha.so3 builds
+        them). Index 3 and 2, fixed and adaptive steps, dense output, events; the sparse
+        path, first-order states and sensitivities are refused with rotations.
     user : None, int, numpy array or ctypes object
         The `user` pointer compiled callbacks receive (void *user: an address, a numpy
         array's data, a ctypes object's address); NULL by default. Python callbacks ignore it.
@@ -284,7 +320,7 @@ class Solver:
                  coupling_patterns=None, parameters=None, depends=("force",),
                  parameter_scale=None, force_p=None, mass_p=None, constraint_p=None,
                  sensitivity_method=("forward",), max_steps=None, adjoint_checkpoints=None,
-                 zero_copy=False, user=None):
+                 zero_copy=False, user=None, space=None):
         self._ptr = None
         self._lock = threading.RLock()  # see _serialized
         self._pending = None          # exception raised inside a callback
@@ -301,11 +337,22 @@ class Solver:
                             f"Solver(n={self.n}, m={self.m}): needs n >= 1 coordinates and "
                             "0 <= m <= n constraints")
         handle = ctypes.c_void_p()
-        self._check(_ffi.ga_create(self.n, self.m, ctypes.byref(handle)))
+        if space is None:
+            self.nq = self.n
+            self._check(_ffi.ga_create(self.n, self.m, ctypes.byref(handle)))
+        else:
+            kinds, counts, self.nq, nv = _space_blocks(space)
+            if nv != self.n:
+                raise error_for(_ffi.GA_ERR_ARG,
+                                f"Solver(n={self.n}, space={space!r}): the blocks have "
+                                f"{nv} velocity coordinates, n must be that")
+            _i = ctypes.c_int * len(kinds)
+            self._check(_ffi.ga_create_space(len(kinds), _i(*kinds), _i(*counts), self.m,
+                                             ctypes.byref(handle)))
         self._ptr = handle
         self._lib = _ffi.lib          # keeps the library alive for __del__ at shutdown
         self._free = _ffi.ga_free
-        n, m = self.n, self.m
+        n, m, nq = self.n, self.m, self.nq
         v = self._view
         # declared patterns first: they decide the shape the callbacks see
         nnz = {}
@@ -405,20 +452,20 @@ class Solver:
         sK, sC = shape("stiffness", (n, n)), shape("damping", (n, n))
         slot = self._slot
         self._cbs = [
-            slot(mass, _MASS, lambda t, q, M, u: call(mass, M, sM, t, (q, n))),
-            slot(force, _FORCE, lambda t, q, qd, f, u: call(force, f, (n,), t, (q, n), (qd, n))),
+            slot(mass, _MASS, lambda t, q, M, u: call(mass, M, sM, t, (q, nq))),
+            slot(force, _FORCE, lambda t, q, qd, f, u: call(force, f, (n,), t, (q, nq), (qd, n))),
             slot(constraint if m else None, _CONSTRAINT,
-                 lambda t, q, p, u: call(constraint, p, (m,), t, (q, n))),
+                 lambda t, q, p, u: call(constraint, p, (m,), t, (q, nq))),
             slot(jacobian if m else None, _CONSTRAINT,
-                 lambda t, q, J, u: call(jacobian, J, sJ, t, (q, n))),
+                 lambda t, q, J, u: call(jacobian, J, sJ, t, (q, nq))),
             slot(stiffness, _STIFFNESS, lambda t, q, qd, a, lam, K, u: call(
-                stiffness, K, sK, t, (q, n), (qd, n), (a, n), (lam, m))),
+                stiffness, K, sK, t, (q, nq), (qd, n), (a, n), (lam, m))),
             slot(damping, _FORCE,
-                 lambda t, q, qd, C, u: call(damping, C, sC, t, (q, n), (qd, n))),
+                 lambda t, q, qd, C, u: call(damping, C, sC, t, (q, nq), (qd, n))),
             slot(constraint_accel, _FORCE, lambda t, q, qd, o, u: call(
-                constraint_accel, o, (m,), t, (q, n), (qd, n))),
+                constraint_accel, o, (m,), t, (q, nq), (qd, n))),
             slot(constraint_dt if m else None, _CONSTRAINT,
-                 lambda t, q, o, u: call(constraint_dt, o, (m,), t, (q, n))),
+                 lambda t, q, o, u: call(constraint_dt, o, (m,), t, (q, nq))),
         ]
         mc, fc, cc, jc, kc, dc, ac, tc = self._cbs
         self._check(_ffi.ga_set_callbacks(self._ptr, _cast(mc, _ffi.MASS_FN),
@@ -439,13 +486,13 @@ class Solver:
             self._user.update(rate=rate, force_y=force_y, coupling=coupling)
             fo = [
                 slot(force_y, _EVENT, lambda t, q, qd, y, f, u: call(
-                    force_y, f, (n,), t, (q, n), (qd, n), (y, r))),
+                    force_y, f, (n,), t, (q, nq), (qd, n), (y, r))),
                 slot(rate, _EVENT, lambda t, q, qd, y, yd, u: call(
-                    rate, yd, (r,), t, (q, n), (qd, n), (y, r))),
+                    rate, yd, (r,), t, (q, nq), (qd, n), (y, r))),
                 slot(coupling, _COUPLING, lambda t, q, qd, y, gq, gv, gy, fy, u: call(
                     lambda t, q, qd, y, out: coupling(t, q, qd, y, out[0], out[1], out[2],
                                                       out[3]),
-                    (gq, gv, gy, fy), ((r, n), (r, n), (r, r), (n, r)), t, (q, n), (qd, n),
+                    (gq, gv, gy, fy), ((r, n), (r, n), (r, r), (n, r)), t, (q, nq), (qd, n),
                     (y, r))),
             ]
             self._cbs += fo
@@ -540,13 +587,13 @@ class Solver:
         self._check(_ffi.ga_set_sensitivity(self._ptr, p.size, self._dp(p),
                                             None if sc is None else self._dp(sc), flags))
         self._parameters = (p, sc)  # alive as long as the solver: the library holds p
-        n, call = self.n, self._call
+        n, nq, call = self.n, self.nq, self._call
         slot = self._slot
         cbs = [
             slot(force_p, _FORCE_P, lambda t, q, qd, j, out, u: call(
-                lambda t, q, qd, o: force_p(t, q, qd, j, o), out, (n,), t, (q, n), (qd, n))),
+                lambda t, q, qd, o: force_p(t, q, qd, j, o), out, (n,), t, (q, nq), (qd, n))),
             slot(mass_p, _MASS_P, lambda t, q, j, a, out, u: call(
-                lambda t, q, a, o: mass_p(t, q, j, a, o), out, (n,), t, (q, n), (a, n))),
+                lambda t, q, a, o: mass_p(t, q, j, a, o), out, (n,), t, (q, nq), (a, n))),
         ]
         if force_p or mass_p:
             self._cbs += cbs
@@ -561,7 +608,7 @@ class Solver:
                 shapes = ((m,), sJ) + (((m,),) if phi_tp else ())
                 return call(lambda t, q, outs: constraint_p(
                     t, q, j, outs[0], outs[1], outs[2] if len(outs) > 2 else None),
-                    places, shapes, t, (q, n))
+                    places, shapes, t, (q, nq))
             cb = slot(constraint_p, _CONSTRAINT_P, trampoline)
             self._cbs.append(cb)
             self._check(_ffi.ga_set_constraint_parameter_derivative(
@@ -591,7 +638,7 @@ class Solver:
         d/dp_j."""
         if self._parameters is None:
             raise error_for(_ffi.GA_ERR_STATE, "no sensitivities: Solver(parameters=...)")
-        n, m, npar = self.n, self.m, self._parameters[0].size
+        n, m, nq, npar = self.n, self.m, self.nq, self._parameters[0].size
         out = [np.empty((npar, max(k, 1))) for k in (n, n, n, m)]
         for j in range(npar):
             self._check(_ffi.ga_get_sensitivity(self._handle(), j,
@@ -614,7 +661,7 @@ class Solver:
         derivatives (zeroed arrays of lengths n, n, n, m, np) where they are not zero."""
         if self._parameters is None:
             raise error_for(_ffi.GA_ERR_STATE, "no sensitivities: Solver(parameters=...)")
-        n, m, npar = self.n, self.m, self._parameters[0].size
+        n, m, nq, npar = self.n, self.m, self.nq, self._parameters[0].size
         v = self._view
 
         def trampoline(fn):
@@ -628,7 +675,7 @@ class Solver:
                     return -1
                 try:
                     outs = [np.zeros(k) for k in (n, n, n, m, npar)]
-                    val = fn(t, self._copied(q, n), self._copied(qd, n), self._copied(qdd, n),
+                    val = fn(t, self._copied(q, nq), self._copied(qd, n), self._copied(qdd, n),
                              self._copied(lam, m) if m else np.zeros(0), *outs)
                     v(value, (1,), True)[0] = float(val)
                     for address, out in zip((dq, dv, dqdd, dlam, dp), outs):
@@ -771,8 +818,10 @@ class Solver:
         initial values (ga_init_y; None on a running solver keeps the states it holds)."""
         q0 = np.ascontiguousarray(q0, dtype=float)
         v0 = np.ascontiguousarray(v0, dtype=float)
-        if q0.shape != (self.n,) or v0.shape != (self.n,):
-            raise error_for(_ffi.GA_ERR_ARG, "q0 and v0 must have shape (%d,)" % self.n)
+        if q0.shape != (self.nq,) or v0.shape != (self.n,):
+            raise error_for(_ffi.GA_ERR_ARG, "q0 and v0 must have shape (%d,)" % self.n
+                            if self.nq == self.n else "q0 and v0 must have shapes (%d,) and "
+                            "(%d,)" % (self.nq, self.n))
         if y0 is None:
             self._check(_ffi.ga_init(self._handle(), float(t0), self._dp(q0), self._dp(v0)))
             return
@@ -893,7 +942,7 @@ class Solver:
         for g in functions:
             if not callable(g):
                 raise TypeError("event functions must be callable, got %r" % (g,))
-        count, n, m, r = len(functions), self.n, self.m, self.r
+        count, n, m, r, nq = len(functions), self.n, self.m, self.r, self.nq
         call = self._call
 
         def evaluate(t, q, v, lam, g, y=None):
@@ -908,16 +957,16 @@ class Solver:
 
         def trampoline(t, q, v, lam, g, u):
             if lam:
-                return call(evaluate, g, (count,), t, (q, n), (v, n), (lam, m))
+                return call(evaluate, g, (count,), t, (q, nq), (v, n), (lam, m))
             return call(lambda t, q, v, g: evaluate(t, q, v, None, g), g, (count,), t,
-                        (q, n), (v, n))
+                        (q, nq), (v, n))
 
         def trampoline_y(t, q, v, y, lam, g, u):
             if lam:
                 return call(lambda t, q, v, y, lam, g: evaluate(t, q, v, lam, g, y), g,
-                            (count,), t, (q, n), (v, n), (y, r), (lam, m))
+                            (count,), t, (q, nq), (v, n), (y, r), (lam, m))
             return call(lambda t, q, v, y, g: evaluate(t, q, v, None, g, y), g, (count,), t,
-                        (q, n), (v, n), (y, r))
+                        (q, nq), (v, n), (y, r))
 
         direction = (_i * max(count, 1))(*[int(np.sign(getattr(g, "direction", 0)))
                                             for g in functions])
@@ -947,7 +996,7 @@ class Solver:
             self._check(_ffi.ga_set_step_hook(self._handle(), _ffi.STEP_HOOK_FN(), None, 0))
             self._hook = None
             return
-        n, m = self.n, self.m
+        n, m, nq = self.n, self.m, self.nq
         address = native_address(fn)
         if address is not None:
             check_compiled_signature(fn, _HOOK, "step hook")
@@ -969,9 +1018,9 @@ class Solver:
                 self._in_callback += 1
                 try:
                     if zero_copy:
-                        args = (view(q, (n,)), view(v, (n,)), view(lam, (m,)) if lam else None)
+                        args = (view(q, (nq,)), view(v, (n,)), view(lam, (m,)) if lam else None)
                     else:
-                        args = (copied(q, n), copied(v, n), copied(lam, m) if lam else None)
+                        args = (copied(q, nq), copied(v, n), copied(lam, m) if lam else None)
                     return 1 if fn(t, *args) else 0
                 except BaseException as e:  # re-raised by the call that stepped
                     self._pending = e
@@ -1002,7 +1051,7 @@ class Solver:
     @_runs_callbacks
     def interpolate(self, t):
         """(q, v, lam) at t inside the last step (dense output, see ga_interpolate)."""
-        q, v, lam = np.empty(self.n), np.empty(self.n), np.empty(max(self.m, 1))
+        q, v, lam = np.empty(self.nq), np.empty(self.n), np.empty(max(self.m, 1))
         self._check(_ffi.ga_interpolate(self._handle(), float(t), self._dp(q), self._dp(v),
                                         self._dp(lam)))
         return q, v, lam[:self.m]
@@ -1043,7 +1092,7 @@ class Solver:
         self._check(_ffi.ga_get_h_last(self._handle(), ctypes.byref(x)))
         return x.value
 
-    q = property(lambda self: self._get(_ffi.ga_get_q, self.n), doc="positions (copy)")
+    q = property(lambda self: self._get(_ffi.ga_get_q, self.nq), doc="positions (copy; nq)")
     v = property(lambda self: self._get(_ffi.ga_get_v, self.n), doc="velocities (copy)")
     qdd = property(lambda self: self._get(_ffi.ga_get_qdd, self.n), doc="accelerations (copy)")
     lam = property(lambda self: self._get(_ffi.ga_get_lambda, self.m), doc="multipliers (copy)")
@@ -1074,7 +1123,7 @@ class Solver:
         with its worst entry (or a constraint with a zero gradient). qdd defaults to zero, lam
         to ones, y to zero."""
         arrays = []
-        for x, size in ((q, self.n), (v, self.n), (qdd, self.n), (lam, self.m), (y, None)):
+        for x, size in ((q, self.nq), (v, self.n), (qdd, self.n), (lam, self.m), (y, None)):
             if x is None:
                 arrays.append(None)
                 continue
