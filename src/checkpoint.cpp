@@ -183,6 +183,16 @@ ga_status Stepper::check_checkpoint(const double *buf, std::size_t len, std::siz
                              "this solver keeps every constraint (GA_REDUNDANT_DROP drops them)",
                              i);
     }
+    // (On a group space: q holds rotations, as ga_init asks of q0; so does the q the kept
+    // matrix was evaluated at, at l.matrix.)
+    const std::size_t q_at = layout2 ? kHeader2 : layout3 ? kHeader3 : kHeader;
+    for (const std::size_t at : {q_at, l.matrix}) {
+        if (at != q_at && !kept)
+            continue;
+        if (const Eigen::Index bad = model.space.invalid_rotation(buf + at); bad >= 0)
+            return diag.fail(GA_ERR_ARG, "checkpoint entries %zu.. (q[%ld..]) are not a rotation",
+                             at + static_cast<std::size_t>(bad), static_cast<long>(bad));
+    }
     if (!model.ready())
         return diag.fail(GA_ERR_STATE, "ga_set_state needs the callbacks (ga_set_callbacks)");
     return GA_OK;

@@ -250,6 +250,110 @@ static void test_dense_output_on_the_group(void **state)
     assert_true(p > 1.9 && p < 2.1);
 }
 
+/* A checkpoint of a run on the group continues bit for bit, in the solver it came from and
+ * in a new one; one whose quaternion is not a unit quaternion is refused, the solver left as
+ * it was. */
+static void test_checkpoint_bit_for_bit(void **state)
+{
+    (void)state;
+    for (int f = 0; f < 2; ++f) {
+        lie_top t = lie_top_make(0);
+        const int formulation = f ? GA_INDEX2_STABILIZED : GA_INDEX3;
+        ga_solver *s = top_solver(&t, formulation), *b = top_solver(&t, formulation);
+        assert_int_equal(ga_set_tolerances(s, 1e-5, 1e-5), GA_OK);
+        assert_int_equal(ga_set_tolerances(b, 1e-5, 1e-5), GA_OK);
+        double q[7], v[6], q1[7], q2[7], q3[7];
+        lie_top_initial(&t, q, v);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        for (int k = 0; k < 100; ++k)
+            assert_int_equal(ga_step_adaptive(s, 1.0), GA_OK);
+        size_t len = 0;
+        assert_int_equal(ga_state_size(s, &len), GA_OK);
+        double *buf = test_malloc(len * sizeof(double)), *after = test_malloc(len * sizeof(double));
+        assert_int_equal(ga_get_state(s, buf, len), GA_OK);
+        for (int k = 0; k < 100; ++k)
+            assert_int_equal(ga_step_adaptive(s, 1.0), GA_OK);
+        assert_int_equal(ga_get_q(s, q1), GA_OK);
+        assert_int_equal(ga_set_state(b, buf, len), GA_OK);
+        for (int k = 0; k < 100; ++k)
+            assert_int_equal(ga_step_adaptive(b, 1.0), GA_OK);
+        assert_int_equal(ga_get_q(b, q2), GA_OK);
+        assert_memory_equal(q1, q2, sizeof q1);
+        assert_int_equal(ga_set_state(s, buf, len), GA_OK);
+        for (int k = 0; k < 100; ++k)
+            assert_int_equal(ga_step_adaptive(s, 1.0), GA_OK);
+        assert_int_equal(ga_get_q(s, q3), GA_OK);
+        assert_memory_equal(q1, q3, sizeof q1);
+
+        assert_int_equal(ga_get_state(s, after, len), GA_OK);
+        buf[CKPT_HEADER + 3] *= 1.01; /* the quaternion's w */
+        assert_int_equal(ga_set_state(s, buf, len), GA_ERR_ARG);
+        assert_non_null(strstr(ga_last_error(s), "not a rotation"));
+        double *now = test_malloc(len * sizeof(double));
+        assert_int_equal(ga_get_state(s, now, len), GA_OK);
+        assert_memory_equal(now, after, len * sizeof(double));
+        test_free(now);
+        test_free(buf);
+        test_free(after);
+        ga_free(s);
+        ga_free(b);
+    }
+}
+
+/* An event on the rotation: the body axis R X crosses the plane x = -0.2 (falling, near
+ * t = 0.41), found on the dense output at order 2 against the reference's crossing (bisection
+ * on lie_top_reference). */
+static int axis_event(double time, const double *q, const double *v, const double *lambda,
+                      double *g, void *user)
+{
+    (void)time, (void)v, (void)lambda;
+    const lie_top *t = user;
+    double R[9];
+    lie_top_rotation(t, q, R);
+    g[0] = R[0] * t->X[0] + R[1] * t->X[1] + R[2] * t->X[2] + 0.2;
+    return 0;
+}
+
+static void test_event_on_the_axis(void **state)
+{
+    (void)state;
+    lie_top t = lie_top_make(0);
+    double lo = 0.38, hi = 0.44; /* g(lo) > 0 > g(hi) */
+    for (int it = 0; it < 40; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        const lie_top_state r = lie_top_reference(&t, mid, (long)ceil(mid * 1e5));
+        if (r.com[0] + 0.2 > 0.0)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    const double t_ref = 0.5 * (lo + hi);
+    double h[3], e[3];
+    for (int i = 0; i < 3; ++i) {
+        h[i] = 1e-3 / (1 << i);
+        ga_solver *s = top_solver(&t, GA_INDEX2_STABILIZED);
+        const int direction[1] = {GA_EVENT_FALLING}, terminal[1] = {1};
+        assert_int_equal(ga_set_events(s, 1, axis_event, direction, terminal, 0), GA_OK);
+        double q[7], v[6];
+        lie_top_initial(&t, q, v);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        ga_status st = GA_OK;
+        for (long k = 0; k < lround(1.0 / h[i]) && st == GA_OK; ++k)
+            st = ga_step(s, h[i]);
+        assert_int_equal(st, GA_EVENT);
+        double te;
+        int index, dir;
+        assert_int_equal(ga_get_event(s, 0, &te, &index, &dir), GA_OK);
+        assert_int_equal(dir, -1);
+        e[i] = fabs(te - t_ref);
+        ga_free(s);
+    }
+    const double p = fit_order(h, e, 3);
+    print_message("  crossing at %.12f: errors %.3e %.3e %.3e, order %.3f\n", t_ref, e[0], e[1],
+                  e[2], p);
+    assert_true(p > 1.9 && p < 2.1);
+}
+
 /* ---- the space's failure paths ---- */
 
 static void test_create_space_refuses_bad_blocks(void **state)
@@ -393,6 +497,8 @@ int main(void)
         cmocka_unit_test(test_energy_where_euler_parameters_fail),
         cmocka_unit_test(test_adaptive_error_follows_tolerance),
         cmocka_unit_test(test_dense_output_on_the_group),
+        cmocka_unit_test(test_checkpoint_bit_for_bit),
+        cmocka_unit_test(test_event_on_the_axis),
         cmocka_unit_test(test_create_space_refuses_bad_blocks),
         cmocka_unit_test(test_vector_blocks_are_ga_create),
         cmocka_unit_test(test_init_refuses_what_is_not_a_rotation),
