@@ -146,7 +146,7 @@ void ConfigurationSpace::group_shift(Vec &q_pert, const Vec &q, Eigen::Index j, 
     }
     Vec3 psi{};
     psi[static_cast<std::size_t>(k)] = e;
-    compose_exp(p.kind, q_pert.data() + p.q0, psi, q_pert.data() + p.q0);
+    compose_exp(p.kind, q.data() + p.q0, psi, q_pert.data() + p.q0);
 }
 
 void ConfigurationSpace::group_restore(Vec &q_pert, const Vec &q, Eigen::Index j) const

@@ -113,8 +113,9 @@ public:
             group_retract(q, e, w, out);
     }
     // q_pert = q (+) e e_j in coordinate j, and back: column differences (q_pert == q outside j)
-    // (On a rotation, q_pert's block o exp(e e_j): shifts of a group compose; restoring
-    // copies the whole block back.)
+    // (On a rotation, q's block o exp(e e_j) into q_pert: a second shift in the same block
+    // replaces the first, so column groups never hold two columns of one rotation -- group
+    // spaces take no patterns; restoring copies the whole block back.)
     void shift_coordinate(Vec &q_pert, const Vec &q, Eigen::Index j, double e) const
     {
         if (euclidean())

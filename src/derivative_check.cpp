@@ -87,7 +87,7 @@ ga_status check_derivatives(Stepper &kernel, const Sensitivities &sens, double t
                             double *worst_out)
 {
     const int n = kernel.nv(), m = kernel.m(), R = kernel.r();
-    Vec q = Eigen::Map<const Vec>(q0, n), v = Eigen::Map<const Vec>(v0, n);
+    Vec q = Eigen::Map<const Vec>(q0, kernel.nq()), v = Eigen::Map<const Vec>(v0, n);
     Vec qdd = qdd0 ? Vec(Eigen::Map<const Vec>(qdd0, n)) : Vec::Zero(n);
     // (ones: the multipliers' part of K_t is checked too)
     Vec lambda = lambda0 ? Vec(Eigen::Map<const Vec>(lambda0, m)) : Vec::Ones(m);
@@ -130,7 +130,7 @@ ga_status check_derivatives(Stepper &kernel, const Sensitivities &sens, double t
         Vec row_max = Vec::Zero(m);
         for (int j = 0; j < n && !st; ++j) {
             Vec qq = q;
-            const double e = step_for(q[j]);
+            const double e = step_for(kernel.model.space.magnitude(q, j));
             kernel.model.space.shift_coordinate(qq, q, j, e);
             st = kernel.model.constraint(t, qq, phi1);
             kernel.model.space.shift_coordinate(qq, q, j, -e);
@@ -199,7 +199,7 @@ ga_status check_derivatives(Stepper &kernel, const Sensitivities &sens, double t
             const double scale = cols.max_abs();
             for (int j = 0; j < n && !st; ++j) {
                 Vec qq = q;
-                const double e = step_for(q[j]);
+                const double e = step_for(kernel.model.space.magnitude(q, j));
                 kernel.model.space.shift_coordinate(qq, q, j, e);
                 st = residual_at(qq, v, r1);
                 kernel.model.space.shift_coordinate(qq, q, j, -e);

@@ -134,6 +134,28 @@ int lie_top_jacobian(double time, const double *q, double *Phi_q, void *user)
     return 0;
 }
 
+int lie_top_stiffness(double time, const double *q, const double *v, const double *qdd,
+                      const double *lambda, double *K, void *user)
+{
+    (void)time, (void)v, (void)qdd;
+    const lie_top *t = user;
+    double R[9], l[3];
+    lie_top_rotation(t, q, R);
+    rotate_back(R, lambda, l);
+    const double *X = t->X;
+    const double Xh[9] = {0, -X[2], X[1], X[2], 0, -X[0], -X[1], X[0], 0};
+    const double lh[9] = {0, -l[2], l[1], l[2], 0, -l[0], -l[1], l[0], 0};
+    memset(K, 0, 36 * sizeof(double));
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            double s = 0.0;
+            for (int k = 0; k < 3; ++k)
+                s += Xh[3 * i + k] * lh[3 * k + j];
+            K[(3 + i) + 6 * (3 + j)] = -s;
+        }
+    return 0;
+}
+
 int lie_top_damping(double time, const double *q, const double *v, double *C, void *user)
 {
     (void)time, (void)q;

@@ -44,6 +44,10 @@ int lie_top_mass(double time, const double *q, double *M, void *user);
 int lie_top_force(double time, const double *q, const double *v, double *f, void *user);
 int lie_top_constraint(double time, const double *q, double *phi, void *user);
 int lie_top_jacobian(double time, const double *q, double *Phi_q, void *user);
+/* K_t = d(Phi_q^T lambda)/dq along right increments: -X~ (R^T lambda)~ in the rotation's
+ * block (M is constant, f does not depend on q) */
+int lie_top_stiffness(double time, const double *q, const double *v, const double *qdd,
+                      const double *lambda, double *K, void *user);
 /* C_t = -df/domega = omega~ J - (J omega)~ (the gyroscopic term's tangent) */
 int lie_top_damping(double time, const double *q, const double *v, double *C, void *user);
 

@@ -354,6 +354,27 @@ static void test_event_on_the_axis(void **state)
     assert_true(p > 1.9 && p < 2.1);
 }
 
+/* The scene's exact tangents agree with galpha's differences along right increments (which
+ * the solver's K_t and C_t are), and with them Newton takes no more iterations. */
+static void test_exact_tangents(void **state)
+{
+    (void)state;
+    lie_top t = lie_top_make(0);
+    ga_solver *s = top_solver(&t, GA_INDEX3);
+    assert_int_equal(ga_set_tangents(s, lie_top_stiffness, lie_top_damping), GA_OK);
+    double q[7], v[6], worst = 0.0;
+    lie_top_initial(&t, q, v);
+    const double psi[3] = {0.3, -0.2, 0.5};
+    assert_int_equal(ga_so3_exp(1, psi, q + 3), GA_OK); /* a general attitude */
+    const double qdd[6] = {0.1, 0.2, 0.3, 1.0, -2.0, 3.0}, lambda[3] = {20.0, -30.0, 140.0};
+    const ga_status st = ga_check_derivatives(s, 0.0, q, v, qdd, lambda, NULL, 1e-6, &worst);
+    if (st)
+        print_error("%s\n", ga_last_error(s));
+    assert_int_equal(st, GA_OK);
+    print_message("  largest relative difference %.2e\n", worst);
+    ga_free(s);
+}
+
 /* ---- the space's failure paths ---- */
 
 static void test_create_space_refuses_bad_blocks(void **state)
@@ -499,6 +520,7 @@ int main(void)
         cmocka_unit_test(test_dense_output_on_the_group),
         cmocka_unit_test(test_checkpoint_bit_for_bit),
         cmocka_unit_test(test_event_on_the_axis),
+        cmocka_unit_test(test_exact_tangents),
         cmocka_unit_test(test_create_space_refuses_bad_blocks),
         cmocka_unit_test(test_vector_blocks_are_ga_create),
         cmocka_unit_test(test_init_refuses_what_is_not_a_rotation),
