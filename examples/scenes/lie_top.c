@@ -182,6 +182,41 @@ static void pivot_inertia(const lie_top *t, const double *w, double *out)
         out[i] = t->Jc[i] * w[i] + t->mass * (XX * w[i] - X[i] * Xw);
 }
 
+int lie_top_pivot_mass(double time, const double *q, double *M, void *user)
+{
+    (void)time, (void)q;
+    const lie_top *t = user;
+    double e[3] = {0, 0, 0};
+    for (int j = 0; j < 3; ++j) {
+        e[j] = 1.0;
+        pivot_inertia(t, e, M + 3 * j);
+        e[j] = 0.0;
+    }
+    return 0;
+}
+
+int lie_top_pivot_force(double time, const double *q, const double *v, double *f, void *user)
+{
+    (void)time;
+    const lie_top *t = user;
+    double R[9], mg[3], gb[3], n[3], Jw[3], wJw[3];
+    const double r[4] = {q[0], q[1], q[2], q[3]};
+    double qq[7] = {0, 0, 0, r[0], r[1], r[2], r[3]};
+    const lie_top quaternion = {0, t->mass, {t->Jc[0], t->Jc[1], t->Jc[2]},
+                                {t->X[0], t->X[1], t->X[2]}, {t->g[0], t->g[1], t->g[2]},
+                                {0, 0, 0}};
+    lie_top_rotation(&quaternion, qq, R);
+    for (int i = 0; i < 3; ++i)
+        mg[i] = t->mass * t->g[i];
+    rotate_back(R, mg, gb);
+    cross(t->X, gb, n);
+    pivot_inertia(t, v, Jw);
+    cross(v, Jw, wJw);
+    for (int i = 0; i < 3; ++i)
+        f[i] = n[i] - wJw[i];
+    return 0;
+}
+
 void lie_top_invariants(const lie_top *t, const double *q, const double *v, double out[3])
 {
     double R[9], Jw[3], L[3], com[3];

@@ -51,6 +51,12 @@ int lie_top_stiffness(double time, const double *q, const double *v, const doubl
 /* C_t = -df/domega = omega~ J - (J omega)~ (the gyroscopic term's tangent) */
 int lie_top_damping(double time, const double *q, const double *v, double *C, void *user);
 
+/* The same top on SO(3) alone, about its pivot (ga_create_space({SO3 1}, m = 0): nq = 4,
+ * nv = 3; q a quaternion, v = omega): the inertia about the pivot J_P, no constraint, the
+ * moment of gravity X x R^T m g. */
+int lie_top_pivot_mass(double time, const double *q, double *M, void *user);
+int lie_top_pivot_force(double time, const double *q, const double *v, double *f, void *user);
+
 /* Energy, vertical angular momentum about the pivot, spin omega_2, from q and v */
 void lie_top_invariants(const lie_top *t, const double *q, const double *v, double out[3]);
 
