@@ -203,11 +203,12 @@ typedef enum {
  *  ones); build them with the maps below. ga_get_size's n is nv; ga_get_space_size gives both.
  *
  *  A space of vector blocks only is R^n and the solver is exactly that of ga_create(n, m).
- *  With rotations, in this version: the index-3 formulation, fixed and adaptive steps,
- *  dense output and events, on the dense linear solver; ga_set_formulation(index 2),
- *  ga_set_pattern, the sparse solver, first-order states and sensitivities return
- *  GA_ERR_ARG, saying so. q0 of ga_init must hold rotations (a quaternion's norm, a matrix's
- *  orthonormality within 1e-6, det > 0), else GA_ERR_ARG names the block.
+ *  With rotations, in this version: index 3 and the stabilized index 2, fixed and adaptive
+ *  steps, dense output and events, checkpoints, forward and adjoint sensitivities (a
+ *  sensitivity's dq is a tangent along right increments, nv numbers), on the dense linear
+ *  solver; ga_set_pattern, the sparse solver and first-order states return GA_ERR_ARG, saying
+ *  so. q0 of ga_init (and q in ga_set_state) must hold rotations (a quaternion's norm, a
+ *  matrix's orthonormality within 1e-6, det > 0), else GA_ERR_ARG names the block.
  *  Errors: GA_ERR_ARG (out, kinds or counts NULL with count > 0, count < 1, an unknown kind, a
  *  count < 1, nq or nv above INT_MAX, m < 0 or m > nv), GA_ERR_NOMEM. */
 GA_API ga_status ga_create_space(int count, const int *kinds, const int *counts, int m,
@@ -910,7 +911,8 @@ GA_API ga_status ga_set_adjoint_checkpoints(ga_solver *s, long interval, long co
 
 /** A cost term: its value at (t, q, v, qdd, lambda) and every partial derivative, in q, v, qdd
  *  (n each), lambda (m; lambda and d_lambda are NULL when m = 0) and the parameters p (np); all
- *  outputs are written. */
+ *  outputs are written. (On a space with rotations, ga_create_space, q has nq entries and d_q
+ *  nv: the derivative along right increments, as Phi_q's.) */
 typedef int (*ga_cost_fn)(double t, const double *q, const double *v, const double *qdd,
                           const double *lambda, double *value, double *d_q, double *d_v,
                           double *d_qdd, double *d_lambda, double *d_p, void *user);

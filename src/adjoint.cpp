@@ -237,6 +237,8 @@ struct Adjoint::Work {
     Eigen::VectorXd rhs;
 #endif
     Mat D, Md, Jd, Kd, Cd, Bd, Zd;
+    Vec xi;  // a group space's increment of the step (log(q_n^-1 q_{n+1}) block by block)
+    Vec bt_eta;  // and B^T eta there
     Eigen::PartialPivLU<Mat> dense_lu;
     std::vector<Eigen::Triplet<double>> entries;
     int np = 0;
@@ -245,7 +247,7 @@ struct Adjoint::Work {
         for (Vec *v : {&my, &mydot, &mw, &ry, &yp})
             v->setZero(r);
         for (Vec *v : {&mq, &mv, &mqdd, &ma, &cq, &cv, &cqdd, &yq, &zq, &rr, &qp, &vp, &tmp, &qpt,
-                       &mqt})
+                       &mqt, &xi, &bt_eta})
             v->setZero(n);
         for (Vec *v : {&ml, &cl, &yl, &ye, &zl, &ze, &rl, &rv, &eta})
             v->setZero(m);
@@ -423,8 +425,15 @@ ga_status Adjoint::step_back(long k, Work &w)
         dense_of(k_.mass_matrix(), w.Md);
         dense_of(k_.jacobian_matrix(), w.Jd);
         D.topLeftCorner(n, n) = (bh2 * c.beta_prime) * w.Md;
+        // On a group q_{n+1} moves by T(xi) times the increment (sec. 16): K_t, the
+        // constraint rows and Z take it as a right factor, Phi_q^T does not (w.JTd: Phi_q T).
+        const bool group = !space.euclidean();
+        if (group)
+            space.increment_between(q_n, x.q, w.xi);
         if (K) {
             dense_of(k_.stiffness_matrix(), w.Kd);
+            if (group)
+                space.right_multiply_tangent(w.xi, w.Kd.data(), n, n);
             D.topLeftCorner(n, n) += bh2 * w.Kd;
         }
         if (C) {
@@ -432,14 +441,18 @@ ga_status Adjoint::step_back(long k, Work &w)
             D.topLeftCorner(n, n) += (bh2 * c.gamma_prime) * w.Cd;
         }
         D.block(0, n, n, m) = w.Jd.transpose();
+        if (group && m > 0)
+            space.right_multiply_tangent(w.xi, w.Jd.data(), m, m);
         D.block(n, 0, m, n) = w.Jd;
         if (index2 && m > 0) {
             dense_of(k_.B_matrix(), w.Bd);
             dense_of(k_.Z_matrix(), w.Zd);
+            if (group)
+                space.right_multiply_tangent(w.xi, w.Zd.data(), m, m);
             if (K)
                 D.block(0, n + m, n, m) = -bh2 * (w.Kd * w.Bd.transpose());
             D.block(n, n + m, m, m) = -(w.Jd * w.Bd.transpose());
-            D.block(n + m, 0, m, n) = s3 * w.Zd + w.Jd;
+            D.block(n + m, 0, m, n) = s3 * w.Zd + (group ? k_.jacobian_matrix().as_dense() : w.Jd);
             D.block(n + m, n + m, m, m) = -s3 * (w.Zd * w.Bd.transpose());
         }
         if (R > 0) {
@@ -475,7 +488,7 @@ ga_status Adjoint::step_back(long k, Work &w)
         y.head(n) = w.tmp + w.mqt;  // d = w - B^T e
         y.segment(n, m) = w.ml / bh2;
         w.ye.setZero();
-        k_.B_matrix().multiply_add(-1.0, w.mq, w.ye);
+        k_.B_matrix().multiply_add(-1.0, w.mqt, w.ye);  // (q moves by T d, d = w - B^T e)
         y.segment(n + m, m) = w.ye;
     } else {
         y.head(n) = w.tmp + w.mqt;
@@ -560,6 +573,14 @@ ga_status Adjoint::step_back(long k, Work &w)
     if (index2 && m > 0) {
         if ((st = forward_.correction_derivative(e0[0], q_n, w.eta, w.qpt, w.tmp)))
             return st;
+        // That is the derivative of B^T eta along qpt; the adjoint wants its transpose, which
+        // is the same only where second derivatives commute (sec. 16): on a group it differs
+        // by qpt x (B^T eta) on each rotation.
+        if (!space.euclidean()) {
+            w.bt_eta.setZero();
+            k_.B_matrix().multiply_transpose_add(1.0, w.eta, w.bt_eta);
+            space.add_cross(-1.0, w.qpt, w.bt_eta, w.tmp);
+        }
         msq += w.tmp;
     }
     if (kind == AdjointRecord::First) {  // the start, differenced in p (sensitivity.cpp)

@@ -915,8 +915,6 @@ GA_API ga_status ga_set_sensitivity(ga_solver *s, int np, double *p, const doubl
             return c.diag.fail(GA_ERR_ARG, "np = %d parameters: must be >= 0", np);
         if (np > 0 && !p)
             return c.diag.fail(GA_ERR_ARG, "np = %d parameters and p is NULL", np);
-        if (np > 0 && !c.model.space.euclidean())
-            return refuse_on_rotations(c, "sensitivity analysis");
         if ((depends & ~(GA_DEPENDS_FORCE | GA_DEPENDS_MASS | GA_DEPENDS_RATE |
                          GA_DEPENDS_CONSTRAINT)) != 0)
             return c.diag.fail(GA_ERR_ARG, "unknown dependence flags 0x%x", static_cast<unsigned>(depends));

@@ -198,6 +198,101 @@ double ConfigurationSpace::group_distance(const Vec &q1, const Vec &q0, Eigen::I
                          [static_cast<std::size_t>(i - p.v0)]);
 }
 
+// A tangent vector s at q_n (q_n o exp(e s)) seen at q_n1 = q_n o exp(xi): q_n o exp(e s) o
+// exp(xi) = q_n1 o exp(e Ad_{exp(-xi)} s), Ad_{exp(-xi)} = R(exp(xi))^T on SO(3); an increment
+// d of xi moves q_n1 by T(xi) d (sec. 14, 16).
+void ConfigurationSpace::group_newmark_derivative(const Vec &q_n, const Vec &q_n1,
+                                                  const Vec &s_q, const Vec &s_v,
+                                                  const Vec &s_a, const Vec &s_a1, double h,
+                                                  double beta, Vec &out) const
+{
+    for (const Part &p : parts_) {
+        const Eigen::Index v0 = p.v0, nv = p.nv;
+        if (p.kind == Kind::Vector) {
+            out.segment(v0, nv) = s_q.segment(v0, nv) + h * s_v.segment(v0, nv) +
+                                  (h * h) * ((0.5 - beta) * s_a.segment(v0, nv) +
+                                             beta * s_a1.segment(v0, nv));
+            continue;
+        }
+        const Vec3 xi = relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0);
+        const Mat3 E = so3::matrix(so3::exp(xi)), T = so3::tangent(xi);
+        double d[3];
+        for (int k = 0; k < 3; ++k)
+            d[k] = h * s_v[v0 + k] + (h * h) * ((0.5 - beta) * s_a[v0 + k] + beta * s_a1[v0 + k]);
+        for (int i = 0; i < 3; ++i) {
+            double r = 0.0;
+            for (int k = 0; k < 3; ++k)
+                r += E[3 * k + i] * s_q[v0 + k] + T[3 * i + k] * d[k];
+            out[v0 + i] = r;
+        }
+    }
+}
+
+void ConfigurationSpace::group_tangent(const Vec &q_n, const Vec &q_n1, const Vec &d, Vec &out,
+                                       bool transposed) const
+{
+    for (const Part &p : parts_) {
+        if (p.kind == Kind::Vector) {
+            if (!transposed)
+                out.segment(p.v0, p.nv) += d.segment(p.v0, p.nv);
+            else if (&out != &d)
+                out.segment(p.v0, p.nv) = d.segment(p.v0, p.nv);
+            continue;
+        }
+        const Mat3 T =
+            so3::tangent(relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0));
+        const double x[3] = {d[p.v0], d[p.v0 + 1], d[p.v0 + 2]};
+        for (int i = 0; i < 3; ++i) {
+            double r = 0.0;
+            for (int k = 0; k < 3; ++k)
+                r += (transposed ? T[3 * k + i] : T[3 * i + k]) * x[k];
+            if (transposed)
+                out[p.v0 + i] = r;
+            else
+                out[p.v0 + i] += r;
+        }
+    }
+}
+
+void ConfigurationSpace::group_transport_transpose(const Vec &q_n, const Vec &q_n1,
+                                                   Vec &m) const
+{
+    for (const Part &p : parts_) {
+        if (p.kind == Kind::Vector)
+            continue;
+        // (Ad_{exp(-xi)})^T = R(exp(xi))
+        const Mat3 E = so3::matrix(
+            so3::exp(relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0)));
+        const double x[3] = {m[p.v0], m[p.v0 + 1], m[p.v0 + 2]};
+        for (int i = 0; i < 3; ++i)
+            m[p.v0 + i] = E[3 * i] * x[0] + E[3 * i + 1] * x[1] + E[3 * i + 2] * x[2];
+    }
+}
+
+void ConfigurationSpace::add_cross(double c, const Vec &u, const Vec &g, Vec &out) const
+{
+    for (const Part &p : parts_) {
+        if (p.kind == Kind::Vector)
+            continue;
+        const Vec3 x = so3::cross(vec3(u.data() + p.v0), vec3(g.data() + p.v0));
+        for (int k = 0; k < 3; ++k)
+            out[p.v0 + k] += c * x[static_cast<std::size_t>(k)];
+    }
+}
+
+void ConfigurationSpace::increment_between(const Vec &q_n, const Vec &q_n1, Vec &xi) const
+{
+    for (const Part &p : parts_) {
+        if (p.kind == Kind::Vector) {
+            xi.segment(p.v0, p.nv) = q_n1.segment(p.q0, p.nv) - q_n.segment(p.q0, p.nv);
+            continue;
+        }
+        const Vec3 x = relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0);
+        for (int k = 0; k < 3; ++k)
+            xi[p.v0 + k] = x[static_cast<std::size_t>(k)];
+    }
+}
+
 void ConfigurationSpace::right_multiply_tangent(const Vec &xi, double *A, Eigen::Index rows,
                                                 Eigen::Index ld) const
 {

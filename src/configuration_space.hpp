@@ -61,6 +61,10 @@ public:
     // increment, recomputed at every iterate (composing Newton's corrections one by one would
     // add the tangent operator's error to each)
     void step_to(const Vec &q_n, const Vec &xi, Vec &q) const;
+    // out += c (u x g) on each rotation's coordinates (vector blocks: nothing)
+    void add_cross(double c, const Vec &u, const Vec &g, Vec &out) const;
+    // xi with q_n1 = q_n (+) xi (log(q_n^-1 q_n1) on a rotation): a recorded step's increment
+    void increment_between(const Vec &q_n, const Vec &q_n1, Vec &xi) const;
     // A <- A T(xi) on the columns of the rotations (rows x nv, column-major with leading
     // dimension ld): the q-columns of K_t and Phi_q in the iteration matrix (sec. 14)
     void right_multiply_tangent(const Vec &xi, double *A, Eigen::Index rows,
@@ -170,22 +174,35 @@ public:
     // of xi enters through the tangent operator T(xi); in R^n both are identities.
     // The derivative of eq. (4) along a derivative of the state: s_q transported, plus
     // h s_v + h^2 ((1/2 - beta) s_a + beta s_a1) through T.
-    void newmark_derivative(const Vec & /*q_n*/, const Vec & /*q_n1*/, const Vec &s_q,
-                            const Vec &s_v, const Vec &s_a, const Vec &s_a1, double h,
-                            double beta, Vec &out) const
+    void newmark_derivative(const Vec &q_n, const Vec &q_n1, const Vec &s_q, const Vec &s_v,
+                            const Vec &s_a, const Vec &s_a1, double h, double beta,
+                            Vec &out) const
     {
-        out = s_q + h * s_v + (h * h) * ((0.5 - beta) * s_a + beta * s_a1);
+        if (euclidean())
+            out = s_q + h * s_v + (h * h) * ((0.5 - beta) * s_a + beta * s_a1);
+        else
+            group_newmark_derivative(q_n, q_n1, s_q, s_v, s_a, s_a1, h, beta, out);
     }
     // s_q += T(xi) d: an increment of the step's xi added to a derivative of q_n1
-    void tangent_increment(const Vec & /*q_n*/, const Vec & /*q_n1*/, const Vec &d,
-                           Vec &s_q) const
+    void tangent_increment(const Vec &q_n, const Vec &q_n1, const Vec &d, Vec &s_q) const
     {
-        s_q += d;
+        if (euclidean())
+            s_q += d;
+        else
+            group_tangent(q_n, q_n1, d, s_q, false);
     }
     // The transposes, in place on an adjoint variable at q_n1: of the transport (to q_n) and
     // of T(xi).
-    void transport_transpose(const Vec & /*q_n*/, const Vec & /*q_n1*/, Vec & /*m*/) const {}
-    void tangent_transpose(const Vec & /*q_n*/, const Vec & /*q_n1*/, Vec & /*m*/) const {}
+    void transport_transpose(const Vec &q_n, const Vec &q_n1, Vec &m) const
+    {
+        if (!euclidean())
+            group_transport_transpose(q_n, q_n1, m);
+    }
+    void tangent_transpose(const Vec &q_n, const Vec &q_n1, Vec &m) const
+    {
+        if (!euclidean())
+            group_tangent(q_n, q_n1, m, m, true);
+    }
 
 private:
     // A block placed: its kind and where its coordinates start in q and in v
@@ -200,6 +217,13 @@ private:
     void group_hermite(const Vec &q_a, const Vec &v_a, const Vec &q_b, const Vec &v_b, double h,
                        double h00, double h10, double h01, double h11, Vec &out) const;
     double group_magnitude(const Vec &q, Eigen::Index i) const;
+    void group_newmark_derivative(const Vec &q_n, const Vec &q_n1, const Vec &s_q,
+                                  const Vec &s_v, const Vec &s_a, const Vec &s_a1, double h,
+                                  double beta, Vec &out) const;
+    // out += T(xi) d, or with transposed: out = T(xi)^T d (out may be d)
+    void group_tangent(const Vec &q_n, const Vec &q_n1, const Vec &d, Vec &out,
+                       bool transposed) const;
+    void group_transport_transpose(const Vec &q_n, const Vec &q_n1, Vec &m) const;
     double group_distance(const Vec &q1, const Vec &q0, Eigen::Index i) const;
     const Part &part_of(Eigen::Index i) const { return parts_[part_of_[i]]; }
 

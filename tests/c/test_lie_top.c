@@ -375,6 +375,142 @@ static void test_exact_tangents(void **state)
     ga_free(s);
 }
 
+/* Sensitivities on the group: the top whose mass is parameter 0 and whose initial spin
+ * omega_2 is parameter 1 (a start parameter: dv0 = e_5, since d(omega x X)/d omega_2 = e_2 x
+ * X = 0). */
+typedef struct sens_top {
+    lie_top top;
+    double p[2]; /* mass, spin */
+} sens_top;
+
+static int st_mass(double time, const double *q, double *M, void *user)
+{
+    sens_top *u = user;
+    u->top.mass = u->p[0];
+    return lie_top_mass(time, q, M, &u->top);
+}
+static int st_force(double time, const double *q, const double *v, double *f, void *user)
+{
+    sens_top *u = user;
+    u->top.mass = u->p[0];
+    return lie_top_force(time, q, v, f, &u->top);
+}
+static int st_constraint(double time, const double *q, double *phi, void *user)
+{
+    return lie_top_constraint(time, q, phi, &((sens_top *)user)->top);
+}
+static int st_jacobian(double time, const double *q, double *J, void *user)
+{
+    return lie_top_jacobian(time, q, J, &((sens_top *)user)->top);
+}
+
+enum { SENS_STEPS = 2000 };
+
+/* G = z of the centre of mass (q[2], a vector coordinate) */
+static int com_z_cost(double time, const double *q, const double *v, const double *qdd,
+                      const double *lambda, double *value, double *d_q, double *d_v,
+                      double *d_qdd, double *d_lambda, double *d_p, void *user)
+{
+    (void)time, (void)v, (void)qdd, (void)lambda, (void)user;
+    *value = q[2];
+    for (int i = 0; i < 6; ++i)
+        d_q[i] = d_v[i] = d_qdd[i] = 0.0; /* (d_q along right increments: nv of them) */
+    d_q[2] = 1.0;
+    for (int i = 0; i < 3; ++i)
+        d_lambda[i] = 0.0;
+    d_p[0] = d_p[1] = 0.0;
+    return 0;
+}
+static const double SENS_H = 1e-3; /* to t = 2 */
+
+/* One run from (mass, spin); the centre of mass at the end, and with `sens` the forward
+ * derivatives of it (or, with `adjoint`, the adjoint gradient of its z coordinate) */
+static void sens_run(int formulation, double mass, double spin, double *com, double d[2][3],
+                     int adjoint, double *grad)
+{
+    sens_top u = {lie_top_make(0), {mass, spin}};
+    u.top.omega0[1] = spin;
+    int kinds[2], counts[2];
+    lie_top_blocks(&u.top, kinds, counts);
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create_space(2, kinds, counts, LIE_TOP_M, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, st_mass, st_force, st_constraint, st_jacobian, &u),
+                     GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    if (d || adjoint) {
+        assert_int_equal(ga_set_sensitivity(s, 2, u.p, NULL, GA_DEPENDS_FORCE | GA_DEPENDS_MASS),
+                         GA_OK);
+        const double dq0[6] = {0}, dv0[6] = {0, 0, 0, 0, 1, 0};
+        assert_int_equal(ga_set_sensitivity_start(s, 1, dq0, dv0), GA_OK);
+        if (adjoint)
+            assert_int_equal(ga_set_sensitivity_method(s, GA_SENSITIVITY_FORWARD |
+                                                              GA_SENSITIVITY_ADJOINT,
+                                                       SENS_STEPS + 10),
+                             GA_OK);
+    }
+    double q[7], v[6];
+    lie_top_initial(&u.top, q, v);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    for (int k = 0; k < SENS_STEPS; ++k)
+        assert_int_equal(ga_step(s, SENS_H), GA_OK);
+    assert_int_equal(ga_get_q(s, q), GA_OK);
+    memcpy(com, q, 3 * sizeof(double));
+    for (int j = 0; j < 2 && d; ++j) {
+        double dq[6];
+        assert_int_equal(ga_get_sensitivity(s, j, dq, NULL, NULL, NULL), GA_OK);
+        memcpy(d[j], dq, 3 * sizeof(double));
+    }
+    if (adjoint) {
+        double J;
+        assert_int_equal(ga_adjoint_gradient(s, NULL, com_z_cost, &J, grad), GA_OK);
+        assert_true(J == q[2]);
+    }
+    ga_free(s);
+}
+
+static void test_sensitivities_equal_differences_of_runs(void **state)
+{
+    (void)state;
+    for (int f = 0; f < 2; ++f) {
+        const int formulation = f ? GA_INDEX2_STABILIZED : GA_INDEX3;
+        double com[3], d[2][3];
+        sens_run(formulation, 15.0, 150.0, com, d, 0, NULL);
+        const double e[2] = {15.0 * 1e-5, 150.0 * 1e-6};
+        for (int j = 0; j < 2; ++j) {
+            double plus[3], minus[3];
+            sens_run(formulation, 15.0 + (j == 0 ? e[0] : 0.0), 150.0 + (j == 1 ? e[1] : 0.0),
+                     plus, NULL, 0, NULL);
+            sens_run(formulation, 15.0 - (j == 0 ? e[0] : 0.0), 150.0 - (j == 1 ? e[1] : 0.0),
+                     minus, NULL, 0, NULL);
+            double worst = 0.0, size = 0.0;
+            for (int i = 0; i < 3; ++i) {
+                const double cd = (plus[i] - minus[i]) / (2.0 * e[j]);
+                worst = fmax(worst, fabs(cd - d[j][i]));
+                size = fmax(size, fabs(d[j][i]));
+            }
+            print_message("  formulation %d, parameter %d: |dcom/dp| %.4e, against central "
+                          "differences %.2e relative\n",
+                          formulation, j, size, worst / size);
+            assert_true(worst <= 1e-7 * size);
+        }
+    }
+}
+
+static void test_adjoint_equals_forward(void **state)
+{
+    (void)state;
+    for (int f = 0; f < 2; ++f) {
+        const int formulation = f ? GA_INDEX2_STABILIZED : GA_INDEX3;
+        double com[3], d[2][3], grad[2];
+        sens_run(formulation, 15.0, 150.0, com, d, 1, grad);
+        for (int j = 0; j < 2; ++j) {
+            print_message("  formulation %d, parameter %d: adjoint %.12e, forward %.12e\n",
+                          formulation, j, grad[j], d[j][2]);
+            assert_true(fabs(grad[j] - d[j][2]) <= 1e-9 * fabs(d[j][2]));
+        }
+    }
+}
+
 /* ---- the space's failure paths ---- */
 
 static void test_create_space_refuses_bad_blocks(void **state)
@@ -489,9 +625,6 @@ static void test_what_rotations_do_not_offer_is_refused(void **state)
     assert_non_null(strstr(ga_last_error(s), "sparse linear solver"));
     assert_int_equal(ga_set_first_order(s, 1, NULL, no_rate), GA_ERR_ARG);
     assert_non_null(strstr(ga_last_error(s), "first-order states"));
-    double p[1] = {15.0};
-    assert_int_equal(ga_set_sensitivity(s, 1, p, NULL, GA_DEPENDS_FORCE), GA_ERR_ARG);
-    assert_non_null(strstr(ga_last_error(s), "sensitivity"));
     /* refused, nothing changed: the run is the one without the calls */
     double q[7], v[6], qa[7], qb[7];
     lie_top_initial(&t, q, v);
@@ -521,6 +654,8 @@ int main(void)
         cmocka_unit_test(test_checkpoint_bit_for_bit),
         cmocka_unit_test(test_event_on_the_axis),
         cmocka_unit_test(test_exact_tangents),
+        cmocka_unit_test(test_sensitivities_equal_differences_of_runs),
+        cmocka_unit_test(test_adjoint_equals_forward),
         cmocka_unit_test(test_create_space_refuses_bad_blocks),
         cmocka_unit_test(test_vector_blocks_are_ga_create),
         cmocka_unit_test(test_init_refuses_what_is_not_a_rotation),

@@ -288,8 +288,9 @@ class Solver:
         move on the group with body-frame angular velocities: q has nq numbers (4 or 9 per
         rotation), v and everything shaped like it n (3 per rotation), and n must be that
         number. Phi_q and K_t are derivatives along right increments (galpha.so3 builds
-        them). Index 3 and 2, fixed and adaptive steps, dense output, events; the sparse
-        path, first-order states and sensitivities are refused with rotations.
+        them). Index 3 and 2, fixed and adaptive steps, dense output, events, checkpoints,
+        forward and adjoint sensitivities; the sparse path and first-order states are
+        refused with rotations.
     user : None, int, numpy array or ctypes object
         The `user` pointer compiled callbacks receive (void *user: an address, a numpy
         array's data, a ctypes object's address); NULL by default. Python callbacks ignore it.
