@@ -513,6 +513,142 @@ static void test_adjoint_equals_forward(void **state)
 
 /* ---- the space's failure paths ---- */
 
+/* A failure at every callback call of a step on the group, one call at a time (returning > 0,
+ * < 0, or a NaN), in index 3 and 2 with differences or exact tangents: the step returns the
+ * status of that kind with a message, the solver's checkpoint is the one before, byte for
+ * byte, and it steps on to what a solver restored from that checkpoint steps to. */
+typedef struct faulty_top {
+    lie_top top;
+    long calls, fail_at; /* fail_at = 0: none */
+    int kind;            /* 0: return 1, 1: return -1, 2: NaN */
+} faulty_top;
+
+static int faulted(faulty_top *f, double *out)
+{
+    if (f->fail_at == 0 || ++f->calls != f->fail_at)
+        return 0;
+    if (f->kind == 2) {
+        out[0] = NAN;
+        return 0;
+    }
+    return f->kind == 0 ? 1 : -1;
+}
+static int ft_mass(double t, const double *q, double *M, void *u)
+{
+    faulty_top *f = u;
+    lie_top_mass(t, q, M, &f->top);
+    return faulted(f, M);
+}
+static int ft_force(double t, const double *q, const double *v, double *out, void *u)
+{
+    faulty_top *f = u;
+    lie_top_force(t, q, v, out, &f->top);
+    return faulted(f, out);
+}
+static int ft_constraint(double t, const double *q, double *phi, void *u)
+{
+    faulty_top *f = u;
+    lie_top_constraint(t, q, phi, &f->top);
+    return faulted(f, phi);
+}
+static int ft_jacobian(double t, const double *q, double *J, void *u)
+{
+    faulty_top *f = u;
+    lie_top_jacobian(t, q, J, &f->top);
+    return faulted(f, J);
+}
+static int ft_stiffness(double t, const double *q, const double *v, const double *qdd,
+                        const double *lambda, double *K, void *u)
+{
+    faulty_top *f = u;
+    lie_top_stiffness(t, q, v, qdd, lambda, K, &f->top);
+    return faulted(f, K);
+}
+static int ft_damping(double t, const double *q, const double *v, double *C, void *u)
+{
+    faulty_top *f = u;
+    lie_top_damping(t, q, v, C, &f->top);
+    return faulted(f, C);
+}
+
+static ga_solver *faulty_solver(faulty_top *f, int formulation, int exact)
+{
+    int kinds[2], counts[2];
+    lie_top_blocks(&f->top, kinds, counts);
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create_space(2, kinds, counts, LIE_TOP_M, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, ft_mass, ft_force, ft_constraint, ft_jacobian, f), GA_OK);
+    if (exact)
+        assert_int_equal(ga_set_tangents(s, ft_stiffness, ft_damping), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    return s;
+}
+
+static void test_fault_at_every_callback_call(void **state)
+{
+    (void)state;
+    static const ga_status expected[3] = {GA_ERR_CALLBACK_RETRY, GA_ERR_CALLBACK, GA_ERR_NONFINITE};
+    for (int config = 0; config < 4; ++config) {
+        const int formulation = config % 2 ? GA_INDEX2_STABILIZED : GA_INDEX3, exact = config / 2;
+        faulty_top f = {lie_top_make(0), 0, 0, 0};
+        ga_solver *s = faulty_solver(&f, formulation, exact);
+        double q[7], v[6];
+        lie_top_initial(&f.top, q, v);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        for (int k = 0; k < 5; ++k)
+            assert_int_equal(ga_step(s, 1e-3), GA_OK);
+        size_t len = 0;
+        assert_int_equal(ga_state_size(s, &len), GA_OK);
+        double *before = test_malloc(len * sizeof(double)), *after = test_malloc(len * sizeof(double));
+        long reached = 0;
+        double worst = 0.0;
+        for (int kind = 0; kind < 3; ++kind)
+            for (long k = 1;; ++k) {
+                assert_int_equal(ga_get_state(s, before, len), GA_OK);
+                f.calls = 0;
+                f.fail_at = k;
+                f.kind = kind;
+                const ga_status st = ga_step(s, 1e-3);
+                f.fail_at = 0;
+                if (f.calls < k) { /* the step made fewer calls: the sweep is through */
+                    assert_int_equal(st, GA_OK);
+                    reached = k > reached ? k : reached;
+                    assert_int_equal(ga_set_state(s, before, len), GA_OK);
+                    break;
+                }
+                assert_int_equal(st, expected[kind]);
+                assert_true(strlen(ga_last_error(s)) > 0);
+                /* the state as it was: t and the step-size entries, q, v, qdd, lambda, a,
+                 * a_prev, c, c_prev (not the kept matrix, which a failure drops) */
+                assert_int_equal(ga_get_state(s, after, len), GA_OK);
+                assert_memory_equal(before + 4, after + 4, 6 * sizeof(double));
+                assert_memory_equal(before + CKPT_HEADER, after + CKPT_HEADER,
+                                    (7 + 6 * 6 + 3) * sizeof(double));
+                /* it steps on as a solver restored from the checkpoint does */
+                faulty_top g = {lie_top_make(0), 0, 0, 0};
+                ga_solver *r = faulty_solver(&g, formulation, exact);
+                assert_int_equal(ga_set_state(r, before, len), GA_OK);
+                double qa[7], qb[7];
+                assert_int_equal(ga_step(s, 1e-3), GA_OK);
+                assert_int_equal(ga_step(r, 1e-3), GA_OK);
+                assert_int_equal(ga_get_q(s, qa), GA_OK);
+                assert_int_equal(ga_get_q(r, qb), GA_OK);
+                /* (the restored one starts from the kept matrix, this one without) */
+                worst = fmax(worst, max_abs_diff(qa, qb, 7));
+                assert_true(max_abs_diff(qa, qb, 7) < 1e-14);
+                ga_free(r);
+                assert_int_equal(ga_set_state(s, before, len), GA_OK);
+            }
+        print_message("  configuration %d: failures at each of %ld callback calls of a step; "
+                      "next step %.1e from the restored solver's\n",
+                      config, reached - 1, worst);
+        assert_true(reached > 3);
+        test_free(before);
+        test_free(after);
+        ga_free(s);
+    }
+}
+
 static void test_create_space_refuses_bad_blocks(void **state)
 {
     (void)state;
@@ -656,6 +792,7 @@ int main(void)
         cmocka_unit_test(test_exact_tangents),
         cmocka_unit_test(test_sensitivities_equal_differences_of_runs),
         cmocka_unit_test(test_adjoint_equals_forward),
+        cmocka_unit_test(test_fault_at_every_callback_call),
         cmocka_unit_test(test_create_space_refuses_bad_blocks),
         cmocka_unit_test(test_vector_blocks_are_ga_create),
         cmocka_unit_test(test_init_refuses_what_is_not_a_rotation),
