@@ -41,10 +41,7 @@ Quat from_matrix(const Mat3 &R)
 }
 
 // The stored matrix (column-major) as row-major, and back
-Mat3 load_matrix(const double *p)
-{
-    return {p[0], p[3], p[6], p[1], p[4], p[7], p[2], p[5], p[8]};
-}
+Mat3 load_matrix(const double *p) { return {p[0], p[3], p[6], p[1], p[4], p[7], p[2], p[5], p[8]}; }
 void store_matrix(const Mat3 &R, double *p)
 {
     for (int i = 0; i < 3; ++i)
@@ -77,8 +74,8 @@ void compose_exp(ConfigurationSpace::Kind kind, const double *q, const Vec3 &psi
 Vec3 relative_log(ConfigurationSpace::Kind kind, const double *q0, const double *q1)
 {
     if (kind == ConfigurationSpace::Kind::Quaternion)
-        return so3::log(so3::compose(so3::inverse({q0[0], q0[1], q0[2], q0[3]}),
-                                     {q1[0], q1[1], q1[2], q1[3]}));
+        return so3::log(
+            so3::compose(so3::inverse({q0[0], q0[1], q0[2], q0[3]}), {q1[0], q1[1], q1[2], q1[3]}));
     return so3::log(from_matrix(multiply(transpose(load_matrix(q0)), load_matrix(q1))));
 }
 
@@ -160,15 +157,14 @@ void ConfigurationSpace::group_restore(Vec &q_pert, const Vec &q, Eigen::Index j
 }
 
 void ConfigurationSpace::group_hermite(const Vec &q_a, const Vec &v_a, const Vec &q_b,
-                                       const Vec &v_b, double h, double h00, double h10,
-                                       double h01, double h11, Vec &out) const
+                                       const Vec &v_b, double h, double h00, double h10, double h01,
+                                       double h11, Vec &out) const
 {
     for (const Part &p : parts_) {
         if (p.kind == Kind::Vector) {
-            out.segment(p.q0, p.nv) = h00 * q_a.segment(p.q0, p.nv) +
-                                      (h10 * h) * v_a.segment(p.v0, p.nv) +
-                                      h01 * q_b.segment(p.q0, p.nv) +
-                                      (h11 * h) * v_b.segment(p.v0, p.nv);
+            out.segment(p.q0, p.nv) =
+                h00 * q_a.segment(p.q0, p.nv) + (h10 * h) * v_a.segment(p.v0, p.nv) +
+                h01 * q_b.segment(p.q0, p.nv) + (h11 * h) * v_b.segment(p.v0, p.nv);
             continue;
         }
         const Vec3 xi = relative_log(p.kind, q_a.data() + p.q0, q_b.data() + p.q0);
@@ -194,24 +190,23 @@ double ConfigurationSpace::group_distance(const Vec &q1, const Vec &q0, Eigen::I
     const Part &p = part_of(i);
     if (p.kind == Kind::Vector)
         return std::fabs(q1[p.q0 + i - p.v0] - q0[p.q0 + i - p.v0]);
-    return std::fabs(relative_log(p.kind, q0.data() + p.q0, q1.data() + p.q0)
-                         [static_cast<std::size_t>(i - p.v0)]);
+    return std::fabs(relative_log(p.kind, q0.data() + p.q0,
+                                  q1.data() + p.q0)[static_cast<std::size_t>(i - p.v0)]);
 }
 
 // A tangent vector s at q_n (q_n o exp(e s)) seen at q_n1 = q_n o exp(xi): q_n o exp(e s) o
 // exp(xi) = q_n1 o exp(e Ad_{exp(-xi)} s), Ad_{exp(-xi)} = R(exp(xi))^T on SO(3); an increment
 // d of xi moves q_n1 by T(xi) d (sec. 14, 16).
-void ConfigurationSpace::group_newmark_derivative(const Vec &q_n, const Vec &q_n1,
-                                                  const Vec &s_q, const Vec &s_v,
-                                                  const Vec &s_a, const Vec &s_a1, double h,
-                                                  double beta, Vec &out) const
+void ConfigurationSpace::group_newmark_derivative(const Vec &q_n, const Vec &q_n1, const Vec &s_q,
+                                                  const Vec &s_v, const Vec &s_a, const Vec &s_a1,
+                                                  double h, double beta, Vec &out) const
 {
     for (const Part &p : parts_) {
         const Eigen::Index v0 = p.v0, nv = p.nv;
         if (p.kind == Kind::Vector) {
-            out.segment(v0, nv) = s_q.segment(v0, nv) + h * s_v.segment(v0, nv) +
-                                  (h * h) * ((0.5 - beta) * s_a.segment(v0, nv) +
-                                             beta * s_a1.segment(v0, nv));
+            out.segment(v0, nv) =
+                s_q.segment(v0, nv) + h * s_v.segment(v0, nv) +
+                (h * h) * ((0.5 - beta) * s_a.segment(v0, nv) + beta * s_a1.segment(v0, nv));
             continue;
         }
         const Vec3 xi = relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0);
@@ -239,8 +234,7 @@ void ConfigurationSpace::group_tangent(const Vec &q_n, const Vec &q_n1, const Ve
                 out.segment(p.v0, p.nv) = d.segment(p.v0, p.nv);
             continue;
         }
-        const Mat3 T =
-            so3::tangent(relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0));
+        const Mat3 T = so3::tangent(relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0));
         const double x[3] = {d[p.v0], d[p.v0 + 1], d[p.v0 + 2]};
         for (int i = 0; i < 3; ++i) {
             double r = 0.0;
@@ -254,15 +248,14 @@ void ConfigurationSpace::group_tangent(const Vec &q_n, const Vec &q_n1, const Ve
     }
 }
 
-void ConfigurationSpace::group_transport_transpose(const Vec &q_n, const Vec &q_n1,
-                                                   Vec &m) const
+void ConfigurationSpace::group_transport_transpose(const Vec &q_n, const Vec &q_n1, Vec &m) const
 {
     for (const Part &p : parts_) {
         if (p.kind == Kind::Vector)
             continue;
         // (Ad_{exp(-xi)})^T = R(exp(xi))
-        const Mat3 E = so3::matrix(
-            so3::exp(relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0)));
+        const Mat3 E =
+            so3::matrix(so3::exp(relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0)));
         const double x[3] = {m[p.v0], m[p.v0 + 1], m[p.v0 + 2]};
         for (int i = 0; i < 3; ++i)
             m[p.v0 + i] = E[3 * i] * x[0] + E[3 * i + 1] * x[1] + E[3 * i + 2] * x[2];
