@@ -351,15 +351,23 @@ ga_status Adjoint::step_back(long k, Work &w)
     // dq = w - B^T e, dw = w in index 2 (first_order.cpp eliminates it; here it is assembled).
     const FirstOrderParams &p1 = k_.params1;
     const double c1 = R > 0 ? first_order_newton_coefficient(p1, h) : 0.0;
+    // On a group q_{n+1} moves by T(xi) times the increment (sec. 16): K_t, the constraint
+    // rows, Z and g_q take it as a right factor, Phi_q^T does not.
+    const bool group = !space.euclidean();
+    if (group)
+        space.increment_between(q_n, x.q, w.xi);
     Mat Fy, Gw, Ge, Gy;
     if (R > 0) {
         const CouplingBlocks &b = k_.coupling();
+        Mat gq = b.g_q;
+        if (group)
+            space.right_multiply_tangent(w.xi, gq.data(), R, R);
         Fy = -bh2 * b.f_y;
-        Gw = -(b.g_q + c.gamma_prime * b.g_v);
+        Gw = -(gq + c.gamma_prime * b.g_v);
         Gy = c1 * Mat::Identity(R, R) - b.g_y;
         if (index2 && m > 0) {
             dense_of(k_.B_matrix(), w.Bd);
-            Ge = b.g_q * w.Bd.transpose();
+            Ge = gq * w.Bd.transpose();
         }
     }
     const auto add_dense = [&](const Mat &X, int row0, int col0) {
@@ -425,11 +433,6 @@ ga_status Adjoint::step_back(long k, Work &w)
         dense_of(k_.mass_matrix(), w.Md);
         dense_of(k_.jacobian_matrix(), w.Jd);
         D.topLeftCorner(n, n) = (bh2 * c.beta_prime) * w.Md;
-        // On a group q_{n+1} moves by T(xi) times the increment (sec. 16): K_t, the
-        // constraint rows and Z take it as a right factor, Phi_q^T does not (w.JTd: Phi_q T).
-        const bool group = !space.euclidean();
-        if (group)
-            space.increment_between(q_n, x.q, w.xi);
         if (K) {
             dense_of(k_.stiffness_matrix(), w.Kd);
             if (group)

@@ -832,8 +832,6 @@ GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga
             return c.diag.fail(GA_ERR_ARG, "r = %d first-order states: must be >= 0", r);
         if (r > 0 && !rate)
             return c.diag.fail(GA_ERR_ARG, "r = %d > 0: the rate callback is required", r);
-        if (r > 0 && !c.model.space.euclidean())
-            return refuse_on_rotations(c, "first-order states");
         if (c.kernel().setup_done())
             return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after the solver was set up "
                                "(ga_init or ga_set_state): declare the states before");
@@ -872,6 +870,8 @@ GA_API ga_status ga_set_coupling_pattern(ga_solver *s, int which, int nnz, const
             return c.diag.fail(GA_ERR_STATE, "coupling patterns are declared before ga_init_y");
         if (nnz < 0 || (nnz > 0 && (!rows || !cols)))
             return c.diag.fail(GA_ERR_ARG, "pattern with nnz = %d needs rows and cols", nnz);
+        if (which == GA_COUPLING_G_Q && !c.model.space.euclidean())
+            return refuse_on_rotations(c, "a pattern of g_q");
         const int r = c.kernel().r(), nv = c.kernel().nv();
         for (int k = 0; k < nnz; ++k)
             if (rows[k] < 0 || rows[k] >= r || cols[k] < 0 || cols[k] >= nv)

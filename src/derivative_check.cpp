@@ -255,13 +255,21 @@ ga_status check_derivatives(Stepper &kernel, const Sensitivities &sens, double t
             for (int j = 0; j < G.cols() && !st; ++j) {
                 Vec qq = q, vv = v, yy = y;
                 Vec &x = block == 0 ? qq : block == 1 ? vv : yy;
-                const double e = step_for(x[j]);
-                x[j] += e;
+                // (q through the space: along a right increment on a rotation)
+                const double e =
+                    step_for(block == 0 ? kernel.model.space.magnitude(q, j) : x[j]);
+                if (block == 0)
+                    kernel.model.space.shift_coordinate(qq, q, j, e);
+                else
+                    x[j] += e;
                 kernel.model.y_now = &yy;
                 st = kernel.model.rate(t, qq, vv, yy, g1);
                 if (!st && block == 2)
                     st = kernel.model.force(t, qq, vv, f);
-                x[j] -= 2.0 * e;
+                if (block == 0)
+                    kernel.model.space.shift_coordinate(qq, q, j, -e);
+                else
+                    x[j] -= 2.0 * e;
                 if (!st)
                     st = kernel.model.rate(t, qq, vv, yy, g2);
                 if (!st && block == 2)

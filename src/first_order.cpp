@@ -116,16 +116,24 @@ ga_status Stepper::first_order_matrix(double t, const State &x, bool central)
 {
     if (auto st = model.coupling(t, x.q, x.v, x.y, f_, rate_, blocks_, central))
         return st;
+    if (!model.space.euclidean()) {
+        // Newton's dq moves q by T(xi) dq (sec. 16): g_q T for the matrix and G x; at the
+        // accepted state xi = 0
+        g_q_step_ = blocks_.g_q;
+        if (&x == &trial_)
+            model.space.right_multiply_tangent(xi_, g_q_step_.data(), r(), r());
+    }
     schur_valid_ = false;
     return GA_OK;
 }
 
-// G x = g_q x_q + gamma' g_v x_w into out (r).
+// G x = g_q x_q + gamma' g_v x_w into out (r), with g_q (T on a group) as the step sees it.
 namespace {
-void apply_G(const CouplingBlocks &B, double gamma_prime, const Vec &xq, const Vec &xw, Vec &out)
+void apply_G(const Mat &g_q, const Mat &g_v, double gamma_prime, const Vec &xq, const Vec &xw,
+             Vec &out)
 {
-    out.noalias() = B.g_q * xq;
-    out.noalias() += gamma_prime * (B.g_v * xw);
+    out.noalias() = g_q * xq;
+    out.noalias() += gamma_prime * (g_v * xw);
 }
 }  // namespace
 
@@ -151,7 +159,7 @@ ga_status Stepper::first_order_schur(double h, const NewtonCoefficients &c)
         Zl_.col(k) = z_l_;
         if (index2)
             Ze_.col(k) = z_e_;
-        apply_G(blocks_, c.gamma_prime, z_d_, index2 ? z_w_ : z_d_, z_y_);
+        apply_G(coupling_q_step(), blocks_.g_v, c.gamma_prime, z_d_, index2 ? z_w_ : z_d_, z_y_);
         C1_.col(k) += z_y_;
     }
     C1_lu_.compute(C1_);
@@ -163,7 +171,7 @@ ga_status Stepper::first_order_schur(double h, const NewtonCoefficients &c)
                          "the first-order block c1 I - g_y + G Z (c1 = %g) is singular (pivot "
                          "ratio %.3g) in the step from t = %.17g with h = %g",
                          c1, spread, accepted_.t, h);
-    Cg_ = C1_lu_.solve(blocks_.g_q);  // into storage of its own: no temporary
+    Cg_ = C1_lu_.solve(coupling_q_step());  // into storage of its own: no temporary
     Cg_q_norm_ = Cg_.cwiseAbs().rowwise().sum().maxCoeff();
     Cg_ = C1_lu_.solve(blocks_.g_v);
     Cg_v_norm_ = Cg_.cwiseAbs().rowwise().sum().maxCoeff();
@@ -179,7 +187,7 @@ void Stepper::first_order_correction(const NewtonCoefficients &c, Vec &dw)
     const bool index2 = formulation == GA_INDEX2_STABILIZED;
     z_y_ = -ry_;
     if (coupling_exact) {
-        apply_G(blocks_, c.gamma_prime, dq_, dw, gx_);
+        apply_G(coupling_q_step(), blocks_.g_v, c.gamma_prime, dq_, dw, gx_);
         z_y_ += gx_;
     }
     dy_ = C1_lu_.solve(z_y_);

@@ -659,7 +659,7 @@ ga_status ForwardSensitivity::step(double h)
         k_.solve_step_matrix(z.rq, z.rl, z.rv, h, z.d, z.w, z.dl, z.e);
         if (k_.r() > 0) {  // elimination onto y (first_order.cpp): dy, then x0 - Z dy
             z.gy = -z.ry;
-            z.gy.noalias() += b.g_q * z.d;
+            z.gy.noalias() += k_.coupling_q_step() * z.d;
             z.gy.noalias() += c.gamma_prime * (b.g_v * (index2 ? z.w : z.d));
             k_.eliminate_first_order(z.gy, z.dy, z.d, z.dl, z.w);
             s1.y += z.dy;

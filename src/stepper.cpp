@@ -270,6 +270,8 @@ ga_status Stepper::setup_workspace()
     if (r() > 0) {
         const int r1 = r();
         blocks_.allocate(nv_, r1);
+        if (!model.space.euclidean())
+            g_q_step_.setZero(r1, nv_);
         for (Mat *Z : {&Zq_, &Zw_})
             Z->setZero(nv_, r1);
         for (Mat *Z : {&Zl_, &Ze_})

@@ -302,6 +302,11 @@ public:
     const ModelMatrix &B_matrix() const { return B_; }
     const ModelMatrix &Z_matrix() const { return Z_; }
     const CouplingBlocks &coupling() const { return blocks_; }
+    // g_q as Newton's increments see it: g_q T(xi) on a group space, g_q on R^n
+    const Mat &coupling_q_step() const
+    {
+        return model.space.euclidean() ? blocks_.g_q : g_q_step_;
+    }
     bool sparse() const { return sparse_backend_; }
     // Solves with the factorized step matrix, scaled as Newton's (index 3: rv, w and e unused),
     // and the first-order states' elimination after it: dy from gy, then d, dl (and w) less
@@ -470,6 +475,7 @@ private:
     // Phi_q T(xi), Z T(xi) for the iteration matrix (empty on R^n)
     Vec xi_;
     ModelMatrix KT_, JT_, ZT_;
+    Mat g_q_step_;  // g_q T(xi) of the first-order states (first_order_matrix)
     ModelMatrix Z_;                  // index-2: d(Phi_q v + Phi_t)/dq, layout of J_
     Vec f_, phi_, phi_v_, rq_, dq_, dw_, dlambda_, deta_, c_, qdd_tmp_, lambda_tmp_;
     Vec guard_q_, guard_v_;  // index-3 error estimate: the estimate from a (error_estimate.cpp)

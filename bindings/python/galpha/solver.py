@@ -289,8 +289,8 @@ class Solver:
         rotation), v and everything shaped like it n (3 per rotation), and n must be that
         number. Phi_q and K_t are derivatives along right increments (galpha.so3 builds
         them). Index 3 and 2, fixed and adaptive steps, dense output, events, checkpoints,
-        forward and adjoint sensitivities; the sparse path and first-order states are
-        refused with rotations.
+        first-order states, forward and adjoint sensitivities; the sparse path is refused
+        with rotations.
     user : None, int, numpy array or ctypes object
         The `user` pointer compiled callbacks receive (void *user: an address, a numpy
         array's data, a ctypes object's address); NULL by default. Python callbacks ignore it.
