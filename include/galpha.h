@@ -198,17 +198,19 @@ typedef enum {
  *  Storage and algebra: q (ga_init's q0, ga_get_q, ga_interpolate, every callback's q) holds
  *  nq numbers, the blocks' storage in order; v, qdd, a, f and everything shaped like them hold
  *  nv, 3 per rotation (the body-frame angular velocity and its rate). So do the rows of M, C_t
- *  and K_t and the columns of Phi_q: K_t and Phi_q are derivatives along right increments,
- *  d/de of f(q o exp(e w)) and Phi(q o exp(e w)) at e = 0 (on a vector block the ordinary
- *  ones); build them with the maps below. ga_get_size's n is nv; ga_get_space_size gives both.
+ *  and K_t and the columns of Phi_q: Phi_q and K_t are derivatives along right increments,
+ *  Phi_q w = d/de Phi(q o exp(e w)) at e = 0 and K_t likewise of M qdd - f + Phi_q^T lambda
+ *  (on a vector block the ordinary ones); build them with the maps below. ga_get_size's n is
+ *  nv; ga_get_space_size gives both.
  *
  *  A space of vector blocks only is R^n and the solver is exactly that of ga_create(n, m).
  *  With rotations, in this version: index 3 and the stabilized index 2, fixed and adaptive
  *  steps, dense output and events, checkpoints, forward and adjoint sensitivities (a
  *  sensitivity's dq is a tangent along right increments, nv numbers), on the dense linear
  *  solver, with first-order states (their g_q along right increments too); ga_set_pattern,
- *  a coupling pattern of g_q and the sparse solver return GA_ERR_ARG, saying so. q0 of ga_init (and q in ga_set_state) must hold rotations (a quaternion's norm, a
- *  matrix's orthonormality within 1e-6, det > 0), else GA_ERR_ARG names the block.
+ *  a coupling pattern of g_q and the sparse solver return GA_ERR_ARG, saying so. q0 of
+ *  ga_init (and q in ga_set_state) must hold rotations (a quaternion's norm, a matrix's
+ *  orthonormality within 1e-6, det > 0), else GA_ERR_ARG names the block.
  *  Errors: GA_ERR_ARG (out, kinds or counts NULL with count > 0, count < 1, an unknown kind, a
  *  count < 1, nq or nv above INT_MAX, m < 0 or m > nv), GA_ERR_NOMEM. */
 GA_API ga_status ga_create_space(int count, const int *kinds, const int *counts, int m,

@@ -751,7 +751,8 @@ static void test_fault_at_every_callback_call(void **state)
             assert_int_equal(ga_step(s, 1e-3), GA_OK);
         size_t len = 0;
         assert_int_equal(ga_state_size(s, &len), GA_OK);
-        double *before = test_malloc(len * sizeof(double)), *after = test_malloc(len * sizeof(double));
+        double *before = test_malloc(len * sizeof(double));
+        double *after = test_malloc(len * sizeof(double));
         long reached = 0;
         double worst = 0.0;
         for (int kind = 0; kind < 3; ++kind)
