@@ -23,6 +23,16 @@ void lie_top_blocks(const lie_top *t, int *kinds, int *counts)
     counts[1] = 1;
 }
 
+/* R(r) of a unit quaternion r = (w, x, y, z), row-major */
+static void quaternion_matrix(const double *r, double R[9])
+{
+    const double w = r[0], x = r[1], y = r[2], z = r[3];
+    const double M[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                         2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                         2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
+    memcpy(R, M, sizeof M);
+}
+
 void lie_top_rotation(const lie_top *t, const double *q, double R[9])
 {
     const double *r = q + 3;
@@ -32,11 +42,7 @@ void lie_top_rotation(const lie_top *t, const double *q, double R[9])
                 R[3 * i + j] = r[i + 3 * j];
         return;
     }
-    const double w = r[0], x = r[1], y = r[2], z = r[3];
-    const double M[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-                         2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                         2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
-    memcpy(R, M, sizeof M);
+    quaternion_matrix(r, R);
 }
 
 static void cross(const double *a, const double *b, double *c)
@@ -200,12 +206,7 @@ int lie_top_pivot_force(double time, const double *q, const double *v, double *f
     (void)time;
     const lie_top *t = user;
     double R[9], mg[3], gb[3], n[3], Jw[3], wJw[3];
-    const double r[4] = {q[0], q[1], q[2], q[3]};
-    double qq[7] = {0, 0, 0, r[0], r[1], r[2], r[3]};
-    const lie_top quaternion = {0, t->mass, {t->Jc[0], t->Jc[1], t->Jc[2]},
-                                {t->X[0], t->X[1], t->X[2]}, {t->g[0], t->g[1], t->g[2]},
-                                {0, 0, 0}};
-    lie_top_rotation(&quaternion, qq, R);
+    quaternion_matrix(q, R);
     for (int i = 0; i < 3; ++i)
         mg[i] = t->mass * t->g[i];
     rotate_back(R, mg, gb);

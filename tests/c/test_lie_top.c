@@ -605,14 +605,11 @@ static void motor_run(motor_top *u, int formulation, double h, double t_end, dou
     lie_top_blocks(&u->top, kinds, counts);
     ga_solver *s = NULL;
     assert_int_equal(ga_create_space(2, kinds, counts, LIE_TOP_M, &s), GA_OK);
-    assert_int_equal(ga_set_callbacks(s, lie_top_mass, NULL, lie_top_constraint, lie_top_jacobian,
-                                      &u->top),
-                     GA_OK);
     assert_int_equal(ga_set_first_order(s, 1, mt_force_y, mt_rate), GA_OK);
     assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
     double q[7], v[6], y0[1] = {0.0};
     lie_top_initial(&u->top, q, v);
-    /* the callbacks' user is the top for M, Phi; the motor for force_y and rate */
+    /* one user for all: the motor, whose first member is the top that M and Phi read */
     assert_int_equal(ga_set_callbacks(s, lie_top_mass, NULL, lie_top_constraint, lie_top_jacobian,
                                       u),
                      GA_OK);
