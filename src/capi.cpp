@@ -517,8 +517,6 @@ ga_status refuse_on_rotations(ga::Solver &c, const char *what)
 // The checks and the declaration shared by both forms of ga_set_pattern.
 ga_status declare_pattern(ga::Solver &c, int which, int nnz, const int *rows, const int *cols)
 {
-    if (!c.model.space.euclidean())
-        return refuse_on_rotations(c, "a sparsity pattern (the sparse path)");
     if (which < GA_MATRIX_MASS || which > GA_MATRIX_DAMPING)
         return c.diag.fail(GA_ERR_ARG, "unknown matrix %d", which);
     if (c.kernel().setup_done())
@@ -572,8 +570,6 @@ GA_API ga_status ga_set_linear_solver(ga_solver *s, int solver)
     return guarded(s, [&](ga::Solver &c) {
         if (solver < GA_LINEAR_AUTO || solver > GA_LINEAR_DENSE_UNBLOCKED)
             return c.diag.fail(GA_ERR_ARG, "unknown linear solver %d", solver);
-        if (solver == GA_LINEAR_SPARSE && !c.model.space.euclidean())
-            return refuse_on_rotations(c, "the sparse linear solver");
         if (c.kernel().setup_done())
             return c.diag.fail(GA_ERR_STATE, "the linear solver is chosen before ga_init");
         c.kernel().linear_solver = static_cast<ga_linear_solver>(solver);
@@ -620,6 +616,9 @@ GA_API ga_status ga_set_formulation(ga_solver *s, int formulation)
     return guarded(s, [&](ga::Solver &c) {
         if (formulation != GA_INDEX3 && formulation != GA_INDEX2_STABILIZED)
             return c.diag.fail(GA_ERR_ARG, "unknown formulation %d", formulation);
+        if (formulation == GA_INDEX2_STABILIZED && c.kernel().sparse() &&
+            !c.model.space.euclidean())
+            return c.diag.fail(GA_ERR_ARG, "%s", ga::kGroupIndex2Sparse);
         if (formulation == GA_INDEX2_STABILIZED && c.kernel().setup_done())
             c.kernel().setup_index2();  // may throw std::bad_alloc: the formulation stays as it was
         c.kernel().formulation = static_cast<ga_formulation>(formulation);

@@ -87,8 +87,10 @@ ConfigurationSpace::ConfigurationSpace(const std::vector<Block> &blocks) : nq_(0
         parts_.push_back({b.kind, nq_, nv_, b.nv});
         nq_ += stored(b);
         nv_ += b.nv;
-        if (b.kind != Kind::Vector)
+        if (b.kind != Kind::Vector) {
+            rotation_part_.push_back(static_cast<int>(parts_.size()) - 1);
             ++rotations_;
+        }
     }
     if (rotations_ == 0) {  // R^n: the Euclidean bodies, bit for bit those of ga_create
         parts_.clear();
@@ -300,6 +302,26 @@ void ConfigurationSpace::right_multiply_tangent(const Vec &xi, double *A, Eigen:
             c1[r] = a0 * T[1] + a1 * T[4] + a2 * T[7];
             c2[r] = a0 * T[2] + a1 * T[5] + a2 * T[8];
         }
+    }
+}
+
+int ConfigurationSpace::rotation_of(Eigen::Index j, int *local) const
+{
+    if (euclidean())
+        return -1;
+    const int p = part_of_[static_cast<std::size_t>(j)];
+    if (parts_[p].kind == Kind::Vector)
+        return -1;
+    *local = static_cast<int>(j - parts_[p].v0);
+    return static_cast<int>(std::lower_bound(rotation_part_.begin(), rotation_part_.end(), p) -
+                            rotation_part_.begin());
+}
+
+void ConfigurationSpace::rotation_tangents(const Vec &xi, double *T) const
+{
+    for (std::size_t r = 0; r < rotation_part_.size(); ++r) {
+        const Mat3 t = so3::tangent(vec3(xi.data() + parts_[rotation_part_[r]].v0));
+        std::copy(t.begin(), t.end(), T + 9 * r);
     }
 }
 

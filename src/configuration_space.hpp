@@ -69,6 +69,13 @@ public:
     // dimension ld): the q-columns of K_t and Phi_q in the iteration matrix (sec. 14)
     void right_multiply_tangent(const Vec &xi, double *A, Eigen::Index rows,
                                 Eigen::Index ld) const;
+    // The rotation (0, 1, ... in order) that v coordinate j belongs to, and j's place in it
+    // (0..2) in *local; -1 for a vector coordinate. (The sparse path's expanded patterns.)
+    int rotation_of(Eigen::Index j, int *local) const;
+    // The first v coordinate of rotation r
+    Eigen::Index rotation_start(int r) const { return parts_[rotation_part_[r]].v0; }
+    // T(xi) of every rotation in order, 9 numbers each, row-major, into T
+    void rotation_tangents(const Vec &xi, double *T) const;
     // Z <- Z + J ad(., v) on the rotations' columns (J, Z: rows x nv, column-major, ld =
     // rows): Z w += J [w, v] with [w, v] = w x v on each rotation
     void add_bracket(const Vec &v, const double *J, Eigen::Index rows, double *Z) const;
@@ -231,6 +238,7 @@ private:
     Eigen::Index rotations_ = 0;
     std::vector<Part> parts_;     // empty: R^n
     std::vector<int> part_of_;    // v coordinate -> its part (group spaces only)
+    std::vector<int> rotation_part_;  // rotation r -> its part
 };
 
 }  // namespace ga

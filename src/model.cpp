@@ -35,7 +35,7 @@ double central_increment(double x)
 
 // Built aside and moved in at the end: out of memory half way must not leave a grouping that
 // counts groups but lacks their columns (the retried setup would skip it, the step crash).
-void ColumnGroups::build(const ModelMatrix &A)
+void ColumnGroups::build(const ModelMatrix &A, const ConfigurationSpace *space)
 {
     ColumnGroups built;
     const int nrows = A.rows(), ncols = A.cols(), nnz = A.nnz();
@@ -68,6 +68,14 @@ void ColumnGroups::build(const ModelMatrix &A)
             for (int jj : row_cols[i])
                 if (color[jj] >= 0)
                     forbidden[color[jj]] = j;
+        int local = 0;
+        const int rotation = space ? space->rotation_of(j, &local) : -1;
+        if (rotation >= 0)
+            for (int l = 0; l < 3; ++l) {
+                const int jj = static_cast<int>(space->rotation_start(rotation)) + l;
+                if (color[jj] >= 0)
+                    forbidden[color[jj]] = j;
+            }
         int c = 0;
         while (c < groups && forbidden[c] == j)
             ++c;
@@ -138,7 +146,7 @@ void Model::prepare_differences(const ModelMatrix &M, const ModelMatrix &K, cons
     if (fd_stiffness && !constant_mass && M_pert_.size() != M.size())
         M_pert_.copy_layout(M);
     if (fd_stiffness && !K.dense() && K.nnz() > 0 && k_groups_.count() == 0)
-        k_groups_.build(K);
+        k_groups_.build(K, &space);
     if (fd_damping && !C.dense() && C.nnz() > 0 && c_groups_.count() == 0)
         c_groups_.build(C);
 }

@@ -56,7 +56,9 @@ struct ColumnGroups {
     std::vector<int> cols;
     std::vector<int> entry_start;  // and pattern entries entries[entry_start[g] ..)
     std::vector<int> entries;      // (first occurrence of each (row, col) only)
-    void build(const ModelMatrix &A);
+    // space (columns that are q's increments): the columns of one rotation in separate
+    // groups, since a shift of q in a rotation's column replaces the whole rotation
+    void build(const ModelMatrix &A, const ConfigurationSpace *space = nullptr);
     int count() const { return start.empty() ? 0 : static_cast<int>(start.size()) - 1; }
 };
 

@@ -20,7 +20,7 @@ void Stepper::setup_output()
         return;
     auto backend = sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Auto);
     backend->analysis_from(S_.backend());  // the same pattern: its ordering, not a second one
-    O_.setup(std::move(backend), nv_, m_, M_, J_, K_, C_, active_ptr());
+    setup_step_matrix(O_, std::move(backend));
     out_M_.copy_layout(M_);
     out_J_.copy_layout(J_);
     out_f_.setZero(nv_);

@@ -118,6 +118,10 @@ ga_status ForwardSensitivity::start(const State &x)
         return k_.diag.fail(GA_ERR_ARG,
                             "sensitivities on the sparse path need the patterns of K_t "
                             "and C_t (ga_set_pattern; an empty pattern declares a zero matrix)");
+    if (k_.sparse() && !k_.model.space.euclidean())
+        return k_.diag.fail(GA_ERR_ARG, "sensitivities (forward and adjoint) on the sparse path "
+                                        "are not available on a configuration space with "
+                                        "rotations in this version (the dense solver has them)");
     if (k_.r() > 0 && !k_.coupling_exact)
         return k_.diag.fail(GA_ERR_ARG, "sensitivities with first-order states need the coupling "
                                         "blocks in the iteration matrix (ga_set_coupling_exact)");

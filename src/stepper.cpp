@@ -206,6 +206,7 @@ ga_status Stepper::setup_workspace()
     const bool sparse_possible = !M_.dense() && (m_ == 0 || !J_.dense()) &&
                                  (!model.stiffness_needed(K_) || !K_.dense()) &&
                                  (!model.damping_needed(C_) || !C_.dense());
+    const bool group_index2 = !model.space.euclidean() && formulation == GA_INDEX2_STABILIZED;
     bool sparse = false;
     switch (linear_solver) {
     case GA_LINEAR_SPARSE:
@@ -214,9 +215,13 @@ ga_status Stepper::setup_workspace()
                              "the sparse solver needs the patterns of M and Phi_q, and of K_t "
                              "and C_t unless they are neglected (ga_set_pattern; an empty "
                              "pattern declares a zero matrix)");
+        if (group_index2)
+            return diag.fail(GA_ERR_ARG, "%s", kGroupIndex2Sparse);
         sparse = true;
         break;
-    case GA_LINEAR_AUTO: sparse = sparse_possible && nv_ + m_ >= kSparseMinSize; break;
+    case GA_LINEAR_AUTO:
+        sparse = sparse_possible && !group_index2 && nv_ + m_ >= kSparseMinSize;
+        break;
     default: sparse = false;
     }
     std::unique_ptr<LinearBackend> backend;
@@ -236,10 +241,11 @@ ga_status Stepper::setup_workspace()
     }
     M_.allocate();
     J_.allocate();
-    if (!model.space.euclidean()) {  // (dense: group spaces take no patterns)
-        KT_.copy_layout(K_);
-        JT_.copy_layout(J_);
-        ZT_.copy_layout(J_);
+    if (!model.space.euclidean()) {
+        if (!sparse || !K_.dense())  // (sparse: a dense K_t is one that is not needed)
+            KT_.setup(K_, model.space);
+        JT_.setup(J_, model.space);
+        ZT_.setup(J_, model.space);
     }
     // On the sparse path a tangent without a pattern is one that is not needed (neglected, or
     // C_t without forces): no dense n x n for it (1.5 GB at n = 10^4).
@@ -291,9 +297,18 @@ ga_status Stepper::setup_workspace()
     sparse_backend_ = sparse && backend;
     if (redundancy == GA_REDUNDANT_DROP)
         active_.assign(m_, 1);
-    S_.setup(std::move(backend), nv_, m_, M_, J_, K_, C_, active_ptr());
+    setup_step_matrix(S_, std::move(backend));
     workspace_ready_ = true;
     return GA_OK;
+}
+
+// A matrix of the step's layout: on the sparse path of a group space, with the expanded
+// patterns of K_t T and Phi_q T (its lower block), which its other uses fill with K_t, Phi_q.
+void Stepper::setup_step_matrix(IterationMatrix &S, std::unique_ptr<LinearBackend> backend)
+{
+    const bool expanded = sparse_backend_ && !model.space.euclidean();
+    S.setup(std::move(backend), nv_, m_, M_, J_, expanded && !K_.dense() ? KT_.out() : K_, C_,
+            active_ptr(), expanded ? &JT_.out() : nullptr);
 }
 
 void Stepper::forget_setup()
@@ -314,7 +329,7 @@ void Stepper::set_aside_matrix(KeptMatrix &kept)
     auto backend = sparse_backend_ ? make_sparse_backend()
                                    : make_dense_backend(dense_kind(linear_solver));
     backend->analysis_from(S_.backend());  // the same pattern: its ordering
-    kept.S.setup(std::move(backend), nv_, m_, M_, J_, K_, C_, active_ptr());
+    setup_step_matrix(kept.S, std::move(backend));
     kept.S.reserve_factors();
     if (S2_.ready()) {
         kept.S2.setup(nv_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_,
@@ -369,7 +384,7 @@ void Stepper::setup_projection()
         auto backend =
             sparse_backend_ ? make_sparse_backend() : make_dense_backend(DenseKind::Auto);
         backend->analysis_from(S_.backend());  // the same pattern: its ordering
-        P_.setup(std::move(backend), nv_, m_, M_, J_, K_, C_, active_ptr());
+        setup_step_matrix(P_, std::move(backend));
         P_.reserve_factors();
     }
 }
@@ -809,23 +824,22 @@ ga_status Stepper::factorize(double t, const State &x, double h, bool tangents_K
     jacobian_valid_ = false;
     const ModelMatrix *C = tangents_C ? &C_ : nullptr, *K = tangents_K ? &K_ : nullptr;
     const ModelMatrix *J_low = nullptr, *Z = tangent_Z ? &Z_ : nullptr;
-    if (!model.space.euclidean() && &x == &trial_) {
+    if (!model.space.euclidean() && (&x == &trial_ || sparse_backend_)) {
         // q = q_n o exp(xi): the q-columns of K_t and of the constraint rows take T(xi) as a
-        // right factor, Phi_q^T stays (sec. 14). (At the accepted state xi = 0, T = I.)
+        // right factor, Phi_q^T stays (sec. 14). (At the accepted state xi = 0, T = I: the
+        // dense path takes the matrices as they are, the sparse one in its expanded layout.)
+        const Vec *xi = &x == &trial_ ? &xi_ : nullptr;
         if (K) {
-            std::copy(K_.data(), K_.data() + K_.size(), KT_.data());
-            model.space.right_multiply_tangent(xi_, KT_.data(), nv_, nv_);
-            K = &KT_;
+            KT_.apply(K_, xi, model.space);
+            K = &KT_.out();
         }
         if (m_ > 0) {
-            std::copy(J_.data(), J_.data() + J_.size(), JT_.data());
-            model.space.right_multiply_tangent(xi_, JT_.data(), m_, m_);
-            J_low = &JT_;
+            JT_.apply(J_, xi, model.space);
+            J_low = &JT_.out();
         }
         if (Z) {  // index 2: the velocity constraint's curvature, through q as well
-            std::copy(Z_.data(), Z_.data() + Z_.size(), ZT_.data());
-            model.space.right_multiply_tangent(xi_, ZT_.data(), m_, m_);
-            Z = &ZT_;
+            ZT_.apply(Z_, xi, model.space);
+            Z = &ZT_.out();
         }
     }
     const bool ok = formulation == GA_INDEX2_STABILIZED

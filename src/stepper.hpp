@@ -19,10 +19,16 @@
 #include "step_controller.hpp"
 #include "step_doors.hpp"
 #include "step_plan.hpp"
+#include "tangent_product.hpp"
 #include "dense_output.hpp"
 #include "state.hpp"
 
 namespace ga {
+
+// Refused with this message: the sparse index-2 system has no lower block of its own yet
+inline constexpr const char *kGroupIndex2Sparse =
+    "the stabilized index-2 formulation on the sparse path is not available on a "
+    "configuration space with rotations in this version (index 3 is, and the dense solver)";
 
 // The matrix and scratch of an acceleration-level solve (init.cpp): the step's own at the
 // consistent start, separate ones for consistent output, so that reading the output never
@@ -342,6 +348,8 @@ public:
 
 private:
     void forget_setup();
+    // A matrix of the step's layout (S_, P_, O_, a kept S)
+    void setup_step_matrix(IterationMatrix &S, std::unique_ptr<LinearBackend> backend);
 
     ga_status setup();  // chooses the backend and allocates everything; throws std::bad_alloc
     ga_status setup_workspace();  // the part every formulation and option needs
@@ -472,9 +480,10 @@ private:
     // Step workspace, sized once.
     ModelMatrix M_, J_, K_, C_, B_;  // B_: index-2, Phi_q(q_n)
     // On a group space: the step's increment xi (q = q_n (+) xi, sec. 14), and K_t T(xi),
-    // Phi_q T(xi), Z T(xi) for the iteration matrix (empty on R^n)
+    // Phi_q T(xi), Z T(xi) for the iteration matrix (empty on R^n); on the sparse path their
+    // expanded patterns are those of the step's matrix at every state (T = I at xi = 0)
     Vec xi_;
-    ModelMatrix KT_, JT_, ZT_;
+    TangentProduct KT_, JT_, ZT_;
     Mat g_q_step_;  // g_q T(xi) of the first-order states (first_order_matrix)
     ModelMatrix Z_;                  // index-2: d(Phi_q v + Phi_t)/dq, layout of J_
     Vec f_, phi_, phi_v_, rq_, dq_, dw_, dlambda_, deta_, c_, qdd_tmp_, lambda_tmp_;

@@ -39,8 +39,9 @@ struct SaddleBlocks {
     const ModelMatrix *K = nullptr;  // null: neglected
     double cK = 0.0;
     const ModelMatrix *J = nullptr;
-    // The lower-left block where it is not J (dense only): Phi_q T(xi) on a group space,
-    // where the upper-right block stays Phi_q^T (docs/algorithms.md sec. 14)
+    // The lower-left block where it is not J: Phi_q T(xi) on a group space, where the
+    // upper-right block stays Phi_q^T (docs/algorithms.md sec. 14); sparse: in the layout
+    // given at setup
     const ModelMatrix *J_low = nullptr;
     const unsigned char *active = nullptr;  // m flags; null: every constraint active
 };
@@ -50,9 +51,12 @@ public:
     virtual ~LinearBackend() = default;
     // Layouts of the blocks (patterns for the sparse backend); allocates everything.
     // with_inactive: constraints may be made inactive (the sparse pattern needs the diagonal
-    // of the lower-right block then).
+    // of the lower-right block then). J_low (sparse): the layout of the lower-left block when
+    // it is not J's (Phi_q T on a group space, whose pattern holds J's); factorize then takes
+    // it from SaddleBlocks::J_low, or J where that is null.
     virtual void setup(int n, int m, const ModelMatrix &M, const ModelMatrix &J,
-                       const ModelMatrix &K, const ModelMatrix &C, bool with_inactive) = 0;
+                       const ModelMatrix &K, const ModelMatrix &C, bool with_inactive,
+                       const ModelMatrix *J_low = nullptr) = 0;
     // A backend set up already whose analysis (fill-reducing ordering) the next setup may
     // take over if its pattern turns out the same; it must outlive that setup.
     virtual void analysis_from(const LinearBackend *like) { (void)like; }

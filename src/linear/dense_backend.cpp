@@ -22,7 +22,7 @@ public:
     explicit DenseBackend(DenseKind kind) : kind_(kind) {}
 
     void setup(int n, int m, const ModelMatrix &, const ModelMatrix &, const ModelMatrix &,
-               const ModelMatrix &, bool) override
+               const ModelMatrix &, bool, const ModelMatrix *) override
     {
         n_ = n;
         m_ = m;

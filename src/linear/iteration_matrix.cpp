@@ -4,13 +4,14 @@ namespace ga {
 
 void IterationMatrix::setup(std::unique_ptr<LinearBackend> backend, int n, int m,
                             const ModelMatrix &M, const ModelMatrix &J, const ModelMatrix &K,
-                            const ModelMatrix &C, const unsigned char *active)
+                            const ModelMatrix &C, const unsigned char *active,
+                            const ModelMatrix *J_low)
 {
     n_ = n;
     m_ = m;
     active_ = active;
     rhs_.setZero(n + m);
-    backend->setup(n, m, M, J, K, C, active != nullptr);
+    backend->setup(n, m, M, J, K, C, active != nullptr, J_low);
     backend_ = std::move(backend);
 }
 

@@ -13,10 +13,11 @@ namespace ga {
 class IterationMatrix {
 public:
     // active: m flags owned by the caller, fixed for the life of the matrix (null: no
-    // constraint is ever inactive).
+    // constraint is ever inactive). J_low: the layout of a lower-left block of its own
+    // (LinearBackend::setup).
     void setup(std::unique_ptr<LinearBackend> backend, int n, int m, const ModelMatrix &M,
                const ModelMatrix &J, const ModelMatrix &K, const ModelMatrix &C,
-               const unsigned char *active = nullptr);
+               const unsigned char *active = nullptr, const ModelMatrix *J_low = nullptr);
     bool ready() const { return backend_ != nullptr; }
     const char *backend_name() const { return backend_ ? backend_->name() : "none"; }
     const LinearBackend *backend() const { return backend_.get(); }

@@ -17,7 +17,7 @@ namespace {
 class SparseBackend final : public LinearBackend {
 public:
     void setup(int n, int m, const ModelMatrix &M, const ModelMatrix &J, const ModelMatrix &K,
-               const ModelMatrix &C, bool with_inactive) override
+               const ModelMatrix &C, bool with_inactive, const ModelMatrix *J_low) override
     {
         n_ = n;
         m_ = m;
@@ -36,6 +36,9 @@ public:
             entries.emplace_back(n + J.row_index()[k], J.col_index()[k]);  // Phi_q
             entries.emplace_back(J.col_index()[k], n + J.row_index()[k]);  // Phi_q^T
         }
+        if (J_low)  // Phi_q T: J's pattern with whole rotation column blocks
+            for (int k = 0; k < J_low->nnz(); ++k)
+                entries.emplace_back(n + J_low->row_index()[k], J_low->col_index()[k]);
         if (with_inactive)
             for (int i = 0; i < m; ++i)
                 entries.emplace_back(n + i, n + i);
@@ -56,6 +59,12 @@ public:
         map_C_ = map(C, false, 0);
         map_J_ = map(J, false, n);  // Phi_q entry (i, j) at (n + i, j)
         map_JT_ = map(J, true, 0);  // and at (j, n + i)
+        map_low_.clear();
+        low_rows_.clear();
+        if (J_low) {
+            map_low_ = map(*J_low, false, n);
+            low_rows_ = J_low->row_index();
+        }
         diag_.resize(n);
         for (int i = 0; i < n; ++i)
             diag_[i] = S_.slot(i, i);
@@ -72,7 +81,7 @@ public:
             if (marked[slot])
                 top_left_.push_back(slot);
         std::fill(marked.begin(), marked.end(), 0);
-        j_written_ = true;
+        j_written_ = !J_low;  // (a lower block of its own: S is zeroed and added up)
         for (const int slot : map_J_) {
             j_written_ = j_written_ && !marked[slot];
             marked[slot] = 1;
@@ -113,7 +122,10 @@ public:
             for (std::size_t k = 0; k < map_J_.size(); ++k)
                 values[map_J_[k]] = values[map_JT_[k]] = v[k];
         } else if (m_ > 0) {
-            scatter(*b.J, map_J_, 1.0);
+            if (b.J_low && !map_low_.empty())
+                scatter(*b.J_low, map_low_, 1.0);
+            else
+                scatter(*b.J, map_J_, 1.0);
             scatter(*b.J, map_JT_, 1.0);
         }
         if (m_ > 0) {
@@ -121,6 +133,9 @@ public:
                 for (std::size_t k = 0; k < map_J_.size(); ++k)
                     if (!b.active[J_rows_[k]])
                         values[map_J_[k]] = values[map_JT_[k]] = 0.0;
+                for (std::size_t k = 0; k < map_low_.size(); ++k)
+                    if (!b.active[low_rows_[k]])
+                        values[map_low_[k]] = 0.0;
                 for (int i = 0; i < m_; ++i)
                     if (!b.active[i])
                         values[lower_diag_[i]] = 1.0;
@@ -153,6 +168,7 @@ private:
     std::vector<int> map_M_, map_K_, map_C_, map_J_, map_JT_, diag_, lower_diag_, top_left_;
     bool j_written_ = false;  // no slot of Phi_q twice in its pattern
     std::vector<int> J_rows_;  // row of each Phi_q entry
+    std::vector<int> map_low_, low_rows_;  // the lower block's own layout (setup's J_low)
 };
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <cmocka.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <galpha.h>
@@ -903,12 +904,6 @@ static void test_what_rotations_do_not_offer_is_refused(void **state)
     (void)state;
     lie_top t = lie_top_make(0);
     ga_solver *s = top_solver(&t, GA_INDEX3);
-    const int rows[1] = {0}, cols[1] = {0};
-    assert_int_equal(ga_set_pattern(s, GA_MATRIX_MASS, 1, rows, cols), GA_ERR_ARG);
-    assert_non_null(strstr(ga_last_error(s), "sparsity pattern"));
-    assert_non_null(strstr(ga_last_error(s), "rotations"));
-    assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_ERR_ARG);
-    assert_non_null(strstr(ga_last_error(s), "sparse linear solver"));
     const int row[1] = {0}, col[1] = {4};
     assert_int_equal(ga_set_first_order(s, 1, NULL, no_rate), GA_OK);
     assert_int_equal(ga_set_coupling_pattern(s, GA_COUPLING_G_Q, 1, row, col), GA_ERR_ARG);
@@ -931,6 +926,163 @@ static void test_what_rotations_do_not_offer_is_refused(void **state)
     ga_free(b);
 }
 
+/* The top on the sparse path: the callbacks' values at declared patterns. Phi_q's rotation
+ * columns are R X~: with X = (0, 1, 0) column 4 is zero and left out of the pattern, so that
+ * Phi_q T (all three columns) needs the expanded lower block; K_t = -X~ (R^T lambda)~ has rows
+ * 3 and 5 only, its columns 3 and 5 no common row (one column group without the rule that
+ * keeps a rotation's columns apart). */
+static const int SP_J_ROWS[9] = {0, 1, 2, 0, 1, 2, 0, 1, 2};
+static const int SP_J_COLS[9] = {0, 1, 2, 3, 3, 3, 5, 5, 5};
+static const int SP_K_ROWS[4] = {3, 3, 5, 5};
+static const int SP_K_COLS[4] = {3, 4, 4, 5};
+
+static int sp_mass(double time, const double *q, double *M, void *user)
+{
+    double D[36];
+    lie_top_mass(time, q, D, user);
+    for (int i = 0; i < 6; ++i)
+        M[i] = D[7 * i];
+    return 0;
+}
+
+static int sp_jacobian(double time, const double *q, double *J, void *user)
+{
+    double D[18];
+    lie_top_jacobian(time, q, D, user);
+    for (int k = 0; k < 9; ++k)
+        J[k] = D[SP_J_ROWS[k] + 3 * SP_J_COLS[k]];
+    return 0;
+}
+
+static int sp_stiffness(double time, const double *q, const double *v, const double *qdd,
+                        const double *lambda, double *K, void *user)
+{
+    double D[36];
+    lie_top_stiffness(time, q, v, qdd, lambda, D, user);
+    for (int k = 0; k < 4; ++k)
+        K[k] = D[SP_K_ROWS[k] + 6 * SP_K_COLS[k]];
+    return 0;
+}
+
+static int sp_damping(double time, const double *q, const double *v, double *C, void *user)
+{
+    double D[36];
+    lie_top_damping(time, q, v, D, user);
+    for (int k = 0; k < 9; ++k)
+        C[k] = D[(3 + k % 3) + 6 * (3 + k / 3)];
+    return 0;
+}
+
+/* exact: K_t by its callback, else by differences on its pattern */
+static ga_solver *sparse_top_solver(lie_top *t, int exact)
+{
+    int kinds[2], counts[2];
+    lie_top_blocks(t, kinds, counts);
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create_space(2, kinds, counts, LIE_TOP_M, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, sp_mass, lie_top_force, lie_top_constraint,
+                                      sp_jacobian, t),
+                     GA_OK);
+    const int diag[6] = {0, 1, 2, 3, 4, 5};
+    int c_rows[9], c_cols[9];
+    for (int k = 0; k < 9; ++k) {
+        c_rows[k] = 3 + k % 3;
+        c_cols[k] = 3 + k / 3;
+    }
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_MASS, 6, diag, diag), GA_OK);
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_JACOBIAN, 9, SP_J_ROWS, SP_J_COLS), GA_OK);
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_STIFFNESS, 4, SP_K_ROWS, SP_K_COLS), GA_OK);
+    assert_int_equal(ga_set_pattern(s, GA_MATRIX_DAMPING, 9, c_rows, c_cols), GA_OK);
+    assert_int_equal(ga_set_tangents(s, exact ? sp_stiffness : NULL, sp_damping), GA_OK);
+    assert_int_equal(ga_set_linear_solver(s, GA_LINEAR_SPARSE), GA_OK);
+    return s;
+}
+
+/* The sparse path gives the dense path's run: at every step of 0.5 s (h = 1e-3) the centre of
+ * mass within 1e-11 (two LUs' round-off), Newton's iterations the same; K_t by differences
+ * on its pattern as well (the Newton tolerance's difference) */
+static void test_sparse_path_is_the_dense_one(void **state)
+{
+    (void)state;
+    for (int matrix = 0; matrix < 2; ++matrix) {
+        lie_top t = lie_top_make(matrix);
+        ga_solver *d = top_solver(&t, GA_INDEX3);
+        assert_int_equal(ga_set_tangents(d, lie_top_stiffness, lie_top_damping), GA_OK);
+        ga_solver *s = sparse_top_solver(&t, 1), *f = sparse_top_solver(&t, 0);
+        double q[12], v[6];
+        lie_top_initial(&t, q, v);
+        assert_int_equal(ga_init(d, 0.0, q, v), GA_OK);
+        assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+        assert_int_equal(ga_init(f, 0.0, q, v), GA_OK);
+        assert_string_equal(ga_linear_solver_name(s), "sparse KLU");
+        double worst = 0.0, worst_fd = 0.0;
+        for (int k = 0; k < 500; ++k) {
+            assert_int_equal(ga_step(d, 1e-3), GA_OK);
+            assert_int_equal(ga_step(s, 1e-3), GA_OK);
+            assert_int_equal(ga_step(f, 1e-3), GA_OK);
+            double qd[12], qs[12], qf[12];
+            assert_int_equal(ga_get_q(d, qd), GA_OK);
+            assert_int_equal(ga_get_q(s, qs), GA_OK);
+            assert_int_equal(ga_get_q(f, qf), GA_OK);
+            worst = fmax(worst, max_diff(qd, qs));
+            worst_fd = fmax(worst_fd, max_diff(qd, qf));
+        }
+        top_result rd, rs, rf;
+        read_result(d, &rd);
+        read_result(s, &rs);
+        read_result(f, &rf);
+        print_message("  %s: sparse - dense %.2e (K_t by differences %.2e); Newton %lld / %lld / "
+                      "%lld\n",
+                      matrix ? "matrix" : "quaternion", worst, worst_fd, rd.newton, rs.newton,
+                      rf.newton);
+        assert_true(worst < 1e-12);
+        assert_true(worst_fd < 1e-12);
+        assert_int_equal(rs.newton, rd.newton);
+        assert_true(llabs(rf.newton - rd.newton) <= rd.newton / 50);
+        ga_free(d);
+        ga_free(s);
+        ga_free(f);
+    }
+}
+
+/* What the sparse path does not offer on rotations is refused by name, the solver unchanged */
+static void test_sparse_path_refusals(void **state)
+{
+    (void)state;
+    lie_top t = lie_top_make(0);
+    double q[7], v[6];
+    lie_top_initial(&t, q, v);
+    ga_solver *s = sparse_top_solver(&t, 1);
+    assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "index-2"));
+    assert_non_null(strstr(ga_last_error(s), "rotations"));
+    assert_int_equal(ga_set_formulation(s, GA_INDEX3), GA_OK);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    assert_int_equal(ga_set_formulation(s, GA_INDEX2_STABILIZED), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "index-2"));
+    ga_solver *b = sparse_top_solver(&t, 1);
+    assert_int_equal(ga_init(b, 0.0, q, v), GA_OK);
+    for (int k = 0; k < 10; ++k) { /* the refused call changed nothing */
+        assert_int_equal(ga_step(s, 1e-3), GA_OK);
+        assert_int_equal(ga_step(b, 1e-3), GA_OK);
+    }
+    double qa[7], qb[7];
+    assert_int_equal(ga_get_q(s, qa), GA_OK);
+    assert_int_equal(ga_get_q(b, qb), GA_OK);
+    assert_memory_equal(qa, qb, sizeof qa);
+    ga_free(s);
+    ga_free(b);
+    /* sensitivities */
+    ga_solver *z = sparse_top_solver(&t, 1);
+    double p[1] = {15.0};
+    assert_int_equal(ga_set_sensitivity(z, 1, p, NULL, 0), GA_OK);
+    assert_int_equal(ga_init(z, 0.0, q, v), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(z), "sensitivities"));
+    assert_non_null(strstr(ga_last_error(z), "rotations"));
+    ga_free(z);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -951,6 +1103,8 @@ int main(void)
         cmocka_unit_test(test_vector_blocks_are_ga_create),
         cmocka_unit_test(test_init_refuses_what_is_not_a_rotation),
         cmocka_unit_test(test_what_rotations_do_not_offer_is_refused),
+        cmocka_unit_test(test_sparse_path_is_the_dense_one),
+        cmocka_unit_test(test_sparse_path_refusals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -2,7 +2,7 @@
 with galpha.so3, against an independent reference -- Euler's equations about the pivot with a
 rotation matrix by scipy's DOP853 at rtol 1e-12, checked by the Lagrange top's invariants.
 Order 2 in the centre of mass in both formulations, quaternion and matrix storage agreeing to
-round-off, and the space's argument checks."""
+round-off, the sparse path, and the space's argument checks."""
 import os
 import sys
 
@@ -134,5 +134,33 @@ def test_space_arguments_are_checked():
     with pytest.raises(galpha.ArgumentError, match="6 velocity coordinates"):
         galpha.Solver(7, 3, top.mass, top.force, top.constraint, top.jacobian,
                       space=[("vector", 3), ("so3", 1)])
-    with pytest.raises(galpha.ArgumentError, match="rotations"):
-        top.solver(galpha.GA_INDEX3, linear_solver=galpha.GA_LINEAR_SPARSE)
+
+
+class SparseTop(Top):
+    """The same top with declared patterns (1-D value arrays): M's diagonal, Phi_q whole,
+    K_t and C_t on the rotation's 3 x 3 block (by differences)."""
+    ROT = (np.repeat(np.arange(3, 6), 3), np.tile(np.arange(3, 6), 3))
+    PATTERNS = {"mass": (np.arange(6), np.arange(6)),
+                "jacobian": (np.repeat(np.arange(3), 6), np.tile(np.arange(6), 3)),
+                "stiffness": ROT, "damping": ROT}
+
+    def mass(self, t, q, M):
+        M[...] = np.concatenate([MASS * np.ones(3), JC])
+
+    def jacobian(self, t, q, J):
+        D = np.zeros((3, 6))
+        Top.jacobian(self, t, q, D)
+        J[...] = D.ravel()
+
+    def solver(self, formulation, **options):
+        return Top.solver(self, formulation, patterns=self.PATTERNS,
+                          linear_solver=galpha.GA_LINEAR_SPARSE, **options)
+
+
+def test_the_sparse_path_is_the_dense_one():
+    qa, va = run(SparseTop(False), galpha.GA_INDEX3, 1e-3, 0.2)
+    qb, vb = run(Top(False), galpha.GA_INDEX3, 1e-3, 0.2)
+    assert np.abs(qa - qb).max() < 1e-12
+    assert np.abs(va - vb).max() < 1e-12 * 150
+    with pytest.raises(galpha.ArgumentError, match="index-2 formulation on the sparse path"):
+        run(SparseTop(False), galpha.GA_INDEX2_STABILIZED, 1e-3, 1e-3)

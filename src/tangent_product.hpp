@@ -1,0 +1,32 @@
+// ga::TangentProduct: A T(xi), a user matrix times the tangent operator on the columns of the
+// rotations (docs/algorithms.md sec. 14, 16) -- K_t, Phi_q and Z where the step's q moves as
+// q_n o exp(xi). Dense: a copy, multiplied in place. With a declared pattern: every entry in
+// a rotation's column spreads over the three columns of that rotation, so the product has the
+// expanded pattern (whole 3-column blocks), fixed at setup; each refactorization scatters the
+// entries with T's coefficients (no allocation, linear in the entries).
+#pragma once
+
+#include <vector>
+
+#include "configuration_space.hpp"
+#include "matrix.hpp"
+
+namespace ga {
+
+class TangentProduct {
+public:
+    // The layout of A T for A's layout (A's pattern expanded); allocates.
+    void setup(const ModelMatrix &A, const ConfigurationSpace &space);
+    // out() = A T(xi), or with xi null A itself in the expanded layout (T = I)
+    void apply(const ModelMatrix &A, const Vec *xi, const ConfigurationSpace &space);
+    const ModelMatrix &out() const { return out_; }
+
+private:
+    ModelMatrix out_;
+    // per entry of A: its first target in out_ (the rotation's three columns are consecutive
+    // entries there), the rotation it is in (-1: a vector column, one target) and its place
+    std::vector<int> target_, rotation_, local_;
+    std::vector<double> T_;  // 9 per rotation
+};
+
+}  // namespace ga
