@@ -21,6 +21,7 @@ extern "C" {
 #include "scenes/chain.h"
 #include "scenes/pendulum.h"
 #include "scenes/slider_crank.h"
+#include "scenes/spatial_chain.h"
 }
 
 namespace {
@@ -48,7 +49,15 @@ struct Scene {
     ga_status (*declare)(ga_solver *, void *);  // declares patterns (sparse models)
     int formulation = GA_INDEX3;
     ga_constraint_fn dt = nullptr;  // Phi_t (index 2), central differences when null
+    // a solver with its space, callbacks, tangents and patterns (in place of ga_create and the
+    // callbacks above), when given
+    ga_status (*create)(void *user, ga_solver **out) = nullptr;
 };
+
+ga_status create_spatial_chain(void *user, ga_solver **out)
+{
+    return spatial_chain_solver(static_cast<spatial_chain *>(user), out);
+}
 
 ga_status declare_chain(ga_solver *s, void *user) { return chain_declare_patterns(static_cast<chain *>(user), s); }
 ga_status declare_andrews31(ga_solver *s, void *) { return an31_declare_patterns(s); }
@@ -67,14 +76,19 @@ struct Result {
 ga_solver *make(const Scene &sc, int solver, double tol)
 {
     ga_solver *s = nullptr;
-    if (ga_create(sc.n, sc.m, &s))
-        return nullptr;
-    if (sc.declare)
-        sc.declare(s, sc.user);
-    ga_set_callbacks(s, sc.mass, sc.force, sc.constraint, sc.jacobian, sc.user);
-    ga_set_tangents(s, sc.stiffness, nullptr);
-    ga_set_constraint_accel(s, sc.accel);
-    ga_set_constraint_dt(s, sc.dt);
+    if (sc.create) {
+        if (sc.create(sc.user, &s))
+            return nullptr;
+    } else {
+        if (ga_create(sc.n, sc.m, &s))
+            return nullptr;
+        if (sc.declare)
+            sc.declare(s, sc.user);
+        ga_set_callbacks(s, sc.mass, sc.force, sc.constraint, sc.jacobian, sc.user);
+        ga_set_tangents(s, sc.stiffness, nullptr);
+        ga_set_constraint_accel(s, sc.accel);
+        ga_set_constraint_dt(s, sc.dt);
+    }
     ga_set_rho_inf(s, sc.rho);
     ga_set_newton(s, tol, 20);
     ga_set_constant_mass(s, sc.constant_mass);
@@ -303,7 +317,45 @@ int main(int argc, char **argv)
                     r.per_step / r.limit, peak_rss_kib());
         return 0;
     }
+    if (mode == "spatial_chain_steps" && argc > 2) {  // for callgrind, as chain_steps
+        const int bodies = std::atoi(argv[2]);
+        const int steps = argc > 3 ? std::atoi(argv[3]) : 10;
+        spatial_chain c = spatial_chain_make(bodies, 2.0);
+        std::vector<double> q(7 * static_cast<std::size_t>(bodies)),
+            v(6 * static_cast<std::size_t>(bodies));
+        spatial_chain_initial(&c, q.data(), v.data());
+        ga_solver *s = nullptr;
+        if (spatial_chain_solver(&c, &s) || ga_set_rho_inf(s, 0.7) || ga_set_newton(s, 1e-10, 20) ||
+            ga_set_linear_solver(s, GA_LINEAR_SPARSE) || ga_init(s, 0.0, q.data(), v.data()))
+            return 1;
+        for (int k = 0; k < steps; ++k)
+            if (ga_step(s, 1e-3))
+                return 1;
+        ga_free(s);
+        return 0;
+    }
+    if (mode == "spatial_chain" && argc > 2) {
+        // N rods on R^3 x SO(3) joined by spherical joints (sparse path on a group space),
+        // spinning about their axes as they fall; the chain's columns
+        const int bodies = std::atoi(argv[2]);
+        const int steps = argc > 3 ? std::atoi(argv[3]) : 20;
+        spatial_chain c = spatial_chain_make(bodies, 2.0);
+        Scene sc{"spatial_chain", 6 * bodies, 3 * bodies, nullptr, nullptr, nullptr, nullptr,
+                 nullptr, nullptr, &c, {}, {}, 1e-3, steps * 1e-3, 0.7, 1, nullptr};
+        sc.create = create_spatial_chain;
+        sc.q0.resize(7 * static_cast<std::size_t>(bodies));
+        sc.v0.resize(6 * static_cast<std::size_t>(bodies));
+        spatial_chain_initial(&c, sc.q0.data(), sc.v0.data());
+        const int repeats = std::max(3, std::min(200, static_cast<int>(1e6 / (sc.n + sc.m))));
+        const Result r = measure(sc, GA_LINEAR_SPARSE, 1e-10, repeats);
+        std::printf("%d,%d,%d,%s,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%ld\n", bodies, sc.n, sc.m,
+                    r.backend.c_str(), steps, r.newton, r.factorizations, 1e6 * r.per_step,
+                    1e6 * r.first_step, 1e6 * r.later_per_step, 1e6 * r.limit,
+                    r.per_step / r.limit, peak_rss_kib());
+        return 0;
+    }
     std::fprintf(stderr, "usage: step_cost scenes [tol] | step_cost chain N [steps] [tol] "
-                         "[formulation] | step_cost scene_steps|scene_limit NAME [tol] [reps]\n");
+                         "[formulation] | step_cost spatial_chain N [steps] | step_cost "
+                         "scene_steps|scene_limit NAME [tol] [reps]\n");
     return 2;
 }

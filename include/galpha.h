@@ -207,8 +207,11 @@ typedef enum {
  *  With rotations, in this version: index 3 and the stabilized index 2, fixed and adaptive
  *  steps, dense output and events, checkpoints, forward and adjoint sensitivities (a
  *  sensitivity's dq is a tangent along right increments, nv numbers), on the dense linear
- *  solver, with first-order states (their g_q along right increments too); ga_set_pattern,
- *  a coupling pattern of g_q and the sparse solver return GA_ERR_ARG, saying so. q0 of
+ *  solver, with first-order states (their g_q along right increments too). The sparse path
+ *  (ga_set_pattern: patterns of the nv-column matrices) in index 3, for the step and its
+ *  finite-difference tangents; there the stabilized index 2 and sensitivities return
+ *  GA_ERR_ARG at ga_init (or ga_set_formulation), saying so, as does a coupling pattern of
+ *  g_q. q0 of
  *  ga_init (and q in ga_set_state) must hold rotations (a quaternion's norm, a matrix's
  *  orthonormality within 1e-6, det > 0), else GA_ERR_ARG names the block.
  *  Errors: GA_ERR_ARG (out, kinds or counts NULL with count > 0, count < 1, an unknown kind, a

@@ -22,6 +22,11 @@ echo "links,n,m,backend,steps,newton_per_step,factorizations_per_step,us_per_ste
 for N in 10 30 100 300 1000 3000 10000 30000 100000; do
     "$b/step_cost" chain "$N" 50 >> "$out/chain.csv"
 done
+echo "spatial chain scaling (rods on R^3 x SO(3), spherical joints: the sparse path on a group space)"
+echo "bodies,n,m,backend,steps,newton_per_step,factorizations_per_step,us_per_step,first_step_us,later_us_per_step,limit_us,ratio,peak_rss_kib" > "$out/spatial_chain.csv"
+for N in 1000 3000 10000 30000 100000; do
+    "$b/step_cost" spatial_chain "$N" 50 >> "$out/spatial_chain.csv"
+done
 echo "links,n,m,runs,setup_us,later_us_per_step,setup_in_steps" > "$out/chain_setup.csv"
 for N in 1000 10000 100000; do  # ga_create to ga_init against a step (steps 2-10), best of runs
     "$b/step_cost" chain_setup "$N" 10 >> "$out/chain_setup.csv"
@@ -46,6 +51,13 @@ if command -v valgrind >/dev/null; then
             "$b/step_cost" chain_steps "$N" 10 2>&1 |
             sed -n "s/.*Collected : \([0-9]*\).*/$N,\1/p" |
             awk -F, '{printf "%s,%.0f\n", $1, $2 / 10}' >> "$out/chain_instructions.csv"
+    done
+    echo "bodies,instructions_per_step" > "$out/spatial_chain_instructions.csv"
+    for N in 1000 10000 100000; do
+        valgrind --tool=callgrind --toggle-collect=ga_step --callgrind-out-file=/dev/null \
+            "$b/step_cost" spatial_chain_steps "$N" 10 2>&1 |
+            sed -n "s/.*Collected : \([0-9]*\).*/$N,\1/p" |
+            awk -F, '{printf "%s,%.0f\n", $1, $2 / 10}' >> "$out/spatial_chain_instructions.csv"
     done
 fi
 if command -v valgrind >/dev/null; then
