@@ -184,8 +184,13 @@ GA_API ga_status ga_create(int n, int m, ga_solver **out);
 typedef enum {
     GA_SPACE_VECTOR = 0,         /**< coordinates of R^k, in q and in v alike */
     GA_SPACE_SO3_QUATERNION = 1, /**< rotations, each 4 numbers (w, x, y, z) in q, 3 in v */
-    GA_SPACE_SO3_MATRIX = 2      /**< rotations, each 9 numbers in q (the rotation matrix,
+    GA_SPACE_SO3_MATRIX = 2,     /**< rotations, each 9 numbers in q (the rotation matrix,
                                       column-major), 3 in v */
+    GA_SPACE_SE3 = 3             /**< rigid poses (x, R) of SE(3), each 7 numbers in q (the
+                                      position x in space, then R's unit quaternion w, x, y,
+                                      z) and 6 in v, the body-frame twist (u, w) = (R^T x',
+                                      omega), moved by (x, R) o exp(u, w) = (x + R V(w) u,
+                                      R exp(w)), V(w) = T(w)^T (docs/algorithms.md sec. 16) */
 } ga_space_kind;
 
 /** Create a solver whose configuration is a product of blocks, block i of kind kinds[i]

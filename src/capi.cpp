@@ -313,6 +313,14 @@ GA_API ga_status ga_create_space(int count, const int *kinds, const int *counts,
                         {quaternion ? Space::Kind::Quaternion : Space::Kind::Matrix, 3});
                 break;
             }
+            case GA_SPACE_SE3:
+                nq += 7 * c;
+                nv += 6 * c;
+                if (nq > INT_MAX)
+                    return GA_ERR_ARG;
+                for (int k = 0; k < counts[i]; ++k)
+                    blocks.push_back({Space::Kind::Pose, 6});
+                break;
             default: return GA_ERR_ARG;
             }
             if (nq > INT_MAX || nv > INT_MAX)

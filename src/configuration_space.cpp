@@ -1,9 +1,12 @@
-// The group blocks of ga::ConfigurationSpace (docs/algorithms.md sec. 14): rotations stored
-// as unit quaternions or as column-major rotation matrices, moved by right increments,
-// q o exp(psi), with psi in the body frame; vector blocks as in R^n.
+// The group blocks of ga::ConfigurationSpace (docs/algorithms.md sec. 14, 16): rotations stored
+// as unit quaternions or as column-major rotation matrices, and rigid poses of SE(3) (a
+// position and a quaternion), moved by right increments, q o exp(xi), with xi in the body
+// frame; vector blocks as in R^n. Each group block of width w (3 or 6) goes through the same
+// four maps: exp onto its storage, the log between two storages, T(xi) and the transport
+// Ad_{exp(-xi)} (w x w, row-major).
 #include "configuration_space.hpp"
 
-#include "lie/so3.hpp"
+#include "lie/se3.hpp"
 
 namespace ga {
 
@@ -12,8 +15,12 @@ namespace {
 using so3::Mat3;
 using so3::Quat;
 using so3::Vec3;
+using Kind = ConfigurationSpace::Kind;
+using Alg = std::array<double, 6>;  // an element of a block's algebra (3 or 6 used)
+using Op = std::array<double, 36>;  // a w x w operator, row-major
 
 Vec3 vec3(const double *p) { return {p[0], p[1], p[2]}; }
+Quat quat(const double *p) { return {p[0], p[1], p[2], p[3]}; }
 
 // A rotation matrix (row-major) as a unit quaternion with w >= 0 (Shepperd: from the largest
 // of the four squared components, so that no division is by a small number)
@@ -48,35 +55,72 @@ void store_matrix(const Mat3 &R, double *p)
         for (int j = 0; j < 3; ++j)
             p[i + 3 * j] = R[3 * i + j];
 }
-Mat3 multiply(const Mat3 &A, const Mat3 &B)
-{
-    Mat3 C{};
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
-    return C;
-}
-Mat3 transpose(const Mat3 &A) { return {A[0], A[3], A[6], A[1], A[4], A[7], A[2], A[5], A[8]}; }
+using se3::detail::mul;
+using se3::detail::transpose;
 
-// out = q o exp(psi) on one rotation block (out may be q)
-void compose_exp(ConfigurationSpace::Kind kind, const double *q, const Vec3 &psi, double *out)
+// out = q o exp(xi) on one group block (out may be q)
+void compose_exp(Kind kind, const double *q, const double *xi, double *out)
 {
-    if (kind == ConfigurationSpace::Kind::Quaternion) {
-        const Quat r = so3::compose({q[0], q[1], q[2], q[3]}, so3::exp(psi));
-        for (int k = 0; k < 4; ++k)
-            out[k] = r[k];
-    } else {
-        store_matrix(multiply(load_matrix(q), so3::matrix(so3::exp(psi))), out);
+    if (kind == Kind::Quaternion) {
+        const Quat r = so3::compose(quat(q), so3::exp(vec3(xi)));
+        std::copy(r.begin(), r.end(), out);
+    } else if (kind == Kind::Matrix) {
+        store_matrix(mul(load_matrix(q), so3::matrix(so3::exp(vec3(xi)))), out);
+    } else {  // (x, R) o exp(u, w) = (x + R V(w) u, R exp(w))
+        const Quat r = quat(q + 3);
+        const Vec3 dx = so3::rotate(r, se3::exp_translation(vec3(xi), vec3(xi + 3)));
+        const Quat r1 = so3::compose(r, so3::exp(vec3(xi + 3)));
+        for (int k = 0; k < 3; ++k)
+            out[k] = q[k] + dx[static_cast<std::size_t>(k)];
+        std::copy(r1.begin(), r1.end(), out + 3);
     }
 }
 
-// log(q0^-1 q1) on one rotation block
-Vec3 relative_log(ConfigurationSpace::Kind kind, const double *q0, const double *q1)
+// log(q0^-1 q1) on one group block
+Alg relative_log(Kind kind, const double *q0, const double *q1)
 {
-    if (kind == ConfigurationSpace::Kind::Quaternion)
-        return so3::log(
-            so3::compose(so3::inverse({q0[0], q0[1], q0[2], q0[3]}), {q1[0], q1[1], q1[2], q1[3]}));
-    return so3::log(from_matrix(multiply(transpose(load_matrix(q0)), load_matrix(q1))));
+    Alg a{};
+    if (kind == Kind::Pose) {
+        const Quat r0 = quat(q0 + 3);
+        const Vec3 dx = so3::rotate(so3::inverse(r0), {q1[0] - q0[0], q1[1] - q0[1],
+                                                      q1[2] - q0[2]});
+        return se3::log(dx, so3::compose(so3::inverse(r0), quat(q1 + 3)));
+    }
+    const Vec3 w = kind == Kind::Quaternion
+                       ? so3::log(so3::compose(so3::inverse(quat(q0)), quat(q1)))
+                       : so3::log(from_matrix(mul(transpose(load_matrix(q0)), load_matrix(q1))));
+    std::copy(w.begin(), w.end(), a.begin());
+    return a;
+}
+
+// w x w blocks of a 3 x 3 (rotations) or a 6 x 6 (poses)
+Op widen(const Mat3 &A)
+{
+    Op o{};
+    std::copy(A.begin(), A.end(), o.begin());
+    return o;
+}
+Op tangent(Kind kind, const double *xi)
+{
+    return kind == Kind::Pose ? se3::tangent({xi[0], xi[1], xi[2], xi[3], xi[4], xi[5]})
+                              : widen(so3::tangent(vec3(xi)));
+}
+Op tangent_inverse(Kind kind, const double *xi)
+{
+    return kind == Kind::Pose ? se3::tangent_inverse({xi[0], xi[1], xi[2], xi[3], xi[4], xi[5]})
+                              : widen(so3::tangent_inverse(vec3(xi)));
+}
+// Ad_{exp(-xi)}: R(exp(xi))^T on a rotation
+Op transport(Kind kind, const double *xi)
+{
+    return kind == Kind::Pose ? se3::transport({xi[0], xi[1], xi[2], xi[3], xi[4], xi[5]})
+                              : widen(transpose(so3::matrix(so3::exp(vec3(xi)))));
+}
+// ad_v: v~ on a rotation
+Op ad(Kind kind, const double *v)
+{
+    return kind == Kind::Pose ? se3::ad({v[0], v[1], v[2], v[3], v[4], v[5]})
+                              : widen(se3::detail::hat(vec3(v)));
 }
 
 }  // namespace
@@ -109,8 +153,10 @@ void ConfigurationSpace::group_retract(const Vec &q, double e, const Vec &w, Vec
             out.segment(p.q0, p.nv) = q.segment(p.q0, p.nv) + e * w.segment(p.v0, p.nv);
             continue;
         }
-        const double *d = w.data() + p.v0;
-        compose_exp(p.kind, q.data() + p.q0, {e * d[0], e * d[1], e * d[2]}, out.data() + p.q0);
+        Alg d{};
+        for (Eigen::Index k = 0; k < p.nv; ++k)
+            d[static_cast<std::size_t>(k)] = e * w[p.v0 + k];
+        compose_exp(p.kind, q.data() + p.q0, d.data(), out.data() + p.q0);
     }
 }
 
@@ -128,10 +174,10 @@ void ConfigurationSpace::group_taylor(const Vec &q, const Vec &v, const Vec &qdd
                                       (0.5 * h * h) * qdd.segment(p.v0, p.nv);
             continue;
         }
-        Vec3 psi{};
-        for (int k = 0; k < 3; ++k)
-            psi[k] = h * v[p.v0 + k] + 0.5 * h * h * qdd[p.v0 + k];
-        compose_exp(p.kind, q.data() + p.q0, psi, out.data() + p.q0);
+        Alg psi{};
+        for (Eigen::Index k = 0; k < p.nv; ++k)
+            psi[static_cast<std::size_t>(k)] = h * v[p.v0 + k] + 0.5 * h * h * qdd[p.v0 + k];
+        compose_exp(p.kind, q.data() + p.q0, psi.data(), out.data() + p.q0);
     }
 }
 
@@ -143,9 +189,9 @@ void ConfigurationSpace::group_shift(Vec &q_pert, const Vec &q, Eigen::Index j, 
         q_pert[p.q0 + k] = q[p.q0 + k] + e;
         return;
     }
-    Vec3 psi{};
+    Alg psi{};
     psi[static_cast<std::size_t>(k)] = e;
-    compose_exp(p.kind, q.data() + p.q0, psi, q_pert.data() + p.q0);
+    compose_exp(p.kind, q.data() + p.q0, psi.data(), q_pert.data() + p.q0);
 }
 
 void ConfigurationSpace::group_restore(Vec &q_pert, const Vec &q, Eigen::Index j) const
@@ -154,8 +200,7 @@ void ConfigurationSpace::group_restore(Vec &q_pert, const Vec &q, Eigen::Index j
     if (p.kind == Kind::Vector)
         q_pert[p.q0 + j - p.v0] = q[p.q0 + j - p.v0];
     else
-        q_pert.segment(p.q0, p.kind == Kind::Quaternion ? 4 : 9) =
-            q.segment(p.q0, p.kind == Kind::Quaternion ? 4 : 9);
+        q_pert.segment(p.q0, stored(p.kind, p.nv)) = q.segment(p.q0, stored(p.kind, p.nv));
 }
 
 void ConfigurationSpace::group_hermite(const Vec &q_a, const Vec &v_a, const Vec &q_b,
@@ -169,22 +214,32 @@ void ConfigurationSpace::group_hermite(const Vec &q_a, const Vec &v_a, const Vec
                 h01 * q_b.segment(p.q0, p.nv) + (h11 * h) * v_b.segment(p.v0, p.nv);
             continue;
         }
-        const Vec3 xi = relative_log(p.kind, q_a.data() + p.q0, q_b.data() + p.q0);
-        const Mat3 Ti = so3::tangent_inverse(xi);
+        const Alg xi = relative_log(p.kind, q_a.data() + p.q0, q_b.data() + p.q0);
+        const Op Ti = tangent_inverse(p.kind, xi.data());
         const double *va = v_a.data() + p.v0, *vb = v_b.data() + p.v0;
-        Vec3 psi{};
-        for (int k = 0; k < 3; ++k) {
-            const double end = Ti[3 * k] * vb[0] + Ti[3 * k + 1] * vb[1] + Ti[3 * k + 2] * vb[2];
-            psi[k] = (h10 * h) * va[k] + h01 * xi[k] + (h11 * h) * end;
+        const Eigen::Index w = p.nv;
+        Alg psi{};
+        for (Eigen::Index k = 0; k < w; ++k) {
+            double end = 0.0;
+            for (Eigen::Index l = 0; l < w; ++l)
+                end += Ti[static_cast<std::size_t>(w * k + l)] * vb[l];
+            psi[static_cast<std::size_t>(k)] =
+                (h10 * h) * va[k] + h01 * xi[static_cast<std::size_t>(k)] + (h11 * h) * end;
         }
-        compose_exp(p.kind, q_a.data() + p.q0, psi, out.data() + p.q0);
+        compose_exp(p.kind, q_a.data() + p.q0, psi.data(), out.data() + p.q0);
     }
 }
 
+// A pose's translation coordinates scale with its position (the radian of its rotation's)
 double ConfigurationSpace::group_magnitude(const Vec &q, Eigen::Index i) const
 {
     const Part &p = part_of(i);
-    return p.kind == Kind::Vector ? std::fabs(q[p.q0 + i - p.v0]) : 1.0;
+    if (p.kind == Kind::Vector)
+        return std::fabs(q[p.q0 + i - p.v0]);
+    if (p.kind == Kind::Pose && i - p.v0 < 3)
+        return std::sqrt(q[p.q0] * q[p.q0] + q[p.q0 + 1] * q[p.q0 + 1] +
+                         q[p.q0 + 2] * q[p.q0 + 2]);
+    return 1.0;
 }
 
 double ConfigurationSpace::group_distance(const Vec &q1, const Vec &q0, Eigen::Index i) const
@@ -197,29 +252,31 @@ double ConfigurationSpace::group_distance(const Vec &q1, const Vec &q0, Eigen::I
 }
 
 // A tangent vector s at q_n (q_n o exp(e s)) seen at q_n1 = q_n o exp(xi): q_n o exp(e s) o
-// exp(xi) = q_n1 o exp(e Ad_{exp(-xi)} s), Ad_{exp(-xi)} = R(exp(xi))^T on SO(3); an increment
-// d of xi moves q_n1 by T(xi) d (sec. 14, 16).
+// exp(xi) = q_n1 o exp(e Ad_{exp(-xi)} s); an increment d of xi moves q_n1 by T(xi) d (sec.
+// 14, 16).
 void ConfigurationSpace::group_newmark_derivative(const Vec &q_n, const Vec &q_n1, const Vec &s_q,
                                                   const Vec &s_v, const Vec &s_a, const Vec &s_a1,
                                                   double h, double beta, Vec &out) const
 {
     for (const Part &p : parts_) {
-        const Eigen::Index v0 = p.v0, nv = p.nv;
+        const Eigen::Index v0 = p.v0, w = p.nv;
         if (p.kind == Kind::Vector) {
-            out.segment(v0, nv) =
-                s_q.segment(v0, nv) + h * s_v.segment(v0, nv) +
-                (h * h) * ((0.5 - beta) * s_a.segment(v0, nv) + beta * s_a1.segment(v0, nv));
+            out.segment(v0, w) =
+                s_q.segment(v0, w) + h * s_v.segment(v0, w) +
+                (h * h) * ((0.5 - beta) * s_a.segment(v0, w) + beta * s_a1.segment(v0, w));
             continue;
         }
-        const Vec3 xi = relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0);
-        const Mat3 E = so3::matrix(so3::exp(xi)), T = so3::tangent(xi);
-        double d[3];
-        for (int k = 0; k < 3; ++k)
-            d[k] = h * s_v[v0 + k] + (h * h) * ((0.5 - beta) * s_a[v0 + k] + beta * s_a1[v0 + k]);
-        for (int i = 0; i < 3; ++i) {
+        const Alg xi = relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0);
+        const Op A = transport(p.kind, xi.data()), T = tangent(p.kind, xi.data());
+        Alg d{};
+        for (Eigen::Index k = 0; k < w; ++k)
+            d[static_cast<std::size_t>(k)] =
+                h * s_v[v0 + k] + (h * h) * ((0.5 - beta) * s_a[v0 + k] + beta * s_a1[v0 + k]);
+        for (Eigen::Index i = 0; i < w; ++i) {
             double r = 0.0;
-            for (int k = 0; k < 3; ++k)
-                r += E[3 * k + i] * s_q[v0 + k] + T[3 * i + k] * d[k];
+            for (Eigen::Index k = 0; k < w; ++k)
+                r += A[static_cast<std::size_t>(w * i + k)] * s_q[v0 + k] +
+                     T[static_cast<std::size_t>(w * i + k)] * d[static_cast<std::size_t>(k)];
             out[v0 + i] = r;
         }
     }
@@ -229,19 +286,24 @@ void ConfigurationSpace::group_tangent(const Vec &q_n, const Vec &q_n1, const Ve
                                        bool transposed) const
 {
     for (const Part &p : parts_) {
+        const Eigen::Index w = p.nv;
         if (p.kind == Kind::Vector) {
             if (!transposed)
-                out.segment(p.v0, p.nv) += d.segment(p.v0, p.nv);
+                out.segment(p.v0, w) += d.segment(p.v0, w);
             else if (&out != &d)
-                out.segment(p.v0, p.nv) = d.segment(p.v0, p.nv);
+                out.segment(p.v0, w) = d.segment(p.v0, w);
             continue;
         }
-        const Mat3 T = so3::tangent(relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0));
-        const double x[3] = {d[p.v0], d[p.v0 + 1], d[p.v0 + 2]};
-        for (int i = 0; i < 3; ++i) {
+        const Alg xi = relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0);
+        const Op T = tangent(p.kind, xi.data());
+        Alg x{};
+        for (Eigen::Index k = 0; k < w; ++k)
+            x[static_cast<std::size_t>(k)] = d[p.v0 + k];
+        for (Eigen::Index i = 0; i < w; ++i) {
             double r = 0.0;
-            for (int k = 0; k < 3; ++k)
-                r += (transposed ? T[3 * k + i] : T[3 * i + k]) * x[k];
+            for (Eigen::Index k = 0; k < w; ++k)
+                r += T[static_cast<std::size_t>(transposed ? w * k + i : w * i + k)] *
+                     x[static_cast<std::size_t>(k)];
             if (transposed)
                 out[p.v0 + i] = r;
             else
@@ -255,23 +317,35 @@ void ConfigurationSpace::group_transport_transpose(const Vec &q_n, const Vec &q_
     for (const Part &p : parts_) {
         if (p.kind == Kind::Vector)
             continue;
-        // (Ad_{exp(-xi)})^T = R(exp(xi))
-        const Mat3 E =
-            so3::matrix(so3::exp(relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0)));
-        const double x[3] = {m[p.v0], m[p.v0 + 1], m[p.v0 + 2]};
-        for (int i = 0; i < 3; ++i)
-            m[p.v0 + i] = E[3 * i] * x[0] + E[3 * i + 1] * x[1] + E[3 * i + 2] * x[2];
+        const Eigen::Index w = p.nv;
+        const Alg xi = relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0);
+        const Op A = transport(p.kind, xi.data());
+        Alg x{};
+        for (Eigen::Index k = 0; k < w; ++k)
+            x[static_cast<std::size_t>(k)] = m[p.v0 + k];
+        for (Eigen::Index i = 0; i < w; ++i) {
+            double r = 0.0;
+            for (Eigen::Index k = 0; k < w; ++k)
+                r += A[static_cast<std::size_t>(w * k + i)] * x[static_cast<std::size_t>(k)];
+            m[p.v0 + i] = r;
+        }
     }
 }
 
+// out += c (-ad_u^T g): u x g on a rotation
 void ConfigurationSpace::add_cross(double c, const Vec &u, const Vec &g, Vec &out) const
 {
     for (const Part &p : parts_) {
         if (p.kind == Kind::Vector)
             continue;
-        const Vec3 x = so3::cross(vec3(u.data() + p.v0), vec3(g.data() + p.v0));
-        for (int k = 0; k < 3; ++k)
-            out[p.v0 + k] += c * x[static_cast<std::size_t>(k)];
+        const Eigen::Index w = p.nv;
+        const Op A = ad(p.kind, u.data() + p.v0);
+        for (Eigen::Index i = 0; i < w; ++i) {
+            double r = 0.0;
+            for (Eigen::Index k = 0; k < w; ++k)
+                r += A[static_cast<std::size_t>(w * k + i)] * g[p.v0 + k];
+            out[p.v0 + i] -= c * r;
+        }
     }
 }
 
@@ -282,8 +356,8 @@ void ConfigurationSpace::increment_between(const Vec &q_n, const Vec &q_n1, Vec 
             xi.segment(p.v0, p.nv) = q_n1.segment(p.q0, p.nv) - q_n.segment(p.q0, p.nv);
             continue;
         }
-        const Vec3 x = relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0);
-        for (int k = 0; k < 3; ++k)
+        const Alg x = relative_log(p.kind, q_n.data() + p.q0, q_n1.data() + p.q0);
+        for (Eigen::Index k = 0; k < p.nv; ++k)
             xi[p.v0 + k] = x[static_cast<std::size_t>(k)];
     }
 }
@@ -294,13 +368,19 @@ void ConfigurationSpace::right_multiply_tangent(const Vec &xi, double *A, Eigen:
     for (const Part &p : parts_) {
         if (p.kind == Kind::Vector)
             continue;
-        const Mat3 T = so3::tangent(vec3(xi.data() + p.v0));
-        double *c0 = A + p.v0 * ld, *c1 = c0 + ld, *c2 = c1 + ld;
+        const Eigen::Index w = p.nv;
+        const Op T = tangent(p.kind, xi.data() + p.v0);
+        double *c = A + p.v0 * ld;
         for (Eigen::Index r = 0; r < rows; ++r) {
-            const double a0 = c0[r], a1 = c1[r], a2 = c2[r];
-            c0[r] = a0 * T[0] + a1 * T[3] + a2 * T[6];
-            c1[r] = a0 * T[1] + a1 * T[4] + a2 * T[7];
-            c2[r] = a0 * T[2] + a1 * T[5] + a2 * T[8];
+            Alg a{};
+            for (Eigen::Index k = 0; k < w; ++k)
+                a[static_cast<std::size_t>(k)] = c[r + k * ld];
+            for (Eigen::Index j = 0; j < w; ++j) {
+                double s = 0.0;
+                for (Eigen::Index k = 0; k < w; ++k)
+                    s += a[static_cast<std::size_t>(k)] * T[static_cast<std::size_t>(w * k + j)];
+                c[r + j * ld] = s;
+            }
         }
     }
 }
@@ -319,25 +399,27 @@ int ConfigurationSpace::rotation_of(Eigen::Index j, int *local) const
 
 void ConfigurationSpace::rotation_tangents(const Vec &xi, double *T) const
 {
-    for (std::size_t r = 0; r < rotation_part_.size(); ++r) {
-        const Mat3 t = so3::tangent(vec3(xi.data() + parts_[rotation_part_[r]].v0));
-        std::copy(t.begin(), t.end(), T + 9 * r);
+    for (const int pi : rotation_part_) {
+        const Part &p = parts_[pi];
+        const Op t = tangent(p.kind, xi.data() + p.v0);
+        std::copy(t.begin(), t.begin() + p.nv * p.nv, T);
+        T += p.nv * p.nv;
     }
 }
 
+// Z <- Z + J (-ad_v) on each group block's columns: Z w += J [w, v], [w, v] = -ad_v w
 void ConfigurationSpace::add_bracket(const Vec &v, const double *J, Eigen::Index rows,
                                      double *Z) const
 {
     for (const Part &p : parts_) {
         if (p.kind == Kind::Vector)
             continue;
-        // w x v = -v~ w: column k of J (-v~) is -sum_l J_l (v~)_{lk}
-        const double *w = v.data() + p.v0;
-        const Mat3 vh{0.0, -w[2], w[1], w[2], 0.0, -w[0], -w[1], w[0], 0.0};
-        for (int k = 0; k < 3; ++k) {
+        const Eigen::Index w = p.nv;
+        const Op A = ad(p.kind, v.data() + p.v0);
+        for (Eigen::Index k = 0; k < w; ++k) {
             double *z = Z + (p.v0 + k) * rows;
-            for (int l = 0; l < 3; ++l) {
-                const double c = vh[3 * l + k];
+            for (Eigen::Index l = 0; l < w; ++l) {
+                const double c = A[static_cast<std::size_t>(w * l + k)];
                 if (c == 0.0)
                     continue;
                 const double *jl = J + (p.v0 + l) * rows;
@@ -352,13 +434,15 @@ Eigen::Index ConfigurationSpace::invalid_rotation(const double *q) const
 {
     constexpr double kTol = 1e-6;
     for (const Part &p : parts_) {
-        const double *b = q + p.q0;
-        if (p.kind == Kind::Quaternion) {
+        if (p.kind == Kind::Quaternion || p.kind == Kind::Pose) {
+            const Eigen::Index at = p.kind == Kind::Pose ? p.q0 + 3 : p.q0;
+            const double *b = q + at;
             const double n = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3]);
             if (!(std::fabs(n - 1.0) <= kTol))
-                return p.q0;
+                return at;
         } else if (p.kind == Kind::Matrix) {
-            const Mat3 R = load_matrix(b), RtR = multiply(transpose(R), R);
+            const double *b = q + p.q0;
+            const Mat3 R = load_matrix(b), RtR = mul(transpose(R), R);
             double off = 0.0;
             for (int i = 0; i < 3; ++i)
                 for (int j = 0; j < 3; ++j)

@@ -29,16 +29,21 @@ namespace ga {
 
 class ConfigurationSpace {
 public:
-    enum class Kind : unsigned char { Vector, Quaternion, Matrix };
+    // Pose: SE(3), a position and a quaternion (7 numbers), a twist (u, w) in v
+    enum class Kind : unsigned char { Vector, Quaternion, Matrix, Pose };
     struct Block {
         Kind kind;
-        Eigen::Index nv;  // v's coordinates: 3 for a rotation
+        Eigen::Index nv;  // v's coordinates: 3 for a rotation, 6 for a pose
     };
     // Storage of one block's q
-    static Eigen::Index stored(const Block &b)
+    static Eigen::Index stored(Kind kind, Eigen::Index nv)
     {
-        return b.kind == Kind::Vector ? b.nv : b.kind == Kind::Quaternion ? 4 : 9;
+        return kind == Kind::Vector ? nv
+               : kind == Kind::Quaternion ? 4
+               : kind == Kind::Matrix     ? 9
+                                          : 7;
     }
+    static Eigen::Index stored(const Block &b) { return stored(b.kind, b.nv); }
 
     explicit ConfigurationSpace(Eigen::Index n) : nq_(n), nv_(n) {}
     // The product of the blocks in order; of vector blocks only, R^n (the space above).
@@ -47,6 +52,7 @@ public:
     Eigen::Index nq() const { return nq_; }
     Eigen::Index nv() const { return nv_; }
     bool euclidean() const { return parts_.empty(); }
+    // The group blocks (rotations and poses), numbered 0, 1, ... in order
     Eigen::Index rotations() const { return rotations_; }
 
     // ---- group blocks (configuration_space.cpp); never called on R^n ----
@@ -69,19 +75,20 @@ public:
     // dimension ld): the q-columns of K_t and Phi_q in the iteration matrix (sec. 14)
     void right_multiply_tangent(const Vec &xi, double *A, Eigen::Index rows,
                                 Eigen::Index ld) const;
-    // The rotation (0, 1, ... in order) that v coordinate j belongs to, and j's place in it
-    // (0..2) in *local; -1 for a vector coordinate. (The sparse path's expanded patterns.)
+    // The group block (0, 1, ... in order) that v coordinate j belongs to, and j's place in
+    // it in *local; -1 for a vector coordinate. (The sparse path's expanded patterns.)
     int rotation_of(Eigen::Index j, int *local) const;
-    // The first v coordinate of rotation r
+    // The first v coordinate of group block r, and its width (3 or 6)
     Eigen::Index rotation_start(int r) const { return parts_[rotation_part_[r]].v0; }
-    // T(xi) of every rotation in order, 9 numbers each, row-major, into T
+    int rotation_width(int r) const { return static_cast<int>(parts_[rotation_part_[r]].nv); }
+    // T(xi) of every group block in order, width^2 numbers each, row-major, into T
     void rotation_tangents(const Vec &xi, double *T) const;
     // Z <- Z + J ad(., v) on the rotations' columns (J, Z: rows x nv, column-major, ld =
     // rows): Z w += J [w, v] with [w, v] = w x v on each rotation
     void add_bracket(const Vec &v, const double *J, Eigen::Index rows, double *Z) const;
     // The first rotation block whose storage is not a rotation (a quaternion's norm, a
     // matrix's orthonormality or determinant off by more than 1e-6), as the index of its
-    // first coordinate in q; -1 if none.
+    // first coordinate in q (a pose's quaternion's); -1 if none.
     Eigen::Index invalid_rotation(const double *q) const;
 
     // eq. (4) on a segment: q = q_n + h v_n + h^2 ((1/2 - beta) a_n + beta a)

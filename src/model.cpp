@@ -71,7 +71,7 @@ void ColumnGroups::build(const ModelMatrix &A, const ConfigurationSpace *space)
         int local = 0;
         const int rotation = space ? space->rotation_of(j, &local) : -1;
         if (rotation >= 0)
-            for (int l = 0; l < 3; ++l) {
+            for (int l = 0; l < space->rotation_width(rotation); ++l) {
                 const int jj = static_cast<int>(space->rotation_start(rotation)) + l;
                 if (color[jj] >= 0)
                     forbidden[color[jj]] = j;

@@ -7,7 +7,13 @@ namespace ga {
 
 void TangentProduct::setup(const ModelMatrix &A, const ConfigurationSpace &space)
 {
-    T_.assign(9 * static_cast<std::size_t>(space.rotations()), 0.0);
+    offset_.assign(static_cast<std::size_t>(space.rotations()), 0);
+    std::size_t size = 0;
+    for (int r = 0; r < space.rotations(); ++r) {
+        offset_[static_cast<std::size_t>(r)] = static_cast<int>(size);
+        size += static_cast<std::size_t>(space.rotation_width(r) * space.rotation_width(r));
+    }
+    T_.assign(size, 0.0);
     if (A.dense()) {
         out_.copy_layout(A);
         return;
@@ -35,13 +41,14 @@ void TangentProduct::setup(const ModelMatrix &A, const ConfigurationSpace &space
         const bool fresh = p == 0 || std::get<0>(keys[p - 1]) != c0 ||
                            std::get<1>(keys[p - 1]) != row;
         if (fresh) {
-            const int width = rotation_[k] < 0 ? 1 : 3;
+            const int width = rotation_[k] < 0 ? 1 : space.rotation_width(rotation_[k]);
             for (int w = 0; w < width; ++w) {
                 rows.push_back(row);
                 cols.push_back(c0 + w);
             }
         }
-        target_[k] = static_cast<int>(rows.size()) - (rotation_[k] < 0 ? 1 : 3);
+        target_[k] = static_cast<int>(rows.size()) -
+                     (rotation_[k] < 0 ? 1 : space.rotation_width(rotation_[k]));
     }
     out_.set_pattern(A.rows(), A.cols(), rows.data(), cols.data(), static_cast<int>(rows.size()));
     out_.allocate();
@@ -67,8 +74,9 @@ void TangentProduct::apply(const ModelMatrix &A, const Vec *xi, const Configurat
         } else if (!xi) {
             o[target_[k] + local_[k]] += a[k];
         } else {  // (A T)_{i, c} = sum_l A_{i, l} T_{l, c}: row local_ of T
-            const double *t = T_.data() + 9 * r + 3 * local_[k];
-            for (int c = 0; c < 3; ++c)
+            const int w = space.rotation_width(r);
+            const double *t = T_.data() + offset_[r] + w * local_[k];
+            for (int c = 0; c < w; ++c)
                 o[target_[k] + c] += a[k] * t[c];
         }
     }

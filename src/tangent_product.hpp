@@ -1,8 +1,8 @@
 // ga::TangentProduct: A T(xi), a user matrix times the tangent operator on the columns of the
 // rotations (docs/algorithms.md sec. 14, 16) -- K_t, Phi_q and Z where the step's q moves as
 // q_n o exp(xi). Dense: a copy, multiplied in place. With a declared pattern: every entry in
-// a rotation's column spreads over the three columns of that rotation, so the product has the
-// expanded pattern (whole 3-column blocks), fixed at setup; each refactorization scatters the
+// a rotation's column spreads over the columns of that rotation (3; a pose's 6), so the product
+// has the expanded pattern (whole column blocks), fixed at setup; each refactorization scatters the
 // entries with T's coefficients (no allocation, linear in the entries).
 #pragma once
 
@@ -23,10 +23,11 @@ public:
 
 private:
     ModelMatrix out_;
-    // per entry of A: its first target in out_ (the rotation's three columns are consecutive
-    // entries there), the rotation it is in (-1: a vector column, one target) and its place
+    // per entry of A: its first target in out_ (the group block's columns are consecutive
+    // entries there), the block it is in (-1: a vector column, one target) and its place
     std::vector<int> target_, rotation_, local_;
-    std::vector<double> T_;  // 9 per rotation
+    std::vector<double> T_;      // width^2 per group block, from offset_[block]
+    std::vector<int> offset_;
 };
 
 }  // namespace ga
