@@ -9,7 +9,9 @@
  * constraint, a q-dependent mass matrix, its constraint acceleration term given) in index 3
  * and index 2; the top on R^3 x SO(3) (examples/scenes/lie_top.h: nq = 7, nv = 6, the joint
  * as 3 constraints) in index 3 and index 2, with differences for its tangents or with its
- * exact K_t and C_t; the top on SO(3) alone about its pivot (nq = 4, nv = 3, no constraint).
+ * exact K_t and C_t; the top on SO(3) alone about its pivot (nq = 4, nv = 3, no constraint);
+ * the top on SE(3) (lie_top_se3_*: nq = 7, nv = 6, the joint as 3 constraints, exact
+ * tangents; index 2 gives the same numbers there, the joint being linear in the increment).
  * Errors against lie_top_reference (RK4, 400 000 steps).
  *
  *   lie_top_cost [rounds]   -> CSV on stdout:
@@ -28,12 +30,12 @@
 #include "rounds.h"
 #include "scenes/lie_top.h"
 
-enum { FORMULATIONS = 7, MODES = 2, TARGETS = 2, MAX_ROUNDS = 64, PIVOT = 6 };
+enum { FORMULATIONS = 8, MODES = 2, TARGETS = 2, MAX_ROUNDS = 64, PIVOT = 6, SE3 = 7 };
 
 static const char *const NAMES[FORMULATIONS] = {
     "euler_parameters_index3", "euler_parameters_index2", "r3so3_index3",
     "r3so3_index2",            "r3so3_exact_index3",      "r3so3_exact_index2",
-    "so3_pivot"};
+    "so3_pivot",               "se3_exact_index3"};
 static const char *const MODE_NAMES[MODES] = {"fixed", "adaptive"};
 static const double TARGET[TARGETS] = {1e-3, 1e-5};
 static const double T_END = 2.0;
@@ -77,6 +79,14 @@ static outcome run(int f, int mode, double setting)
         const double one[4] = {1.0, 0.0, 0.0, 0.0};
         memcpy(q, one, sizeof one);
         memcpy(v, lt.omega0, 3 * sizeof(double));
+    } else if (f == SE3) {
+        const int kinds[1] = {GA_SPACE_SE3}, counts[1] = {1};
+        if (ga_create_space(1, kinds, counts, LIE_TOP_M, &s) ||
+            ga_set_callbacks(s, lie_top_mass, lie_top_se3_force, lie_top_se3_constraint,
+                             lie_top_se3_jacobian, &lt) ||
+            ga_set_tangents(s, lie_top_se3_stiffness, lie_top_se3_damping))
+            return o;
+        lie_top_se3_initial(&lt, q, v);
     } else {
         int kinds[2], counts[2];
         lie_top_blocks(&lt, kinds, counts);
@@ -88,7 +98,7 @@ static outcome run(int f, int mode, double setting)
             return o;
         lie_top_initial(&lt, q, v);
     }
-    const int index2 = f % 2 == 1 && f != PIVOT;
+    const int index2 = f == 1 || f == 3 || f == 5;
     if (ga_set_formulation(s, index2 ? GA_INDEX2_STABILIZED : GA_INDEX3) ||
         (mode == 1 && ga_set_tolerances(s, setting, setting))) {
         ga_free(s);

@@ -343,6 +343,15 @@ ga_status Stepper::load_checkpoint(const double *buf, bool internal, bool keep_m
 ga_status Stepper::rebuild_matrix()
 {
     const MatrixRecipe &r = recipe_;
+    // A recipe whose tangent this workspace holds no storage for (the sparse path keeps no
+    // dense K_t or C_t it did not need at setup; the callbacks changed since, or the
+    // checkpoint came from another solver): no rebuild, a fresh matrix (the caller's choice)
+    const auto unheld = [](const ModelMatrix &A) {
+        return A.dense() && A.size() != static_cast<Eigen::Index>(A.rows()) * A.cols();
+    };
+    if ((r.K && unheld(K_)) || (r.C && unheld(C_)))
+        return diag.fail(GA_ERR_STATE, "the checkpoint's kept matrix holds %s, for which this "
+                         "solver's sparse path has no pattern", r.K && unheld(K_) ? "K_t" : "C_t");
     State &x = trial_;  // scratch between steps
     x.q = r.q;
     x.v = r.v;

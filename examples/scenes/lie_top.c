@@ -294,3 +294,109 @@ lie_top_state lie_top_reference(const lie_top *t, double t_end, long steps)
         r.reaction[i] = t->mass * (t->g[i] - acc[i]);
     return r;
 }
+
+/* ---- the top on SE(3) ---- */
+
+static void hat(const double *a, double A[9]) /* row-major a~ */
+{
+    const double M[9] = {0, -a[2], a[1], a[2], 0, -a[0], -a[1], a[0], 0};
+    memcpy(A, M, sizeof M);
+}
+
+void lie_top_se3_initial(const lie_top *t, double *q0, double *v0)
+{
+    lie_top_initial(t, q0, v0); /* x = X, R = I; x' = omega x X = U at R = I */
+}
+
+int lie_top_se3_force(double time, const double *q, const double *v, double *f, void *user)
+{
+    (void)time;
+    const lie_top *t = user;
+    double R[9], mg[3], gb[3], wU[3], Jw[3], wJw[3];
+    lie_top_rotation(t, q, R);
+    const double *U = v, *w = v + 3;
+    for (int i = 0; i < 3; ++i)
+        mg[i] = t->mass * t->g[i];
+    rotate_back(R, mg, gb);
+    cross(w, U, wU);
+    for (int i = 0; i < 3; ++i)
+        Jw[i] = t->Jc[i] * w[i];
+    cross(w, Jw, wJw);
+    for (int i = 0; i < 3; ++i) {
+        f[i] = gb[i] - t->mass * wU[i];
+        f[3 + i] = -wJw[i];
+    }
+    return 0;
+}
+
+int lie_top_se3_constraint(double time, const double *q, double *phi, void *user)
+{
+    (void)time;
+    const lie_top *t = user;
+    double R[9], y[3];
+    lie_top_rotation(t, q, R);
+    rotate_back(R, q, y);
+    for (int i = 0; i < 3; ++i)
+        phi[i] = y[i] - t->X[i];
+    return 0;
+}
+
+/* d/de of exp(-e w~) R^T (x + e R u) = u - w x y = u + y~ w, y = R^T x */
+int lie_top_se3_jacobian(double time, const double *q, double *Phi_q, void *user)
+{
+    (void)time;
+    const lie_top *t = user;
+    double R[9], y[3], Y[9];
+    lie_top_rotation(t, q, R);
+    rotate_back(R, q, y);
+    hat(y, Y);
+    memset(Phi_q, 0, 18 * sizeof(double));
+    for (int i = 0; i < 3; ++i) {
+        Phi_q[i + 3 * i] = 1.0;
+        for (int j = 0; j < 3; ++j)
+            Phi_q[i + 3 * (3 + j)] = Y[3 * i + j];
+    }
+    return 0;
+}
+
+int lie_top_se3_stiffness(double time, const double *q, const double *v, const double *qdd,
+                          const double *lambda, double *K, void *user)
+{
+    (void)time, (void)v, (void)qdd;
+    const lie_top *t = user;
+    double R[9], y[3], mg[3], gb[3], G[9], L[9], Y[9];
+    lie_top_rotation(t, q, R);
+    rotate_back(R, q, y);
+    for (int i = 0; i < 3; ++i)
+        mg[i] = t->mass * t->g[i];
+    rotate_back(R, mg, gb);
+    hat(gb, G);
+    hat(lambda, L);
+    hat(y, Y);
+    memset(K, 0, 36 * sizeof(double));
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            double LY = 0.0;
+            for (int k = 0; k < 3; ++k)
+                LY += L[3 * i + k] * Y[3 * k + j];
+            K[i + 6 * (3 + j)] = -G[3 * i + j];
+            K[(3 + i) + 6 * j] = L[3 * i + j];
+            K[(3 + i) + 6 * (3 + j)] = LY;
+        }
+    return 0;
+}
+
+int lie_top_se3_damping(double time, const double *q, const double *v, double *C, void *user)
+{
+    lie_top_damping(time, q, v, C, user); /* the (w, w) block, zeros elsewhere */
+    const lie_top *t = user;
+    double W[9], Uh[9];
+    hat(v + 3, W);
+    hat(v, Uh);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            C[i + 6 * j] = t->mass * W[3 * i + j];
+            C[i + 6 * (3 + j)] = -t->mass * Uh[3 * i + j];
+        }
+    return 0;
+}

@@ -57,7 +57,23 @@ int lie_top_damping(double time, const double *q, const double *v, double *C, vo
 int lie_top_pivot_mass(double time, const double *q, double *M, void *user);
 int lie_top_pivot_force(double time, const double *q, const double *v, double *f, void *user);
 
-/* Energy, vertical angular momentum about the pivot, spin omega_2, from q and v */
+/* The same top on SE(3) (ga_create_space({SE3 1}, m = 3): nq = 7, nv = 6; use
+ * lie_top_make(0)): q = (x, R's quaternion) as on R^3 x SO(3), v = (U, omega) the body twist,
+ * U = R^T x'. The joint as Phi = R^T x - X, Phi_q = [I, (R^T x)~]; M = diag(m I, J_c) as
+ * lie_top_mass; f = (R^T m g - m omega x U, -omega x J_c omega). The multiplier is the
+ * reaction in the body frame (R lambda in space). */
+void lie_top_se3_initial(const lie_top *t, double *q0, double *v0);
+int lie_top_se3_force(double time, const double *q, const double *v, double *f, void *user);
+int lie_top_se3_constraint(double time, const double *q, double *phi, void *user);
+int lie_top_se3_jacobian(double time, const double *q, double *Phi_q, void *user);
+/* K_t of -f + Phi_q^T lambda along right increments: -(R^T m g)~ (u rows, w columns),
+ * lambda~ (w rows, u columns), lambda~ (R^T x)~ (w rows, w columns) */
+int lie_top_se3_stiffness(double time, const double *q, const double *v, const double *qdd,
+                          const double *lambda, double *K, void *user);
+/* C_t = -df/dv: m omega~ (u, u), -m U~ (u, w), omega~ J - (J omega)~ (w, w) */
+int lie_top_se3_damping(double time, const double *q, const double *v, double *C, void *user);
+/* Energy, vertical angular momentum about the pivot, spin omega_2, from q and v (any of the
+ * formulations with a quaternion at q + 3 and omega at v + 3: they use the rotation only) */
 void lie_top_invariants(const lie_top *t, const double *q, const double *v, double out[3]);
 
 /* The reference at t_end by RK4 with `steps` steps: R (row-major), omega, omega', and from

@@ -1083,6 +1083,99 @@ static void test_sparse_path_refusals(void **state)
     ga_free(z);
 }
 
+/* ---- the top on SE(3) (lie_top_se3_*): the same motion, another group ---- */
+
+static ga_solver *se3_solver(lie_top *t, int formulation)
+{
+    const int kinds[1] = {GA_SPACE_SE3}, counts[1] = {1};
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create_space(1, kinds, counts, LIE_TOP_M, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, lie_top_mass, lie_top_se3_force, lie_top_se3_constraint,
+                                      lie_top_se3_jacobian, t),
+                     GA_OK);
+    assert_int_equal(ga_set_tangents(s, lie_top_se3_stiffness, lie_top_se3_damping), GA_OK);
+    assert_int_equal(ga_set_formulation(s, formulation), GA_OK);
+    return s;
+}
+
+/* centre of mass x, omega, and the reaction in space R lambda */
+static top_result se3_run(int formulation, double h, double t_end)
+{
+    lie_top t = lie_top_make(0);
+    ga_solver *s = se3_solver(&t, formulation);
+    double q[7], v[6], lambda[3], R[9];
+    lie_top_se3_initial(&t, q, v);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    top_result r = {GA_OK, {0}, {0}, {0}, 0.0, 0, 0};
+    const long n = lround(t_end / h);
+    for (long k = 0; k < n && r.st == GA_OK; ++k)
+        r.st = ga_step(s, h);
+    read_result(s, &r);
+    assert_int_equal(ga_get_q(s, q), GA_OK);
+    assert_int_equal(ga_get_lambda(s, lambda), GA_OK);
+    lie_top_rotation(&t, q, R);
+    for (int i = 0; i < 3; ++i)
+        r.reaction[i] = R[3 * i] * lambda[0] + R[3 * i + 1] * lambda[1] + R[3 * i + 2] * lambda[2];
+    ga_free(s);
+    return r;
+}
+
+static void test_se3_callbacks_are_their_derivatives(void **state)
+{
+    (void)state;
+    lie_top t = lie_top_make(0);
+    ga_solver *s = se3_solver(&t, GA_INDEX3);
+    double q[7], v[6], worst = 0.0;
+    lie_top_se3_initial(&t, q, v);
+    const double psi[3] = {0.3, -0.2, 0.5};
+    assert_int_equal(ga_so3_exp(1, psi, q + 3), GA_OK);
+    q[0] += 0.1; /* off the joint: Phi_q's (R^T x)~ block is checked where R^T x != X */
+    const double qdd[6] = {0.1, 0.2, 0.3, 1.0, -2.0, 3.0}, lambda[3] = {20.0, -30.0, 140.0};
+    const ga_status st = ga_check_derivatives(s, 0.0, q, v, qdd, lambda, NULL, 1e-6, &worst);
+    if (st)
+        print_error("%s\n", ga_last_error(s));
+    assert_int_equal(st, GA_OK);
+    print_message("  largest relative difference %.2e\n", worst);
+    ga_free(s);
+}
+
+static void se3_order_two(int formulation)
+{
+    const lie_top_state ref = checked_reference(2.0);
+    double h[4], e_com[4], e_omega[4], e_reaction[4];
+    for (int i = 0; i < 4; ++i) {
+        h[i] = 1e-3 / (1 << i);
+        const top_result r = se3_run(formulation, h[i], 2.0);
+        assert_int_equal(r.st, GA_OK);
+        e_com[i] = max_diff(r.com, ref.com);
+        e_omega[i] = max_diff(r.omega, ref.omega);
+        e_reaction[i] = max_diff(r.reaction, ref.reaction);
+        print_message("  SE(3) %s h = %.3e: centre of mass %.3e, omega %.3e, reaction %.3e, "
+                      "%.2f Newton iterations per step\n",
+                      formulation == GA_INDEX3 ? "index 3" : "index 2", h[i], e_com[i],
+                      e_omega[i], e_reaction[i], (double)r.newton / (double)r.steps);
+    }
+    const double p[3] = {fit_order(h, e_com, 4), fit_order(h, e_omega, 4),
+                         fit_order(h, e_reaction, 4)};
+    print_message("  orders: centre of mass %.3f, omega %.3f, reaction %.3f\n", p[0], p[1], p[2]);
+    for (int k = 0; k < 3; ++k) {
+        assert_true(p[k] > 1.9);
+        assert_true(p[k] < 2.1);
+    }
+}
+
+static void test_se3_order_two_index3(void **state)
+{
+    (void)state;
+    se3_order_two(GA_INDEX3);
+}
+
+static void test_se3_order_two_index2(void **state)
+{
+    (void)state;
+    se3_order_two(GA_INDEX2_STABILIZED);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1105,6 +1198,9 @@ int main(void)
         cmocka_unit_test(test_what_rotations_do_not_offer_is_refused),
         cmocka_unit_test(test_sparse_path_is_the_dense_one),
         cmocka_unit_test(test_sparse_path_refusals),
+        cmocka_unit_test(test_se3_callbacks_are_their_derivatives),
+        cmocka_unit_test(test_se3_order_two_index3),
+        cmocka_unit_test(test_se3_order_two_index2),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
