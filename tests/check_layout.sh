@@ -33,7 +33,7 @@ fi
 # (q itself, not a sensitivity's tangent s.q: "q +=", "x.q = s.q + h * s.v ...", "q + e * v",
 # "q[j] + e"; comments aside)
 q_sites=$(grep -nE '(^|[^.[:alnum:]_])q(\.segment\([^)]*\))? \+= |\.q = [a-z_0-9]*\.q \+ [a-z_]* \* [a-z_0-9]*\.?v|\.q \+= [a-z_]*\.(d|bt|cbt)\b|(^|[^.[:alnum:]_])q [+-] [a-z_]* \* v\b|\bq\[[a-z]\] [+-] [a-z_]' \
-    "$src"/*.cpp "$src"/*.hpp | grep -v 'configuration_space.hpp' | grep -vE '^[^:]+:[0-9]+:\s*//' || true)
+    "$src"/*.cpp "$src"/*.hpp | grep -vE 'configuration_space\.(hpp|cpp)' | grep -vE '^[^:]+:[0-9]+:\s*//' || true)
 if [ -n "$q_sites" ]; then
     echo "q moved outside the configuration space:"; echo "$q_sites"; status=1
 fi
