@@ -194,15 +194,16 @@ typedef enum {
 } ga_space_kind;
 
 /** Create a solver whose configuration is a product of blocks, block i of kind kinds[i]
- *  holding counts[i] coordinates (GA_SPACE_VECTOR) or counts[i] rotations in a row (the
- *  SO(3) kinds), and m constraints. Rotations move on the group, by right increments with
- *  body-frame angular velocities, q_{n+1} = q_n o exp(xi) (the conventions of the rotation
- *  maps below; docs/algorithms.md sec. 14): no unit-norm constraint, and no Euler parameters'
- *  velocities.
+ *  holding counts[i] coordinates (GA_SPACE_VECTOR), counts[i] rotations in a row (the SO(3)
+ *  kinds) or counts[i] poses (GA_SPACE_SE3), and m constraints. Rotations and poses move on
+ *  the group, by right increments with body-frame velocities, q_{n+1} = q_n o exp(xi) (the
+ *  conventions of the rotation and pose maps below; docs/algorithms.md sec. 14, 16): no
+ *  unit-norm constraint, and no Euler parameters' velocities.
  *
  *  Storage and algebra: q (ga_init's q0, ga_get_q, ga_interpolate, every callback's q) holds
  *  nq numbers, the blocks' storage in order; v, qdd, a, f and everything shaped like them hold
- *  nv, 3 per rotation (the body-frame angular velocity and its rate). So do the rows of M, C_t
+ *  nv, 3 per rotation (the body-frame angular velocity and its rate) and 6 per pose (the
+ *  body-frame twist (u, w) and its rate). So do the rows of M, C_t
  *  and K_t and the columns of Phi_q: Phi_q and K_t are derivatives along right increments,
  *  Phi_q w = d/de Phi(q o exp(e w)) at e = 0 and K_t likewise of M qdd - f + Phi_q^T lambda
  *  (on a vector block the ordinary ones); build them with the maps below. ga_get_size's n is
@@ -1201,6 +1202,34 @@ GA_API ga_status ga_so3_tangent(long count, const double *psi, double *T);
  *  and carry a relative error of about eps / (2 pi - |psi|) there (the increments of a step
  *  stay far below pi). */
 GA_API ga_status ga_so3_tangent_inverse(long count, const double *psi, double *T);
+/**@}*/
+
+/** @name Poses: SE(3) as a position and a unit quaternion
+ *  The special Euclidean group's maps, in the conventions of GA_SPACE_SE3 blocks:
+ *  - a pose is 7 numbers (x, q): the position x of the body's origin in space, then its
+ *    rotation as a unit quaternion (w, x, y, z), as ga_so3_* take it;
+ *  - a twist xi = (u, w) is 6 numbers, the body-frame translation u first, then the rotation w;
+ *  - increments are right: (x, R) o exp(u, w) = (x + R V(w) u, R exp(w)), V(w) = T_SO3(w)^T;
+ *    exp(u, w) is (V(w) u, exp(w)), and compose is (xa, Ra) o (xb, Rb) = (xa + Ra xb, Ra Rb);
+ *  - the tangent operator T(xi) (exp(xi + d) = exp(xi) o exp(T(xi) d + O(|d|^2))) is
+ *    [T_SO3(w), C(u, w); 0, T_SO3(w)], C the series sum_k (-1)^k U_k / (k+1)! of the
+ *    off-diagonal blocks U_k of ad_xi^k, ad_xi = [w~ u~; 0 w~] (docs/algorithms.md sec. 16).
+ *
+ *  Arrays, counts, in-place use and errors as for ga_so3_*: twists 6 doubles, poses 7,
+ *  matrices 6 x 6 column-major (36); GA_ERR_ARG (nothing written) also for a pose whose
+ *  quaternion is not of unit norm within 1e-6 (ga_se3_log, ga_se3_compose) and |w| >= 2 pi in
+ *  ga_se3_tangent_inverse. */
+/**@{*/
+/** p_i = exp(xi_i) = (V(w_i) u_i, exp(w_i)). */
+GA_API ga_status ga_se3_exp(long count, const double *xi, double *p);
+/** xi_i = log(p_i): w = log(q_i) (|w| <= pi, as ga_so3_log), u = V(w)^-1 x_i. */
+GA_API ga_status ga_se3_log(long count, const double *p, double *xi);
+/** ab_i = a_i o b_i = (x_a + R_a x_b, q_a o q_b) (quaternions normalized first). */
+GA_API ga_status ga_se3_compose(long count, const double *a, const double *b, double *ab);
+/** T_i = T(xi_i), 6 x 6 column-major. */
+GA_API ga_status ga_se3_tangent(long count, const double *xi, double *T);
+/** T_i = T(xi_i)^-1 = [T_SO3^-1, -T_SO3^-1 C T_SO3^-1; 0, T_SO3^-1] (|w_i| < 2 pi). */
+GA_API ga_status ga_se3_tangent_inverse(long count, const double *xi, double *T);
 /**@}*/
 
 #ifdef __cplusplus

@@ -1,5 +1,5 @@
-// The rotation group's maps in the C API (ga_so3_*): src/lie/so3.hpp over arrays of items,
-// with the checks of the header's contract; matrices leave column-major.
+// The group maps in the C API (ga_so3_*, ga_se3_*): src/lie/so3.hpp and se3.hpp over arrays
+// of items, with the checks of the header's contract; matrices leave column-major.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -7,11 +7,13 @@
 #include <initializer_list>
 
 #include "galpha.h"
+#include "lie/se3.hpp"
 #include "lie/so3.hpp"
 
 namespace {
 
 namespace so3 = ga::so3;
+namespace se3 = ga::se3;
 
 // count items of `width` doubles each: count >= 0, the arrays' lengths representable, and an
 // array given whenever there is an item
@@ -67,6 +69,13 @@ void put(const so3::Mat3 &A, double *out)  // row-major in, column-major out
             out[i + 3 * j] = A[3 * i + j];
 }
 
+void put(const se3::Mat6 &A, double *out)
+{
+    for (int i = 0; i < 6; ++i)
+        for (int j = 0; j < 6; ++j)
+            out[i + 6 * j] = A[6 * i + j];
+}
+
 template <std::size_t N> void put(const std::array<double, N> &x, double *out)
 {
     for (std::size_t i = 0; i < N; ++i)
@@ -74,6 +83,15 @@ template <std::size_t N> void put(const std::array<double, N> &x, double *out)
 }
 
 const auto any = [](const double *) { return true; };
+
+constexpr double kTwoPi = 6.283185307179586;
+se3::Twist twist(const double *x) { return {x[0], x[1], x[2], x[3], x[4], x[5]}; }
+// a pose (x, quaternion) whose quaternion is within 1e-6 of unit norm
+bool near_unit_pose(const double *p) { return near_unit(p + 3); }
+std::array<double, 7> pose(const so3::Vec3 &x, const so3::Quat &q)
+{
+    return {x[0], x[1], x[2], q[0], q[1], q[2], q[3]};
+}
 
 // out_i = f(in_i) for count items of In doubles in and Out out, each input accepted by `check`
 // before the first output is written
@@ -126,8 +144,51 @@ GA_API ga_status ga_so3_tangent(long count, const double *psi, double *T)
 
 GA_API ga_status ga_so3_tangent_inverse(long count, const double *psi, double *T)
 {
-    constexpr double kTwoPi = 6.283185307179586;
     const auto invertible = [](const double *p) { return so3::norm(vec3(p)) < kTwoPi; };
     return map_items<3, 9>(count, psi, T, invertible,
                            [](const double *p) { return so3::tangent_inverse(vec3(p)); });
+}
+
+GA_API ga_status ga_se3_exp(long count, const double *xi, double *p)
+{
+    return map_items<6, 7>(count, xi, p, any, [](const double *x) {
+        const so3::Vec3 u = vec3(x), w = vec3(x + 3);
+        return pose(se3::exp_translation(u, w), so3::exp(w));
+    });
+}
+
+GA_API ga_status ga_se3_log(long count, const double *p, double *xi)
+{
+    return map_items<7, 6>(count, p, xi, near_unit_pose,
+                           [](const double *x) { return se3::log(vec3(x), unit(x + 3)); });
+}
+
+GA_API ga_status ga_se3_compose(long count, const double *a, const double *b, double *ab)
+{
+    if (!valid(count, 7, {a, b, ab}) || !all_items<7>(count, a, near_unit_pose) ||
+        !all_items<7>(count, b, near_unit_pose))
+        return GA_ERR_ARG;
+    for (long i = 0; i < count; ++i) {
+        const double *x = a + 7 * i, *y = b + 7 * i;
+        const so3::Quat qa = unit(x + 3);
+        const so3::Mat3 R = so3::matrix(qa);
+        so3::Vec3 p = vec3(x);
+        for (int r = 0; r < 3; ++r)
+            p[r] += R[3 * r] * y[0] + R[3 * r + 1] * y[1] + R[3 * r + 2] * y[2];
+        put(pose(p, so3::compose(qa, unit(y + 3))), ab + 7 * i);
+    }
+    return GA_OK;
+}
+
+GA_API ga_status ga_se3_tangent(long count, const double *xi, double *T)
+{
+    return map_items<6, 36>(count, xi, T, any,
+                            [](const double *x) { return se3::tangent(twist(x)); });
+}
+
+GA_API ga_status ga_se3_tangent_inverse(long count, const double *xi, double *T)
+{
+    const auto invertible = [](const double *x) { return so3::norm(vec3(x + 3)) < kTwoPi; };
+    return map_items<6, 36>(count, xi, T, invertible,
+                            [](const double *x) { return se3::tangent_inverse(twist(x)); });
 }

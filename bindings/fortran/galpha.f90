@@ -35,7 +35,7 @@ module galpha
        GA_LINEAR_DENSE_UNBLOCKED = 5
   integer(c_int), parameter, public :: GA_INDEX3 = 0, GA_INDEX2_STABILIZED = 1
   integer(c_int), parameter, public :: GA_SPACE_VECTOR = 0, GA_SPACE_SO3_QUATERNION = 1, &
-       GA_SPACE_SO3_MATRIX = 2
+       GA_SPACE_SO3_MATRIX = 2, GA_SPACE_SE3 = 3
   integer(c_int), parameter, public :: GA_REDUNDANT_REFUSE = 0, GA_REDUNDANT_DROP = 1
   integer(c_int), parameter, public :: GA_INIT_PROJECT = 0, GA_INIT_REFUSE = 1
   integer(c_int), parameter, public :: GA_OUTPUT_CONSISTENT = 0, GA_OUTPUT_STEP = 1
@@ -657,6 +657,38 @@ module galpha
        real(c_double), intent(in) :: psi(*)
        real(c_double), intent(out) :: T(*)
      end function ga_so3_tangent_inverse
+     ! SE(3) as poses (x, quaternion): twists (u, w) 6, poses 7, matrices 6 x 6 column-major
+     integer(c_int) function ga_se3_exp(count, xi, p) bind(C, name="ga_se3_exp")
+       import :: c_int, c_long, c_double
+       integer(c_long), value :: count
+       real(c_double), intent(in) :: xi(*)
+       real(c_double), intent(out) :: p(*)
+     end function ga_se3_exp
+     integer(c_int) function ga_se3_log(count, p, xi) bind(C, name="ga_se3_log")
+       import :: c_int, c_long, c_double
+       integer(c_long), value :: count
+       real(c_double), intent(in) :: p(*)
+       real(c_double), intent(out) :: xi(*)
+     end function ga_se3_log
+     integer(c_int) function ga_se3_compose(count, a, b, ab) bind(C, name="ga_se3_compose")
+       import :: c_int, c_long, c_double
+       integer(c_long), value :: count
+       real(c_double), intent(in) :: a(*), b(*)
+       real(c_double), intent(out) :: ab(*)
+     end function ga_se3_compose
+     integer(c_int) function ga_se3_tangent(count, xi, T) bind(C, name="ga_se3_tangent")
+       import :: c_int, c_long, c_double
+       integer(c_long), value :: count
+       real(c_double), intent(in) :: xi(*)
+       real(c_double), intent(out) :: T(*)
+     end function ga_se3_tangent
+     integer(c_int) function ga_se3_tangent_inverse(count, xi, T) &
+          bind(C, name="ga_se3_tangent_inverse")
+       import :: c_int, c_long, c_double
+       integer(c_long), value :: count
+       real(c_double), intent(in) :: xi(*)
+       real(c_double), intent(out) :: T(*)
+     end function ga_se3_tangent_inverse
      function c_strlen(p) bind(C, name="strlen")
        import :: c_ptr, c_size_t
        type(c_ptr), value :: p
@@ -686,7 +718,8 @@ module galpha
        ga_set_sensitivity_start, ga_get_sensitivity_y, &
        ga_set_sensitivity_method, ga_adjoint_gradient, ga_set_adjoint_checkpoints, &
        ga_set_step_hook, ga_so3_exp, ga_so3_log, ga_so3_compose, ga_so3_matrix, ga_so3_tangent, &
-       ga_so3_tangent_inverse
+       ga_so3_tangent_inverse, ga_se3_exp, ga_se3_log, ga_se3_compose, ga_se3_tangent, &
+       ga_se3_tangent_inverse
 
   ! ---- the Fortran layer --------------------------------------------------------------------
   type, public :: galpha_solver
@@ -837,6 +870,8 @@ module galpha
   public :: galpha_strerror, galpha_version, galpha_version_number
   public :: galpha_so3_exp, galpha_so3_log, galpha_so3_compose, galpha_so3_matrix, &
        galpha_so3_tangent, galpha_so3_tangent_inverse
+  public :: galpha_se3_exp, galpha_se3_log, galpha_se3_compose, galpha_se3_tangent, &
+       galpha_se3_tangent_inverse
 
 contains
 
@@ -951,6 +986,63 @@ contains
     end if
     status = ga_so3_tangent_inverse(count, psi, T)
   end function galpha_so3_tangent_inverse
+
+  ! The pose maps likewise: twists 6 wide, poses 7, tangents 36 (6 x 6 column-major).
+  integer(c_int) function galpha_se3_exp(xi, p) result(status)
+    real(c_double), intent(in) :: xi(:)
+    real(c_double), intent(out) :: p(:)
+    integer(c_long) :: count
+    if (.not. whole_items(size(xi), 6, size(p), 7, count)) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_se3_exp(count, xi, p)
+  end function galpha_se3_exp
+
+  integer(c_int) function galpha_se3_log(p, xi) result(status)
+    real(c_double), intent(in) :: p(:)
+    real(c_double), intent(out) :: xi(:)
+    integer(c_long) :: count
+    if (.not. whole_items(size(p), 7, size(xi), 6, count)) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_se3_log(count, p, xi)
+  end function galpha_se3_log
+
+  integer(c_int) function galpha_se3_compose(a, b, ab) result(status)
+    real(c_double), intent(in) :: a(:)
+    real(c_double), intent(in) :: b(:)
+    real(c_double), intent(out) :: ab(:)
+    integer(c_long) :: count
+    if (size(b) /= size(a) .or. .not. whole_items(size(a), 7, size(ab), 7, count)) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_se3_compose(count, a, b, ab)
+  end function galpha_se3_compose
+
+  integer(c_int) function galpha_se3_tangent(xi, T) result(status)
+    real(c_double), intent(in) :: xi(:)
+    real(c_double), intent(out) :: T(:)
+    integer(c_long) :: count
+    if (.not. whole_items(size(xi), 6, size(T), 36, count)) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_se3_tangent(count, xi, T)
+  end function galpha_se3_tangent
+
+  integer(c_int) function galpha_se3_tangent_inverse(xi, T) result(status)
+    real(c_double), intent(in) :: xi(:)
+    real(c_double), intent(out) :: T(:)
+    integer(c_long) :: count
+    if (.not. whole_items(size(xi), 6, size(T), 36, count)) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_se3_tangent_inverse(count, xi, T)
+  end function galpha_se3_tangent_inverse
 
   integer(c_int) function solver_create(this, n, m) result(status)
     class(galpha_solver), intent(inout) :: this

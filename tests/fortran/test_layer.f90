@@ -469,6 +469,31 @@ program test_layer
     call expect(ga_so3_exp(1_c_long, psi, qz) == GA_ERR_ARG, 'so3_exp refuses a NaN')
   end block
 
+  ! the pose maps: a screw of a quarter turn about z with translation 1 along x moves the
+  ! origin to (2/pi, 2/pi, 0) (V(w) u, u = e_x); log gives the twist back; T T^-1 = I;
+  ! the pose of an unnormalized quaternion and a short array are refused
+  block
+    real(c_double) :: xi(6), p(7), back6(6), t6(36), ti6(36), pp(7)
+    real(c_double), parameter :: two_pi = 8.0d0 * atan(1.0d0)
+    xi = [1.0d0, 0.0d0, 0.0d0, 0.0d0, 0.0d0, two_pi / 4.0d0]
+    call ok(galpha_se3_exp(xi, p), 'se3_exp')
+    call expect(abs(p(1) - 4.0d0 / two_pi) < 1d-15 .and. abs(p(2) - 4.0d0 / two_pi) < 1d-15 &
+                .and. abs(p(3)) < 1d-15, 'se3_exp: the screw moves the origin by V(w) u')
+    call ok(galpha_se3_log(p, back6), 'se3_log')
+    call expect(maxval(abs(back6 - xi)) < 1d-15, 'se3_log inverts se3_exp')
+    call ok(galpha_se3_tangent(xi, t6), 'se3_tangent')
+    call ok(galpha_se3_tangent_inverse(xi, ti6), 'se3_tangent_inverse')
+    call expect(maxval(abs(matmul(reshape(t6, [6, 6]), reshape(ti6, [6, 6])) - &
+                reshape([(merge(1.0d0, 0.0d0, mod(index, 7) == 1), index = 1, 36)], [6, 6]))) &
+                < 1d-14, 'se3_tangent_inverse inverts se3_tangent')
+    call ok(galpha_se3_compose(p, p, pp), 'se3_compose')
+    call expect(abs(pp(1)) < 1d-15 .and. abs(pp(2) - 8.0d0 / two_pi) < 1d-15, &
+                'se3_compose: two quarter screws, the origin at (0, 4/pi, 0)')
+    call expect(galpha_se3_tangent(xi, t6(1:35)) == GA_ERR_ARG, 'se3_tangent: room')
+    p(4) = 1.1d0
+    call expect(galpha_se3_log(p, back6) == GA_ERR_ARG, 'se3_log refuses a non-unit pose')
+  end block
+
   call s%free()
   call r%free()
   deallocate (ckpt, back)  ! (a main program's allocatables are never freed on their own)

@@ -23,7 +23,8 @@ from ._ffi import (GA_DEPENDS_CONSTRAINT, GA_DEPENDS_FORCE, GA_DEPENDS_MASS,  # 
                    GA_OUTPUT_CONSISTENT, GA_OUTPUT_STEP,
                    GA_PREDICTOR_CONSTANT_A, GA_PREDICTOR_EXTRAPOLATE, GA_PREDICTOR_ZERO,
                    GA_REDUNDANT_DROP, GA_REDUNDANT_REFUSE,
-                   GA_REUSE_AUTO, GA_REUSE_NEVER, GA_SPACE_SO3_MATRIX, GA_SPACE_SO3_QUATERNION,
+                   GA_REUSE_AUTO, GA_REUSE_NEVER, GA_SPACE_SE3, GA_SPACE_SO3_MATRIX,
+                   GA_SPACE_SO3_QUATERNION,
                    GA_SPACE_VECTOR, GA_TANGENT_AUTO, GA_TANGENT_FD,
                    GA_TANGENT_NEGLECT)
 from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceError,  # noqa: F401
@@ -33,7 +34,7 @@ from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceErr
                      StepSizeError, UnresolvedError)
 from .integrate import IntegrateResult, OdeSolution, integrate  # noqa: F401
 from .solver import Sensitivity, Solver  # noqa: F401
-from . import so3  # noqa: F401,E402
+from . import se3, so3  # noqa: F401,E402
 
 
 def __getattr__(name):

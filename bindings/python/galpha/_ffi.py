@@ -148,7 +148,7 @@ GA_MATRIX_MASS, GA_MATRIX_JACOBIAN, GA_MATRIX_STIFFNESS, GA_MATRIX_DAMPING = 0, 
 (GA_LINEAR_AUTO, GA_LINEAR_DENSE, GA_LINEAR_SPARSE, GA_LINEAR_DENSE_LAPACK,
  GA_LINEAR_DENSE_EIGEN, GA_LINEAR_DENSE_UNBLOCKED) = 0, 1, 2, 3, 4, 5
 GA_INDEX3, GA_INDEX2_STABILIZED = 0, 1
-GA_SPACE_VECTOR, GA_SPACE_SO3_QUATERNION, GA_SPACE_SO3_MATRIX = 0, 1, 2
+GA_SPACE_VECTOR, GA_SPACE_SO3_QUATERNION, GA_SPACE_SO3_MATRIX, GA_SPACE_SE3 = 0, 1, 2, 3
 GA_REDUNDANT_REFUSE, GA_REDUNDANT_DROP = 0, 1
 GA_INIT_PROJECT, GA_INIT_REFUSE = 0, 1
 GA_OUTPUT_CONSISTENT, GA_OUTPUT_STEP = 0, 1
@@ -253,6 +253,11 @@ _SIGNATURES = {
     "ga_so3_matrix": (_I, [ctypes.c_long, c_double_p, c_double_p]),
     "ga_so3_tangent": (_I, [ctypes.c_long, c_double_p, c_double_p]),
     "ga_so3_tangent_inverse": (_I, [ctypes.c_long, c_double_p, c_double_p]),
+    "ga_se3_exp": (_I, [ctypes.c_long, c_double_p, c_double_p]),
+    "ga_se3_log": (_I, [ctypes.c_long, c_double_p, c_double_p]),
+    "ga_se3_compose": (_I, [ctypes.c_long, c_double_p, c_double_p, c_double_p]),
+    "ga_se3_tangent": (_I, [ctypes.c_long, c_double_p, c_double_p]),
+    "ga_se3_tangent_inverse": (_I, [ctypes.c_long, c_double_p, c_double_p]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():

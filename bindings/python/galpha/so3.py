@@ -28,15 +28,17 @@ def _items(x, width, name):
     return a
 
 
-def _call(fn, name, inputs, out_shape):
+_REFUSED = "a value not finite, a quaternion not of unit norm within 1e-6, or |psi| >= 2 pi " \
+    "for tangent_inverse"
+
+
+def _call(fn, name, inputs, out_shape, refused=_REFUSED):
     count = inputs[0].size // inputs[0].shape[-1]
     out = np.empty(inputs[0].shape[:-1] + out_shape)
     ptrs = [a.ctypes.data_as(_ffi.c_double_p) for a in inputs]
     status = fn(count, *ptrs, out.ctypes.data_as(_ffi.c_double_p))
     if status != _ffi.GA_OK:
-        raise error_for(status, "%s: %s (a value not finite, a quaternion not of unit norm "
-                        "within 1e-6, or |psi| >= 2 pi for tangent_inverse)"
-                        % (name, _ffi.ga_strerror(status).decode()))
+        raise error_for(status, "%s: %s (%s)" % (name, _ffi.ga_strerror(status).decode(), refused))
     return out
 
 
@@ -57,10 +59,10 @@ def compose(a, b):
     return _call(_ffi.ga_so3_compose, "so3.compose", [a, b], (4,))
 
 
-def _matrices(fn, name, x, width):
-    # the C API writes each 3 x 3 column-major; numpy's (..., 3, 3) is row-major: transpose
-    out = _call(fn, name, [_items(x, width, name)], (9,))
-    return np.swapaxes(out.reshape(out.shape[:-1] + (3, 3)), -1, -2)
+def _matrices(fn, name, x, width, size=3, refused=_REFUSED):
+    # the C API writes each matrix column-major; numpy's (..., k, k) is row-major: transpose
+    out = _call(fn, name, [_items(x, width, name)], (size * size,), refused)
+    return np.swapaxes(out.reshape(out.shape[:-1] + (size, size)), -1, -2)
 
 
 def matrix(q):

@@ -197,8 +197,9 @@ def _serialized(method):
 
 
 _SPACE_KINDS = {"vector": _ffi.GA_SPACE_VECTOR, "so3": _ffi.GA_SPACE_SO3_QUATERNION,
-                "so3_matrix": _ffi.GA_SPACE_SO3_MATRIX}
-_SPACE_SIZES = {"vector": (1, 1), "so3": (4, 3), "so3_matrix": (9, 3)}  # (nq, nv) per count
+                "so3_matrix": _ffi.GA_SPACE_SO3_MATRIX, "se3": _ffi.GA_SPACE_SE3}
+_SPACE_SIZES = {"vector": (1, 1), "so3": (4, 3), "so3_matrix": (9, 3),
+                "se3": (7, 6)}  # (nq, nv) per count
 
 
 def _space_blocks(space):
@@ -283,14 +284,15 @@ class Solver:
         interval * count steps; adjoint_gradient() computes earlier segments again.
     space : sequence of (kind, count), optional
         A configuration space that is a product of blocks (ga_create_space): kind "vector"
-        (count coordinates), "so3" (count rotations stored as unit quaternions (w, x, y, z))
-        or "so3_matrix" (count rotation matrices, 9 numbers column-major each). Rotations
-        move on the group with body-frame angular velocities: q has nq numbers (4 or 9 per
-        rotation), v and everything shaped like it n (3 per rotation), and n must be that
-        number. Phi_q and K_t are derivatives along right increments (galpha.so3 builds
-        them). Index 3 and 2, fixed and adaptive steps, dense output, events, checkpoints,
-        first-order states, forward and adjoint sensitivities; the sparse path is refused
-        with rotations.
+        (count coordinates), "so3" (count rotations stored as unit quaternions (w, x, y, z)),
+        "so3_matrix" (count rotation matrices, 9 numbers column-major each) or "se3" (count
+        poses, each the position then the unit quaternion, 7 numbers). Rotations and poses
+        move on the group with body-frame velocities: q has nq numbers (4, 9 or 7 per
+        block item), v and everything shaped like it n (3 per rotation, 6 per pose: the
+        twist (u, w)), and n must be that number. Phi_q and K_t are derivatives along right
+        increments (galpha.so3 and galpha.se3 build them). Index 3 and 2, fixed and
+        adaptive steps, dense output, events, checkpoints, first-order states, forward and
+        adjoint sensitivities; on the sparse path (pattern=) index 3 without sensitivities.
     user : None, int, numpy array or ctypes object
         The `user` pointer compiled callbacks receive (void *user: an address, a numpy
         array's data, a ctypes object's address); NULL by default. Python callbacks ignore it.
