@@ -34,8 +34,8 @@ static void mul4(const double *A, const double *B, double *C)
 static void hat(const double *xi, double *X)
 {
     const double *u = xi, *w = xi + 3;
-    const double x[16] = {0, w[2], -w[1], 0, -w[2], 0, w[0], 0, w[1], -w[0], 0, 0,
-                          u[0], u[1], u[2], 0};
+    const double x[16] = {0,    w[2],  -w[1], 0, -w[2], 0,    w[0], 0,
+                          w[1], -w[0], 0,     0, u[0],  u[1], u[2], 0};
     memcpy(X, x, sizeof x);
 }
 
@@ -105,9 +105,9 @@ static double max_diff(const double *a, const double *b, int n)
 
 #define COUNT 6
 static const double kXi[COUNT][6] = {
-    {0.0, 0.0, 0.0, 0.0, 0.0, 0.0},       {1.0, -2.0, 0.5, 1e-9, -2e-9, 3e-9},
-    {0.3, -0.2, 0.1, 0.4, 0.1, -0.3},      {-2.0, 1.0, 3.0, 0.0, 0.0, 1.5},
-    {0.5, 0.5, -1.0, 1.2, -2.1, 0.7},      {0.0, 1.0, 0.0, 2.9, 0.3, -0.4},
+    {0.0, 0.0, 0.0, 0.0, 0.0, 0.0},   {1.0, -2.0, 0.5, 1e-9, -2e-9, 3e-9},
+    {0.3, -0.2, 0.1, 0.4, 0.1, -0.3}, {-2.0, 1.0, 3.0, 0.0, 0.0, 1.5},
+    {0.5, 0.5, -1.0, 1.2, -2.1, 0.7}, {0.0, 1.0, 0.0, 2.9, 0.3, -0.4},
 };
 
 static void exponential_is_the_matrix_exponential(void **state)
@@ -216,7 +216,7 @@ static void refusals_write_nothing(void **state)
     assert_int_equal(ga_se3_exp(1, NULL, out[0]), GA_ERR_ARG);
     assert_int_equal(ga_se3_exp(1, xi[0], NULL), GA_ERR_ARG);
     assert_int_equal(ga_se3_exp(LONG_MAX, xi[0], out[0]), GA_ERR_ARG);
-    assert_int_equal(ga_se3_exp(0, NULL, NULL), GA_OK); /* nothing to map */
+    assert_int_equal(ga_se3_exp(0, NULL, NULL), GA_OK);         /* nothing to map */
     assert_int_equal(ga_se3_exp(2, xi[0], out[0]), GA_ERR_ARG); /* the second is NaN */
     assert_int_equal(ga_se3_tangent(2, xi[0], out[0]), GA_ERR_ARG);
     assert_int_equal(ga_se3_tangent(LONG_MAX / 8, xi[0], out[0]), GA_ERR_ARG);
