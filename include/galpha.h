@@ -214,11 +214,10 @@ typedef enum {
  *  steps, dense output and events, checkpoints, forward and adjoint sensitivities (a
  *  sensitivity's dq is a tangent along right increments, nv numbers), on the dense linear
  *  solver, with first-order states (their g_q along right increments too). The sparse path
- *  (ga_set_pattern: patterns of the nv-column matrices) in index 3, for the step and its
- *  finite-difference tangents; there the stabilized index 2 and sensitivities return
- *  GA_ERR_ARG at ga_init (or ga_set_formulation), saying so, as does a coupling pattern of
- *  g_q. q0 of
- *  ga_init (and q in ga_set_state) must hold rotations (a quaternion's norm, a matrix's
+ *  (ga_set_pattern: patterns of the nv-column matrices) in index 3 and the stabilized index
+ *  2, for the step and its finite-difference tangents; there sensitivities return GA_ERR_ARG
+ *  at ga_init, saying so, as does a coupling pattern of g_q. q0 of ga_init (and q in
+ *  ga_set_state) must hold rotations (a quaternion's norm, a pose's quaternion's, a matrix's
  *  orthonormality within 1e-6, det > 0), else GA_ERR_ARG names the block.
  *  Errors: GA_ERR_ARG (out, kinds or counts NULL with count > 0, count < 1, an unknown kind, a
  *  count < 1, nq or nv above INT_MAX, m < 0 or m > nv), GA_ERR_NOMEM. */

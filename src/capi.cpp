@@ -624,9 +624,6 @@ GA_API ga_status ga_set_formulation(ga_solver *s, int formulation)
     return guarded(s, [&](ga::Solver &c) {
         if (formulation != GA_INDEX3 && formulation != GA_INDEX2_STABILIZED)
             return c.diag.fail(GA_ERR_ARG, "unknown formulation %d", formulation);
-        if (formulation == GA_INDEX2_STABILIZED && c.kernel().sparse() &&
-            !c.model.space.euclidean())
-            return c.diag.fail(GA_ERR_ARG, "%s", ga::kGroupIndex2Sparse);
         if (formulation == GA_INDEX2_STABILIZED && c.kernel().setup_done())
             c.kernel().setup_index2();  // may throw std::bad_alloc: the formulation stays as it was
         c.kernel().formulation = static_cast<ga_formulation>(formulation);

@@ -407,6 +407,28 @@ void ConfigurationSpace::rotation_tangents(const Vec &xi, double *T) const
     }
 }
 
+void ConfigurationSpace::rotation_brackets(const Vec &v, const Vec *xi, double *G) const
+{
+    for (const int pi : rotation_part_) {
+        const Part &p = parts_[pi];
+        const Eigen::Index w = p.nv;
+        const Op A = ad(p.kind, v.data() + p.v0);
+        const Op T = xi ? tangent(p.kind, xi->data() + p.v0) : Op{};
+        for (Eigen::Index l = 0; l < w; ++l)
+            for (Eigen::Index c = 0; c < w; ++c) {
+                double g = 0.0;
+                if (xi)
+                    for (Eigen::Index j = 0; j < w; ++j)
+                        g -= A[static_cast<std::size_t>(w * l + j)] *
+                             T[static_cast<std::size_t>(w * j + c)];
+                else
+                    g = -A[static_cast<std::size_t>(w * l + c)];
+                G[w * l + c] = g;
+            }
+        G += w * w;
+    }
+}
+
 // Z <- Z + J (-ad_v) on each group block's columns: Z w += J [w, v], [w, v] = -ad_v w
 void ConfigurationSpace::add_bracket(const Vec &v, const double *J, Eigen::Index rows,
                                      double *Z) const

@@ -86,6 +86,9 @@ public:
     // Z <- Z + J ad(., v) on the rotations' columns (J, Z: rows x nv, column-major, ld =
     // rows): Z w += J [w, v] with [w, v] = w x v on each rotation
     void add_bracket(const Vec &v, const double *J, Eigen::Index rows, double *Z) const;
+    // The same bracket for matrices on patterns: -ad(v) T(xi) (xi null: -ad(v)) of every group
+    // block, laid out as rotation_tangents (TangentProduct::add_bracket scatters J by them)
+    void rotation_brackets(const Vec &v, const Vec *xi, double *G) const;
     // The first rotation block whose storage is not a rotation (a quaternion's norm, a
     // matrix's orthonormality or determinant off by more than 1e-6), as the index of its
     // first coordinate in q (a pose's quaternion's); -1 if none.

@@ -336,8 +336,10 @@ ga_status Model::velocity_constraint_tangent(double t, const Vec &q, const Vec &
     for (Eigen::Index k = 0; k < Z.size(); ++k)
         z[k] = (z[k] - j[k]) / span;
     // The difference is the derivative of Phi_q w along v; Z w differentiates Phi_q v along
-    // w. In R^n they are equal; on a group they differ by Phi_q [w, v] (sec. 14).
-    if (!space.euclidean())
+    // w. In R^n they are equal; on a group they differ by Phi_q [w, v] (sec. 14), which on a
+    // pattern falls outside Phi_q's: there the step adds it in the expanded layout
+    // (TangentProduct::add_bracket).
+    if (!space.euclidean() && J.dense())
         space.add_bracket(v, J.data(), J.rows(), Z.data());
     return GA_OK;
 }

@@ -206,7 +206,6 @@ ga_status Stepper::setup_workspace()
     const bool sparse_possible = !M_.dense() && (m_ == 0 || !J_.dense()) &&
                                  (!model.stiffness_needed(K_) || !K_.dense()) &&
                                  (!model.damping_needed(C_) || !C_.dense());
-    const bool group_index2 = !model.space.euclidean() && formulation == GA_INDEX2_STABILIZED;
     bool sparse = false;
     switch (linear_solver) {
     case GA_LINEAR_SPARSE:
@@ -215,12 +214,10 @@ ga_status Stepper::setup_workspace()
                              "the sparse solver needs the patterns of M and Phi_q, and of K_t "
                              "and C_t unless they are neglected (ga_set_pattern; an empty "
                              "pattern declares a zero matrix)");
-        if (group_index2)
-            return diag.fail(GA_ERR_ARG, "%s", kGroupIndex2Sparse);
         sparse = true;
         break;
     case GA_LINEAR_AUTO:
-        sparse = sparse_possible && !group_index2 && nv_ + m_ >= kSparseMinSize;
+        sparse = sparse_possible && nv_ + m_ >= kSparseMinSize;
         break;
     default: sparse = false;
     }
@@ -332,8 +329,7 @@ void Stepper::set_aside_matrix(KeptMatrix &kept)
     setup_step_matrix(kept.S, std::move(backend));
     kept.S.reserve_factors();
     if (S2_.ready()) {
-        kept.S2.setup(nv_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_,
-                      active_ptr());
+        setup_index2_matrix(kept.S2);
         kept.S2.reserve_factors();
     }
     kept.blocks = blocks_;
@@ -356,12 +352,21 @@ void Stepper::take_back_matrix(KeptMatrix &kept)
 void Stepper::setup_index2()
 {
     if (!S2_.ready()) {
-        S2_.setup(nv_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_, K_, C_,
-                  active_ptr());
+        setup_index2_matrix(S2_);
         S2_.reserve_factors();
     }
     if (initialized_)
         prefactor_index2();
+}
+
+// The index-2 system in the step's layout: on the sparse path of a group space with the
+// expanded patterns of K_t T and Phi_q T (setup_step_matrix).
+void Stepper::setup_index2_matrix(Index2Matrix &S2)
+{
+    const bool expanded = sparse_backend_ && !model.space.euclidean();
+    S2.setup(nv_, m_, sparse_backend_, dense_kind(linear_solver), M_, J_,
+             expanded && !K_.dense() ? KT_.out() : K_, C_, expanded ? &JT_.out() : nullptr,
+             active_ptr());
 }
 
 // The sparse LU picks its pivots in its first numeric factorization; for the sparse index-2
@@ -373,7 +378,12 @@ void Stepper::prefactor_index2()
     if (!S2_.sparse())
         return;
     count(counters, GA_COUNT_FACTORIZATIONS);
-    S2_.factorize(M_, nullptr, nullptr, J_, J_, nullptr, params, 1.0);
+    const ModelMatrix *J_low = nullptr;
+    if (!model.space.euclidean() && m_ > 0) {  // its lower block in the expanded layout, T = I
+        JT_.apply(J_, nullptr, model.space);
+        J_low = &JT_.out();
+    }
+    S2_.factorize(M_, nullptr, nullptr, J_, J_, nullptr, params, 1.0, J_low);
 }
 
 // The projection of error estimates (adaptive mode only): set up at the first adaptive call,
@@ -839,6 +849,8 @@ ga_status Stepper::factorize(double t, const State &x, double h, bool tangents_K
         }
         if (Z) {  // index 2: the velocity constraint's curvature, through q as well
             ZT_.apply(Z_, xi, model.space);
+            if (!Z_.dense())
+                ZT_.add_bracket(J_, x.v, xi, model.space);
             Z = &ZT_.out();
         }
     }

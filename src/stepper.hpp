@@ -25,11 +25,6 @@
 
 namespace ga {
 
-// Refused with this message: the sparse index-2 system has no lower block of its own yet
-inline constexpr const char *kGroupIndex2Sparse =
-    "the stabilized index-2 formulation on the sparse path is not available on a "
-    "configuration space with rotations in this version (index 3 is, and the dense solver)";
-
 // The matrix and scratch of an acceleration-level solve (init.cpp): the step's own at the
 // consistent start, separate ones for consistent output, so that reading the output never
 // touches what the next step reuses.
@@ -350,6 +345,7 @@ private:
     void forget_setup();
     // A matrix of the step's layout (S_, P_, O_, a kept S)
     void setup_step_matrix(IterationMatrix &S, std::unique_ptr<LinearBackend> backend);
+    void setup_index2_matrix(Index2Matrix &S2);
 
     ga_status setup();  // chooses the backend and allocates everything; throws std::bad_alloc
     ga_status setup_workspace();  // the part every formulation and option needs

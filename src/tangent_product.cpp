@@ -82,4 +82,21 @@ void TangentProduct::apply(const ModelMatrix &A, const Vec *xi, const Configurat
     }
 }
 
+void TangentProduct::add_bracket(const ModelMatrix &J, const Vec &v, const Vec *xi,
+                                 const ConfigurationSpace &space)
+{
+    space.rotation_brackets(v, xi, T_.data());
+    const double *a = J.data();
+    double *o = out_.data();
+    for (std::size_t k = 0; k < target_.size(); ++k) {
+        const int r = rotation_[k];
+        if (r < 0)
+            continue;
+        const int w = space.rotation_width(r);
+        const double *g = T_.data() + offset_[r] + w * local_[k];
+        for (int c = 0; c < w; ++c)
+            o[target_[k] + c] += a[k] * g[c];
+    }
+}
+
 }  // namespace ga

@@ -19,6 +19,11 @@ public:
     void setup(const ModelMatrix &A, const ConfigurationSpace &space);
     // out() = A T(xi), or with xi null A itself in the expanded layout (T = I)
     void apply(const ModelMatrix &A, const Vec *xi, const ConfigurationSpace &space);
+    // out() += J (-ad_v) T(xi) (xi null: T = I), the curvature's bracket (sec. 16) for a
+    // product set up from J's layout: on patterns it spreads over the rotations' columns as
+    // the product does (Model leaves it out of a Z on a pattern)
+    void add_bracket(const ModelMatrix &J, const Vec &v, const Vec *xi,
+                     const ConfigurationSpace &space);
     const ModelMatrix &out() const { return out_; }
 
 private:

@@ -52,7 +52,8 @@ struct Index2Matrix::Sparse {
         int slot, left_k, b_k;
     };
     std::vector<Term> MBt, CBt, JBt;
-    std::vector<int> J_rows, lambda_diag, eta_diag;  // inactive constraints
+    // inactive constraints: the rows of J's entries and of J2's and Z's (J_low's layout)
+    std::vector<int> J_rows, low_rows, lambda_diag, eta_diag;
     Vec rhs;
 };
 #else
@@ -73,17 +74,19 @@ void Index2Matrix::reset()
 
 void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const ModelMatrix &M,
                          const ModelMatrix &J, const ModelMatrix &K, const ModelMatrix &C,
-                         const unsigned char *active, bool amd_first)
+                         const ModelMatrix *J_low, const unsigned char *active, bool amd_first)
 {
     active_ = active;
 #ifdef GALPHA_HAVE_KLU
     if (sparse) {
-        sparse_ = setup_sparse(n, m, M, J, K, C, active != nullptr, amd_first);
+        sparse_ = setup_sparse(n, m, M, J, K, C, J_low ? *J_low : J, active != nullptr,
+                               amd_first);
         return;
     }
 #else
     (void)sparse, (void)M, (void)J, (void)K, (void)C, (void)amd_first;
 #endif
+    (void)J_low;  // dense: the lower block is written over J's at each factorization
     auto d = std::make_unique<Dense>();
     d->n = n;
     d->m = m;
@@ -121,6 +124,7 @@ std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
                                                                  const ModelMatrix &J,
                                                                  const ModelMatrix &K,
                                                                  const ModelMatrix &C,
+                                                                 const ModelMatrix &L,
                                                                  bool with_inactive,
                                                                  bool amd_first)
 {
@@ -180,8 +184,9 @@ std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
         block(C, false, 0, 0);
         block(K, false, 0, 0);
         block(J, true, 0, l0);   // Phi_q^T
-        block(J, false, l0, 0);  // Phi_q
-        block(J, false, e0, 0);  // Phi_q + (beta h / gamma) Z: Z has the pattern of Phi_q
+        block(L, false, l0, 0);  // Phi_q (T)
+        block(J, false, e0, 0);  // Phi_q + (beta h / gamma) Z (T): Z has the pattern of L
+        block(L, false, e0, 0);
         for_each_term([&](std::vector<Sparse::Term> &, int, int k, int row) {
             entries.emplace_back(row, e0 + Jr[k]);
         });
@@ -201,7 +206,7 @@ std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
         s->C = slots(C, false, 0, 0);
         s->K = slots(K, false, 0, 0);
         s->JT = slots(J, true, 0, l0);
-        s->J2 = slots(J, false, l0, 0);
+        s->J2 = slots(L, false, l0, 0);
         s->J3 = slots(J, false, e0, 0);
         for_each_term([&](std::vector<Sparse::Term> &terms, int a, int k, int row) {
             terms.push_back({s->S.slot(row, e0 + Jr[k]), a, k});
@@ -217,9 +222,9 @@ std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
         block(C, false, 0, w0);
         block(J, true, 0, 2 * n);           // Phi_q^T
         block(J, true, w0, 2 * n + m);      // -B^T (B has the layout of Phi_q)
-        block(J, false, 2 * n, 0);          // Phi_q d
+        block(L, false, 2 * n, 0);          // Phi_q (T) d
         block(J, false, 2 * n + m, w0);     // Phi_q w
-        block(J, false, 2 * n + m, 0);      // (beta h / gamma) Z d
+        block(L, false, 2 * n + m, 0);      // (beta h / gamma) Z (T) d
         for (int i = 0; i < n; ++i) {
             entries.emplace_back(w0 + i, i);       // -I
             entries.emplace_back(w0 + i, w0 + i);  // I
@@ -235,7 +240,7 @@ std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
         s->C = slots(C, false, 0, w0);
         s->JT = slots(J, true, 0, 2 * n);
         s->BT = slots(J, true, w0, 2 * n + m);
-        s->J2 = slots(J, false, 2 * n, 0);
+        s->J2 = slots(L, false, 2 * n, 0);
         s->J3 = slots(J, false, 2 * n + m, w0);
         for (int i = 0; i < n; ++i) {
             s->minus_I.push_back(s->S.slot(w0 + i, i));
@@ -244,9 +249,10 @@ std::unique_ptr<Index2Matrix::Sparse> Index2Matrix::setup_sparse(int n, int m,
     }
     // Z: in the first block column of the velocity-constraint rows, J3's slots (reduced) or
     // those of Phi_q d there (augmented)
-    s->Z = s->reduced ? s->J3 : slots(J, false, 2 * n + m, 0);
+    s->Z = slots(L, false, s->reduced ? e0 : 2 * n + m, 0);
     if (with_inactive) {
         s->J_rows = Jr;
+        s->low_rows = L.row_index();
         const int lambda0 = s->reduced ? l0 : 2 * n, eta0 = s->reduced ? e0 : 2 * n + m;
         for (int i = 0; i < m; ++i) {
             s->lambda_diag.push_back(s->S.slot(lambda0 + i, lambda0 + i));
@@ -286,7 +292,7 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
         if (K)
             scatter(*K, s.K, p.beta * h * h);
         scatter(J, s.JT, 1.0);
-        scatter(J, s.J2, 1.0);
+        scatter(J_low ? *J_low : J, s.J2, 1.0);
         scatter(J, s.J3, 1.0);
         if (Z)
             scatter(*Z, s.Z, cZ);
@@ -304,13 +310,16 @@ bool Index2Matrix::factorize(const ModelMatrix &M, const ModelMatrix *C, const M
         }
         if (active_) {
             // an inactive constraint's rows and columns: those of the identity
-            const std::vector<int> &r = s.J_rows;
+            const std::vector<int> &r = s.J_rows, &low = s.low_rows;
             for (std::size_t k = 0; k < r.size(); ++k)
                 if (!active_[r[k]]) {
-                    v[s.JT[k]] = v[s.J2[k]] = v[s.J3[k]] = v[s.Z[k]] = 0.0;
+                    v[s.JT[k]] = v[s.J3[k]] = 0.0;
                     if (!s.reduced)
                         v[s.BT[k]] = 0.0;
                 }
+            for (std::size_t k = 0; k < low.size(); ++k)
+                if (!active_[low[k]])
+                    v[s.J2[k]] = v[s.Z[k]] = 0.0;
             for (const auto *terms : {&s.MBt, &s.CBt, &s.JBt})
                 for (const Sparse::Term &t : *terms)
                     if (!active_[r[t.b_k]] || (terms == &s.JBt && !active_[r[t.left_k]]))

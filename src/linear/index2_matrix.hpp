@@ -42,23 +42,25 @@ public:
     Index2Matrix(Index2Matrix &&) noexcept;
     Index2Matrix &operator=(Index2Matrix &&) noexcept;
 
-    // Allocates everything (patterns of M, J, K, C: their layouts; B has J's). active: m
-    // flags owned by the caller (null: every constraint active); an inactive constraint's
-    // rows and columns (lambda_bar and eta_bar) are those of the identity, its right-hand side
-    // 0. dense_kind: the dense LU (Lapack counts as Eigen). amd_first (tests): the sparse LU
-    // starts from AMD's ordering even where the band would be chosen. Throws std::bad_alloc.
+    // Allocates everything (patterns of M, J, K, C: their layouts; B has J's). J_low (sparse
+    // on a group space; else null): the layout of Phi_q T(xi), which the position constraint's
+    // rows and the curvature Z then have (K comes in K_t T's layout). active: m flags owned by
+    // the caller (null: every constraint active); an inactive constraint's rows and columns
+    // (lambda_bar and eta_bar) are those of the identity, its right-hand side 0. dense_kind:
+    // the dense LU (Lapack counts as Eigen). amd_first (tests): the sparse LU starts from AMD's
+    // ordering even where the band would be chosen. Throws std::bad_alloc.
     void setup(int n, int m, bool sparse, DenseKind dense_kind, const ModelMatrix &M,
                const ModelMatrix &J, const ModelMatrix &K, const ModelMatrix &C,
-               const unsigned char *active, bool amd_first = false);
+               const ModelMatrix *J_low, const unsigned char *active, bool amd_first = false);
     bool ready() const { return dense_ || sparse_; }
     void reset();  // not set up, as constructed
     bool sparse() const { return sparse_ != nullptr; }
     // sparse, in the reduced (n + 2m) form (else the augmented one, or dense)
     bool sparse_reduced() const;
     // false if singular or numerically singular. Z (layout of J) may be null: left out.
-    // J_low (dense only), when given, is the position constraint's row block in place of J:
-    // Phi_q T(xi) on a group space, where Phi_q^T and the velocity rows keep J (K and Z
-    // come with their T already).
+    // J_low, when given, is the position constraint's row block in place of J: Phi_q T(xi)
+    // on a group space, where Phi_q^T and the velocity rows keep J (K and Z come with their T
+    // already; sparse: in the layouts of setup's J_low and K).
     bool factorize(const ModelMatrix &M, const ModelMatrix *C, const ModelMatrix *K,
                    const ModelMatrix &J, const ModelMatrix &B, const ModelMatrix *Z,
                    const Params &p, double h, const ModelMatrix *J_low = nullptr);
@@ -82,8 +84,8 @@ private:
     struct Sparse;
     static std::unique_ptr<Sparse> setup_sparse(int n, int m, const ModelMatrix &M,
                                                 const ModelMatrix &J, const ModelMatrix &K,
-                                                const ModelMatrix &C, bool with_inactive,
-                                                bool amd_first);
+                                                const ModelMatrix &C, const ModelMatrix &J_low,
+                                                bool with_inactive, bool amd_first);
     const unsigned char *active_ = nullptr;
     std::unique_ptr<Dense> dense_;
     std::unique_ptr<Sparse> sparse_;

@@ -3,8 +3,11 @@
 // A B^T and Phi_q B^T assembled on fixed patterns), taken on a chain, and in the augmented
 // form (the Newmark increment an unknown of its own), taken where one coordinate is in every
 // constraint and Phi_q B^T would be dense; with all constraints active and with some inactive
-// (redundant constraints dropped). The oracle is the dense system with Eigen's LU.
+// (redundant constraints dropped), and in both with a lower block of its own (a group space's
+// Phi_q T, whose pattern spreads every entry over its rotation's columns, and Z in that
+// layout). The oracle is the dense system with Eigen's LU.
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -31,6 +34,8 @@ struct Pattern {
 struct Blocks {
     int n = 0, m = 0;
     ga::ModelMatrix M, J, K, C, B, Z;
+    bool lower = false;  // L = Phi_q T in the position rows, Z in L's layout (ZL)
+    ga::ModelMatrix L, ZL;
 };
 
 void declare(ga::ModelMatrix &A, int rows, int cols, const Pattern &p)
@@ -75,6 +80,32 @@ Blocks make_blocks(int n, int m, const Pattern &jacobian, std::mt19937 &random)
     return b;
 }
 
+// A lower block as on a group space whose rotations are the column triples (3k, 3k+1, 3k+2):
+// J's pattern with every entry spread over its triple, random values; Z likewise.
+void add_lower_block(Blocks &b, const Pattern &jacobian, std::mt19937 &random)
+{
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<std::pair<int, int>> e;
+    for (std::size_t k = 0; k < jacobian.rows.size(); ++k)
+        for (int c = 3 * (jacobian.cols[k] / 3); c < std::min(3 * (jacobian.cols[k] / 3) + 3, b.n);
+             ++c)
+            e.emplace_back(jacobian.rows[k], c);
+    std::sort(e.begin(), e.end());
+    e.erase(std::unique(e.begin(), e.end()), e.end());
+    Pattern L;
+    for (auto [r, c] : e) {
+        L.rows.push_back(r);
+        L.cols.push_back(c);
+    }
+    declare(b.L, b.m, b.n, L);
+    declare(b.ZL, b.m, b.n, L);
+    for (int k = 0; k < b.L.nnz(); ++k) {
+        b.L.data()[k] = u(random);
+        b.ZL.data()[k] = u(random);
+    }
+    b.lower = true;
+}
+
 // The chain's pattern: constraint pair i joins coordinates of bodies i - 1 and i.
 Pattern chain_jacobian(int bodies)
 {
@@ -111,12 +142,13 @@ void sparse_against_dense(const char *what, const Blocks &b, const unsigned char
     const ga::Params p = ga::params_from_rho_inf(0.8);
     const double h = 1e-2;
     ga::Index2Matrix sparse, dense;
-    sparse.setup(b.n, b.m, true, ga::DenseKind::Auto, b.M, b.J, b.K, b.C, active, amd_first);
-    dense.setup(b.n, b.m, false, ga::DenseKind::Eigen, b.M, b.J, b.K, b.C, active);
+    const ga::ModelMatrix *L = b.lower ? &b.L : nullptr, *Z = b.lower ? &b.ZL : &b.Z;
+    sparse.setup(b.n, b.m, true, ga::DenseKind::Auto, b.M, b.J, b.K, b.C, L, active, amd_first);
+    dense.setup(b.n, b.m, false, ga::DenseKind::Eigen, b.M, b.J, b.K, b.C, nullptr, active);
     assert_true(sparse.sparse() && !dense.sparse());
     assert_int_equal(sparse.sparse_reduced(), expect_reduced);
-    assert_true(sparse.factorize(b.M, &b.C, &b.K, b.J, b.B, &b.Z, p, h));
-    assert_true(dense.factorize(b.M, &b.C, &b.K, b.J, b.B, &b.Z, p, h));
+    assert_true(sparse.factorize(b.M, &b.C, &b.K, b.J, b.B, Z, p, h, L));
+    assert_true(dense.factorize(b.M, &b.C, &b.K, b.J, b.B, Z, p, h, L));
     const ga::Vec rq = ga::Vec::LinSpaced(b.n, -1.0, 2.0), phi = ga::Vec::LinSpaced(b.m, 0.5, -0.5),
                   phi_v = ga::Vec::LinSpaced(b.m, -0.3, 0.7);
     ga::Vec d1, w1, l1, e1, d2, w2, l2, e2;
@@ -153,6 +185,11 @@ void reduced_form_on_a_chain(void **)
     some_inactive[5] = some_inactive[17] = some_inactive[2 * bodies - 1] = 0;
     sparse_against_dense("chain, reduced form, all active", b, nullptr, true);
     sparse_against_dense("chain, reduced form, 3 inactive", b, some_inactive.data(), true);
+    Blocks g = make_blocks(3 * bodies, 2 * bodies, chain_jacobian(bodies), random);
+    add_lower_block(g, chain_jacobian(bodies), random);
+    sparse_against_dense("chain, reduced form, lower block", g, nullptr, true);
+    sparse_against_dense("chain, reduced form, lower block, 3 inactive", g, some_inactive.data(),
+                         true);
 }
 
 // The chain straight and at rest, as galpha's chain scene starts (unit links along x): the
@@ -201,6 +238,11 @@ void augmented_form_around_a_hub(void **)
     some_inactive[0] = some_inactive[30] = 0;
     sparse_against_dense("hub, augmented form, all active", b, nullptr, false);
     sparse_against_dense("hub, augmented form, 2 inactive", b, some_inactive.data(), false);
+    Blocks g = make_blocks(n, m, hub_jacobian(m), random);
+    add_lower_block(g, hub_jacobian(m), random);
+    sparse_against_dense("hub, augmented form, lower block", g, nullptr, false);
+    sparse_against_dense("hub, augmented form, lower block, 2 inactive", g,
+                         some_inactive.data(), false);
 }
 
 }  // namespace

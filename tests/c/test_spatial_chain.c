@@ -158,43 +158,50 @@ static double energy(const spatial_chain *c, const double *q, const double *v)
 }
 
 /* 8 bodies, h = 1e-3 to t = 0.5 (the chain falls through about a metre): the sparse run is
- * the dense one to round-off at every step, with the same Newton iterations */
+ * the dense one to round-off at every step, with the same Newton iterations, in index 3 and
+ * in the stabilized index 2 */
 static void test_sparse_run_is_the_dense_run(void **state)
 {
     (void)state;
     enum { N = 8 };
-    dense_chain d;
-    dense_make(&d, N, 2.0);
-    spatial_chain c = spatial_chain_make(N, 2.0);
-    ga_solver *sp = NULL, *de = dense_solver(&d);
-    assert_int_equal(spatial_chain_solver(&c, &sp), GA_OK);
-    assert_int_equal(ga_set_linear_solver(sp, GA_LINEAR_SPARSE), GA_OK);
-    double q[7 * N], v[6 * N], qs[7 * N], qd[7 * N];
-    spatial_chain_initial(&c, q, v);
-    assert_int_equal(ga_init(sp, 0.0, q, v), GA_OK);
-    assert_int_equal(ga_init(de, 0.0, q, v), GA_OK);
-    assert_string_equal(ga_linear_solver_name(sp), "sparse KLU");
-    double worst = 0.0;
-    for (int k = 0; k < 500; ++k) {
-        assert_int_equal(ga_step(sp, 1e-3), GA_OK);
-        assert_int_equal(ga_step(de, 1e-3), GA_OK);
-        assert_int_equal(ga_get_q(sp, qs), GA_OK);
-        assert_int_equal(ga_get_q(de, qd), GA_OK);
-        for (int i = 0; i < 7 * N; ++i)
-            worst = fmax(worst, fabs(qs[i] - qd[i]));
+    for (int form = 0; form < 2; ++form) {
+        const int formulation = form ? GA_INDEX2_STABILIZED : GA_INDEX3;
+        dense_chain d;
+        dense_make(&d, N, 2.0);
+        spatial_chain c = spatial_chain_make(N, 2.0);
+        ga_solver *sp = NULL, *de = dense_solver(&d);
+        assert_int_equal(spatial_chain_solver(&c, &sp), GA_OK);
+        assert_int_equal(ga_set_linear_solver(sp, GA_LINEAR_SPARSE), GA_OK);
+        assert_int_equal(ga_set_formulation(sp, formulation), GA_OK);
+        assert_int_equal(ga_set_formulation(de, formulation), GA_OK);
+        double q[7 * N], v[6 * N], qs[7 * N], qd[7 * N];
+        spatial_chain_initial(&c, q, v);
+        assert_int_equal(ga_init(sp, 0.0, q, v), GA_OK);
+        assert_int_equal(ga_init(de, 0.0, q, v), GA_OK);
+        assert_string_equal(ga_linear_solver_name(sp),
+                            form ? "sparse KLU (stabilized index-2)" : "sparse KLU");
+        double worst = 0.0;
+        for (int k = 0; k < 500; ++k) {
+            assert_int_equal(ga_step(sp, 1e-3), GA_OK);
+            assert_int_equal(ga_step(de, 1e-3), GA_OK);
+            assert_int_equal(ga_get_q(sp, qs), GA_OK);
+            assert_int_equal(ga_get_q(de, qd), GA_OK);
+            for (int i = 0; i < 7 * N; ++i)
+                worst = fmax(worst, fabs(qs[i] - qd[i]));
+        }
+        long long ns, nd;
+        assert_int_equal(ga_get_counter(sp, GA_COUNT_NEWTON_ITERS, &ns), GA_OK);
+        assert_int_equal(ga_get_counter(de, GA_COUNT_NEWTON_ITERS, &nd), GA_OK);
+        print_message("  index %d: sparse - dense %.2e in q; Newton iterations %lld / %lld; "
+                      "lowest end at z = %.3f\n",
+                      form ? 2 : 3, worst, ns, nd, qs[7 * (N - 1) + 2]);
+        assert_true(worst < 1e-11);
+        assert_int_equal(ns, nd);
+        assert_true(qs[7 * (N - 1) + 2] < -0.5); /* it fell */
+        ga_free(sp);
+        ga_free(de);
+        dense_free(&d);
     }
-    long long ns, nd;
-    assert_int_equal(ga_get_counter(sp, GA_COUNT_NEWTON_ITERS, &ns), GA_OK);
-    assert_int_equal(ga_get_counter(de, GA_COUNT_NEWTON_ITERS, &nd), GA_OK);
-    print_message("  sparse - dense %.2e in q; Newton iterations %lld / %lld; lowest end at "
-                  "z = %.3f\n",
-                  worst, ns, nd, qs[7 * (N - 1) + 2]);
-    assert_true(worst < 1e-11);
-    assert_int_equal(ns, nd);
-    assert_true(qs[7 * (N - 1) + 2] < -0.5); /* it fell */
-    ga_free(sp);
-    ga_free(de);
-    dense_free(&d);
 }
 
 /* rho_inf = 1: no numerical dissipation, so the energy stays within the method's O(h^2)

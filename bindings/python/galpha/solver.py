@@ -292,7 +292,8 @@ class Solver:
         twist (u, w)), and n must be that number. Phi_q and K_t are derivatives along right
         increments (galpha.so3 and galpha.se3 build them). Index 3 and 2, fixed and
         adaptive steps, dense output, events, checkpoints, first-order states, forward and
-        adjoint sensitivities; on the sparse path (pattern=) index 3 without sensitivities.
+        adjoint sensitivities; on the sparse path (pattern=) index 3 and 2 without
+        sensitivities.
     user : None, int, numpy array or ctypes object
         The `user` pointer compiled callbacks receive (void *user: an address, a numpy
         array's data, a ctypes object's address); NULL by default. Python callbacks ignore it.
