@@ -6,6 +6,8 @@
 // Ad_{exp(-xi)} (w x w, row-major).
 #include "configuration_space.hpp"
 
+#include <limits>
+
 #include "lie/se3.hpp"
 
 namespace ga {
@@ -452,31 +454,68 @@ void ConfigurationSpace::add_bracket(const Vec &v, const double *J, Eigen::Index
     }
 }
 
+namespace {
+// How far a block's storage is from a rotation: |q| - 1 of a quaternion, the largest entry of
+// R^T R - I of a matrix (infinite with det <= 0); NaN stays NaN
+double rotation_error(Kind kind, const double *b)
+{
+    if (kind != Kind::Matrix) {
+        const double n = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3]);
+        return std::fabs(n - 1.0);
+    }
+    const Mat3 R = load_matrix(b), RtR = mul(transpose(R), R);
+    double off = 0.0;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            off = std::max(off, std::fabs(RtR[3 * i + j] - (i == j ? 1.0 : 0.0)));
+    const double det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) +
+                       R[2] * (R[3] * R[7] - R[4] * R[6]);
+    return std::isnan(off) ? off : det > 0.0 ? off : std::numeric_limits<double>::infinity();
+}
+// where a group block's rotation starts in q (a pose's quaternion after its position)
+Eigen::Index rotation_storage(Kind kind, Eigen::Index q0) { return kind == Kind::Pose ? q0 + 3 : q0; }
+}  // namespace
+
 Eigen::Index ConfigurationSpace::invalid_rotation(const double *q) const
 {
     constexpr double kTol = 1e-6;
     for (const Part &p : parts_) {
-        if (p.kind == Kind::Quaternion || p.kind == Kind::Pose) {
-            const Eigen::Index at = p.kind == Kind::Pose ? p.q0 + 3 : p.q0;
-            const double *b = q + at;
-            const double n = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3]);
-            if (!(std::fabs(n - 1.0) <= kTol))
-                return at;
-        } else if (p.kind == Kind::Matrix) {
-            const double *b = q + p.q0;
-            const Mat3 R = load_matrix(b), RtR = mul(transpose(R), R);
-            double off = 0.0;
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j)
-                    off = std::max(off, std::fabs(RtR[3 * i + j] - (i == j ? 1.0 : 0.0)));
-            const double det = R[0] * (R[4] * R[8] - R[5] * R[7]) -
-                               R[1] * (R[3] * R[8] - R[5] * R[6]) +
-                               R[2] * (R[3] * R[7] - R[4] * R[6]);
-            if (!(off <= kTol) || !(det > 0.0))
-                return p.q0;
-        }
+        if (p.kind == Kind::Vector)
+            continue;
+        const Eigen::Index at = rotation_storage(p.kind, p.q0);
+        if (!(rotation_error(p.kind, q + at) <= kTol))
+            return at;
     }
     return -1;
+}
+
+void ConfigurationSpace::normalize_rotations(double *q) const
+{
+    constexpr double kExact = 1e-10;
+    for (const Part &p : parts_) {
+        if (p.kind == Kind::Vector)
+            continue;
+        double *b = q + rotation_storage(p.kind, p.q0);
+        if (!(rotation_error(p.kind, b) > kExact))
+            continue;
+        if (p.kind != Kind::Matrix) {
+            const double n = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3]);
+            for (int k = 0; k < 4; ++k)
+                b[k] /= n;
+            continue;
+        }
+        // the nearest rotation (polar factor) by Newton-Schulz, R <- R (3 I - R^T R) / 2: each
+        // pass squares the error, 1e-6 -> 1e-12 -> round-off
+        Mat3 R = load_matrix(b);
+        for (int pass = 0; pass < 3; ++pass) {
+            Mat3 E = mul(transpose(R), R);
+            for (int i = 0; i < 9; ++i)
+                E[static_cast<std::size_t>(i)] = 0.5 * ((i % 4 == 0 ? 3.0 : 0.0) -
+                                                        E[static_cast<std::size_t>(i)]);
+            R = mul(R, E);
+        }
+        store_matrix(R, b);
+    }
 }
 
 }  // namespace ga

@@ -93,6 +93,11 @@ public:
     // matrix's orthonormality or determinant off by more than 1e-6), as the index of its
     // first coordinate in q (a pose's quaternion's); -1 if none.
     Eigen::Index invalid_rotation(const double *q) const;
+    // Storage accepted by invalid_rotation but more than 1e-10 off a rotation, made one (a
+    // quaternion normalized, a matrix's nearest rotation): else the state's rotations would
+    // stay 1e-6 off, and a checkpoint of it could drift past the check that accepted it.
+    // Closer storage is left bit for bit as it is.
+    void normalize_rotations(double *q) const;
 
     // eq. (4) on a segment: q = q_n + h v_n + h^2 ((1/2 - beta) a_n + beta a)
     template <class Out, class Q, class V, class A0, class A1>

@@ -26,8 +26,6 @@ void Stepper::setup_output()
     out_f_.setZero(nv_);
     out_c_.setZero(m_);
     out_r_.setZero(nv_);
-    out_q_.setZero(nq_);
-    out_v_.setZero(nv_);
     out_qdd_.setZero(nv_);
     out_lambda_.setZero(m_);
     O_.reserve_factors();

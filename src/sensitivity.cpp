@@ -337,7 +337,15 @@ ga_status ForwardSensitivity::by_differences(const State &accepted, double h, bo
             };
             if (taylor_step) {
                 const State &trial = k_.trial();
-                take(out.q, trial.q);
+                const ConfigurationSpace &space = k_.model.space;
+                // d/dp of q is a tangent: on a group the central difference is
+                // log(q_-^-1 q_+) (second order like the difference; storages do not subtract)
+                if (space.euclidean())
+                    take(out.q, trial.q);
+                else if (side == 0)
+                    sens.xq = trial.q;
+                else
+                    space.increment_between(trial.q, sens.xq, out.q);
                 take(out.v, trial.v);
                 take(out.qdd, trial.qdd);
                 take(out.lambda, trial.lambda);

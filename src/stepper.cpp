@@ -253,6 +253,10 @@ ga_status Stepper::setup_workspace()
     B_.copy_layout(J_);
     Z_.copy_layout(J_);
     f_.setZero(nv_);
+    // dense output's q and v, whatever the output mode (on a group space ga_interpolate
+    // writes q block by block into a vector of its size)
+    out_q_.setZero(nq_);
+    out_v_.setZero(nv_);
     phi_.setZero(m_);
     phi_v_.setZero(m_);
     rq_.setZero(nv_);

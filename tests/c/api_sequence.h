@@ -18,9 +18,14 @@
 
 /* The model: a planar chain of L = 1 to 3 links in Cartesian coordinates (n = 2 L, the point
  * masses at the links' ends), m = L constraints |p_k - p_(k-1)|^2 = 1 (p_(-1) = 0), or L + 1
- * with the first stated twice (redundant), or none (free particles). */
+ * with the first stated twice (redundant), or none (free particles). With a rotor
+ * (run_sequence's `rotor`), a free rigid body follows the chain's coordinates on a group
+ * block of ga_create_space -- a rotation stored as a quaternion or a matrix, or an SE(3) pose
+ * -- with its gyroscopic force and nothing joining it to the chain: nv = n + 3 or n + 6 and
+ * nq = n + 4, 9 or 7 (no rotor: nv = nq = n). */
 enum { MAX_LINKS = 3, NMAX = 2 * MAX_LINKS, MMAX = MAX_LINKS + 1, MAX_OPS = 64,
-       STATE_MAX = 1 + 4 * NMAX + MMAX + 2 + 2 * (3 * NMAX + MMAX), CKPT_MAX = 1024 };
+       VMAX = NMAX + 6, QMAX = NMAX + 9,
+       STATE_MAX = 1 + QMAX + 3 * VMAX + MMAX + 2 + 2 * (3 * VMAX + MMAX), CKPT_MAX = 2048 };
 
 typedef enum fault_kind { NONE, RETURN_RETRY, RETURN_FATAL, WRITE_NAN, WRITE_INF, WRITE_HUGE,
                           REENTER, FAULT_KINDS } fault_kind;
@@ -33,6 +38,8 @@ typedef struct model {
     size_t size, pos;
     int exhausted;         /* the bytes ran out: the sequence ends after this call */
     int links, n, m;       /* m = links, links + 1 (redundant) or 0 */
+    int rotor;             /* 0, or the rotor's kind (GA_SPACE_SO3_QUATERNION, _MATRIX, _SE3) */
+    int nv, nq;            /* v's and q's lengths: n plus the rotor's */
     int r;                 /* first-order states: 0, or 1 (y' = v_0 - y, a force y on q_0) */
     fault_kind fault;      /* armed failure */
     int fault_callback;    /* which callback fails */
@@ -42,7 +49,7 @@ typedef struct model {
     int reentry_allowed;   /* a callback's ga_step on its own solver returned other than STATE */
     int sparse_M, sparse_J, sparse_K; /* patterns declared: the callbacks write values only */
     /* the patterns the callbacks write when declared */
-    int m_diag[NMAX], m_colptr[NMAX + 1];
+    int m_diag[VMAX], m_colptr[VMAX + 1];
     int j_rows[4 * MMAX], j_cols[4 * MMAX], j_nnz;
     int k_rows[3 * NMAX], k_cols[3 * NMAX], k_nnz;
     /* events (ga_set_events): g_k = q_k - level_k, or lambda_0 - level_2 for the third with
@@ -106,9 +113,14 @@ static void model_shape(model *md, int links, int m)
     md->links = links;
     md->n = 2 * links;
     md->m = m;
-    for (int i = 0; i < md->n; ++i)
+    md->nv = md->n + (md->rotor == GA_SPACE_SE3 ? 6 : md->rotor ? 3 : 0);
+    md->nq = md->n + (md->rotor == GA_SPACE_SE3              ? 7
+                      : md->rotor == GA_SPACE_SO3_QUATERNION ? 4
+                      : md->rotor == GA_SPACE_SO3_MATRIX     ? 9
+                                                             : 0);
+    for (int i = 0; i < md->nv; ++i)
         md->m_diag[i] = md->m_colptr[i] = i;
-    md->m_colptr[md->n] = md->n;
+    md->m_colptr[md->nv] = md->nv;
     int nnz = 0;
     for (int k = 0; k < m; ++k) {
         const int link = k < links ? k : 0;  /* the redundant row repeats row 0 */
@@ -135,28 +147,53 @@ static void link_vector(const model *md, int k, const double *x, double d[2])
     d[1] = x[2 * link + 1] - (link > 0 ? x[2 * link - 1] : 0.0);
 }
 
+/* The rotor's mass matrix diagonal: a pose's mass 2, then the inertia (1, 2, 3) */
+static double rotor_inertia(const model *md, int i)
+{
+    const int k = i - md->n - (md->rotor == GA_SPACE_SE3 ? 3 : 0);
+    return k < 0 ? 2.0 : 1.0 + k;
+}
 static int mass(double t, const double *q, double *M, void *user)
 {
     model *md = user;
-    const int n = md->n;
+    const int n = md->n, nv = md->nv;
     (void)t, (void)q;
     if (md->sparse_M) {  /* the diagonal */
-        for (int i = 0; i < n; ++i)
-            M[i] = 1.0;
-        return misbehave(md, MASS, M, n);
+        for (int i = 0; i < nv; ++i)
+            M[i] = i < n ? 1.0 : rotor_inertia(md, i);
+        return misbehave(md, MASS, M, nv);
     }
-    memset(M, 0, sizeof(double) * (size_t)(n * n));
-    for (int i = 0; i < n; ++i)
-        M[i + i * n] = 1.0;
-    return misbehave(md, MASS, M, n * n);
+    memset(M, 0, sizeof(double) * (size_t)(nv * nv));
+    for (int i = 0; i < nv; ++i)
+        M[i + i * nv] = i < n ? 1.0 : rotor_inertia(md, i);
+    return misbehave(md, MASS, M, nv * nv);
+}
+/* The rotor's force in the body frame: -w x J w, and a pose's -m w x u */
+static void rotor_force(const model *md, const double *v, double *f)
+{
+    if (!md->rotor)
+        return;
+    const int w0 = md->nv - 3;
+    const double *w = v + w0;
+    const double Jw[3] = {w[0], 2.0 * w[1], 3.0 * w[2]};
+    f[w0] = -(w[1] * Jw[2] - w[2] * Jw[1]);
+    f[w0 + 1] = -(w[2] * Jw[0] - w[0] * Jw[2]);
+    f[w0 + 2] = -(w[0] * Jw[1] - w[1] * Jw[0]);
+    if (md->rotor == GA_SPACE_SE3) {
+        const double *u = v + md->n;
+        f[md->n] = -2.0 * (w[1] * u[2] - w[2] * u[1]);
+        f[md->n + 1] = -2.0 * (w[2] * u[0] - w[0] * u[2]);
+        f[md->n + 2] = -2.0 * (w[0] * u[1] - w[1] * u[0]);
+    }
 }
 static int force(double t, const double *q, const double *v, double *f, void *user)
 {
     model *md = user;
-    (void)t, (void)q, (void)v;
+    (void)t, (void)q;
     for (int i = 0; i < md->n; ++i)
         f[i] = i % 2 ? -md->p[0] : 0.0;
-    return misbehave(md, FORCE, f, md->n);
+    rotor_force(md, v, f);
+    return misbehave(md, FORCE, f, md->nv);
 }
 static int force_y(double t, const double *q, const double *v, const double *y, double *f,
                    void *user)
@@ -190,7 +227,7 @@ static int jacobian(double t, const double *q, double *J, void *user)
     const int m = md->m;
     (void)t;
     if (!md->sparse_J)
-        memset(J, 0, sizeof(double) * (size_t)(m * md->n));
+        memset(J, 0, sizeof(double) * (size_t)(m * md->nv));
     int e = 0;
     for (int k = 0; k < m; ++k) {
         double d[2];
@@ -205,7 +242,7 @@ static int jacobian(double t, const double *q, double *J, void *user)
                 J[k + col * m] = values[c];
         }
     }
-    return misbehave(md, JACOBIAN, J, md->sparse_J ? md->j_nnz : m * md->n);
+    return misbehave(md, JACOBIAN, J, md->sparse_J ? md->j_nnz : m * md->nv);
 }
 /* K_t = d(Phi_q^T lambda)/dq (M constant, f constant) */
 static int stiffness(double t, const double *q, const double *v, const double *qdd,
@@ -231,15 +268,16 @@ static int stiffness(double t, const double *q, const double *v, const double *q
                 K[e++] = md->m ? -on_link[k] : 0.0;
         return misbehave(md, STIFFNESS, K, md->k_nnz);
     }
-    memset(K, 0, sizeof(double) * (size_t)(n * n));
+    const int nv = md->nv;  /* (the rotor's block is zero: its force is the body frame's) */
+    memset(K, 0, sizeof(double) * (size_t)(nv * nv));
     for (int i = 0; i < n; ++i)
-        K[i + i * n] = diag[i];
+        K[i + i * nv] = diag[i];
     for (int k = 1; k < links && md->m; ++k)
         for (int d = 0; d < 2; ++d) {
             const int a = 2 * k - 2 + d, b = 2 * k + d;
-            K[a + b * n] = K[b + a * n] = -on_link[k];
+            K[a + b * nv] = K[b + a * nv] = -on_link[k];
         }
-    return misbehave(md, STIFFNESS, K, n * n);
+    return misbehave(md, STIFFNESS, K, nv * nv);
 }
 static int accel(double t, const double *q, const double *v, double *out, void *user)
 {
@@ -268,15 +306,15 @@ static int adjoint_cost(double t, const double *q, const double *v, const double
 {
     model *md = user;
     (void)t, (void)v, (void)qdd, (void)lambda;
-    memset(d_q, 0, sizeof(double) * (size_t)md->n);
-    memset(d_v, 0, sizeof(double) * (size_t)md->n);
-    memset(d_qdd, 0, sizeof(double) * (size_t)md->n);
+    memset(d_q, 0, sizeof(double) * (size_t)md->nv);
+    memset(d_v, 0, sizeof(double) * (size_t)md->nv);
+    memset(d_qdd, 0, sizeof(double) * (size_t)md->nv);
     if (md->m)  /* (NULL without constraints) */
         memset(d_lambda, 0, sizeof(double) * (size_t)md->m);
     d_p[0] = d_p[1] = 0.0;
     d_q[0] = 1.0;
     *value = q[0];
-    return misbehave(md, COST, d_q, md->n);
+    return misbehave(md, COST, d_q, md->nv);
 }
 static int running_cost(double t, const double *q, const double *v, const double *qdd,
                         const double *lambda, double *value, double *d_q, double *d_v,
@@ -297,7 +335,7 @@ static ga_status declare_pattern(model *md, ga_solver *s, int *must_fail)
     *must_fail = k >= 5;
     switch (k) {
     case 0: {
-        const ga_status st = ga_set_pattern(s, GA_MATRIX_MASS, md->n, md->m_diag, md->m_diag);
+        const ga_status st = ga_set_pattern(s, GA_MATRIX_MASS, md->nv, md->m_diag, md->m_diag);
         md->sparse_M |= st == GA_OK;
         return st;
     }
@@ -357,29 +395,29 @@ static int coupling(double t, const double *q, const double *v, const double *y,
 {
     model *md = user;
     (void)t, (void)q, (void)v, (void)y;
-    memset(g_q, 0, sizeof(double) * (size_t)md->n);
-    memset(g_v, 0, sizeof(double) * (size_t)md->n);
-    memset(f_y, 0, sizeof(double) * (size_t)md->n);
+    memset(g_q, 0, sizeof(double) * (size_t)md->nv);
+    memset(g_v, 0, sizeof(double) * (size_t)md->nv);
+    memset(f_y, 0, sizeof(double) * (size_t)md->nv);
     g_v[0] = 1.0;
     g_y[0] = -1.0;
     f_y[0] = 1.0;
-    return misbehave(md, COUPLING, g_v, md->n);
+    return misbehave(md, COUPLING, g_v, md->nv);
 }
 /* df/dp: gravity enters every odd force as -p_0; p_1 nothing. M and Phi do not depend on p. */
 static int force_p(double t, const double *q, const double *v, int j, double *f_p, void *user)
 {
     model *md = user;
     (void)t, (void)q, (void)v;
-    for (int i = 0; i < md->n; ++i)
-        f_p[i] = j == 0 && i % 2 ? -1.0 : 0.0;
-    return misbehave(md, FORCE_P, f_p, md->n);
+    for (int i = 0; i < md->nv; ++i)
+        f_p[i] = j == 0 && i % 2 && i < md->n ? -1.0 : 0.0;
+    return misbehave(md, FORCE_P, f_p, md->nv);
 }
 static int mass_p(double t, const double *q, int j, const double *a, double *out, void *user)
 {
     model *md = user;
     (void)t, (void)q, (void)j, (void)a;
-    memset(out, 0, sizeof(double) * (size_t)md->n);
-    return misbehave(md, MASS_P, out, md->n);
+    memset(out, 0, sizeof(double) * (size_t)md->nv);
+    return misbehave(md, MASS_P, out, md->nv);
 }
 static int constraint_p(double t, const double *q, int j, double *phi_p, double *Phi_q_p,
                         double *Phi_t_p, void *user)
@@ -387,7 +425,7 @@ static int constraint_p(double t, const double *q, int j, double *phi_p, double 
     model *md = user;
     (void)t, (void)q, (void)j;
     memset(phi_p, 0, sizeof(double) * (size_t)md->m);
-    memset(Phi_q_p, 0, sizeof(double) * (size_t)(md->sparse_J ? md->j_nnz : md->m * md->n));
+    memset(Phi_q_p, 0, sizeof(double) * (size_t)(md->sparse_J ? md->j_nnz : md->m * md->nv));
     if (Phi_t_p)
         memset(Phi_t_p, 0, sizeof(double) * (size_t)md->m);
     return md->m ? misbehave(md, CONSTRAINT_P, phi_p, md->m) : 0;
@@ -398,10 +436,10 @@ static int step_hook(const ga_solver *s, double t, const double *q, const double
                      const double *lambda, void *user)
 {
     model *md = user;
-    double x[NMAX], h = 0.0, qi[NMAX], vi[NMAX], li[MMAX];
+    double x[QMAX], h = 0.0, qi[QMAX], vi[VMAX], li[MMAX];
     (void)v, (void)lambda;
     ++md->hook_calls;
-    if (ga_get_q(s, x) != GA_OK || memcmp(x, q, sizeof(double) * (size_t)md->n) != 0)
+    if (ga_get_q(s, x) != GA_OK || memcmp(x, q, sizeof(double) * (size_t)md->nq) != 0)
         ++md->hook_wrong;
     if (ga_get_h_last(s, &h) == GA_OK && h > 0.0)  /* may fail with the callbacks: allowed */
         ga_interpolate(s, t - 0.5 * h, qi, vi, md->m ? li : NULL);
@@ -461,17 +499,17 @@ static double step_size(model *md)
 /* t, q, v, qdd, a, lambda (and y, y'); 0 before ga_init */
 static int snapshot(const model *md, ga_solver *s, double *x)
 {
-    const int n = md->n;
+    const int n = md->nv, q = md->nq;  /* (v, qdd, a after q's storage) */
     if (ga_get_t(s, x) != GA_OK)
         return 0;
     SEQ_REQUIRE(ga_get_q(s, x + 1) == GA_OK);
-    SEQ_REQUIRE(ga_get_v(s, x + 1 + n) == GA_OK);
-    SEQ_REQUIRE(ga_get_qdd(s, x + 1 + 2 * n) == GA_OK);
-    SEQ_REQUIRE(ga_get_a(s, x + 1 + 3 * n) == GA_OK);
-    SEQ_REQUIRE(ga_get_lambda(s, md->m ? x + 1 + 4 * n : NULL) == GA_OK);
+    SEQ_REQUIRE(ga_get_v(s, x + 1 + q) == GA_OK);
+    SEQ_REQUIRE(ga_get_qdd(s, x + 1 + q + n) == GA_OK);
+    SEQ_REQUIRE(ga_get_a(s, x + 1 + q + 2 * n) == GA_OK);
+    SEQ_REQUIRE(ga_get_lambda(s, md->m ? x + 1 + q + 3 * n : NULL) == GA_OK);
     if (md->r)
-        SEQ_REQUIRE(ga_get_y(s, x + 1 + 4 * n + md->m, x + 2 + 4 * n + md->m) == GA_OK);
-    int len = 1 + 4 * n + md->m + 2 * md->r;
+        SEQ_REQUIRE(ga_get_y(s, x + 1 + q + 3 * n + md->m, x + 2 + q + 3 * n + md->m) == GA_OK);
+    int len = 1 + q + 3 * n + md->m + 2 * md->r;
     for (int j = 0; md->sens_forward && j < 2; ++j) {
         double *d = x + len;
         SEQ_REQUIRE(ga_get_sensitivity(s, j, d, d + n, d + 2 * n, md->m ? d + 3 * n : NULL) ==
@@ -586,8 +624,9 @@ static void after_step(const model *md, ga_solver *s, ga_status st, const double
 }
 
 /* One sequence: its choices from `data` (fuzzing; the sequence ends with the bytes) or from a
- * generator seeded by `seq`. */
-static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *stats)
+ * generator seeded by `seq`; with `rotor`, on the chain and a rotor of a kind the sequence
+ * draws (the chain's runs draw nothing for it: their choices stay those of the bytes). */
+static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *stats, int rotor)
 {
     model md = {0};
     md.p[0] = 9.81;
@@ -598,11 +637,22 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         next(&md);
     const int links = 1 + pick(&md, MAX_LINKS);
     const int kinds[] = {links, links + 1, 0};
-    model_shape(&md, links, kinds[pick(&md, 3)]);
+    const int m = kinds[pick(&md, 3)];
+    if (rotor) {
+        static const int rotors[3] = {GA_SPACE_SO3_QUATERNION, GA_SPACE_SO3_MATRIX, GA_SPACE_SE3};
+        md.rotor = rotors[pick(&md, 3)];
+    }
+    model_shape(&md, links, m);
     ga_solver *s = NULL;
-    SEQ_REQUIRE(ga_create(md.n, md.m, &s) == GA_OK);
+    if (md.rotor) {
+        const int block_kinds[2] = {GA_SPACE_VECTOR, md.rotor}, counts[2] = {md.n, 1};
+        SEQ_REQUIRE(ga_create_space(2, block_kinds, counts, md.m, &s) == GA_OK);
+    } else {
+        SEQ_REQUIRE(ga_create(md.n, md.m, &s) == GA_OK);
+    }
 #ifdef SEQ_TRACE
-    fprintf(stderr, "n = %d, m = %d\n", md.n, md.m);
+    fprintf(stderr, "n = %d, m = %d, rotor %d (nv %d, nq %d)\n", md.n, md.m, md.rotor, md.nv,
+            md.nq);
 #endif
     md.s = s;
     /* snapshots read the state: the step's qdd and lambda, no callbacks */
@@ -610,7 +660,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
     SEQ_REQUIRE(ga_set_callbacks(s, mass, force, constraint, jacobian, &md) == GA_OK);
     if (pick(&md, 3) == 0) {  /* a third of the runs on the sparse path */
         md.sparse_M = 1;
-        SEQ_REQUIRE(ga_set_pattern(s, GA_MATRIX_MASS, md.n, md.m_diag, md.m_diag) == GA_OK);
+        SEQ_REQUIRE(ga_set_pattern(s, GA_MATRIX_MASS, md.nv, md.m_diag, md.m_diag) == GA_OK);
         if (md.m > 0) {
             md.sparse_J = 1;
             SEQ_REQUIRE(ga_set_pattern(s, GA_MATRIX_JACOBIAN, md.j_nnz, md.j_rows, md.j_cols) ==
@@ -697,15 +747,27 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         case 20: case 21: case 34: case 35: {
             const double angle = 0.3 + uniform(&md);
             /* the first link at `angle` from the downward vertical, the others horizontal */
-            double q0[NMAX], v0[NMAX] = {0};
+            double q0[QMAX] = {0}, v0[VMAX] = {0};
             for (int k = 0; k < md.links; ++k) {
                 q0[2 * k] = sin(angle) + k;
                 q0[2 * k + 1] = -cos(angle);
             }
+            if (md.rotor) {  /* the rotor at a third of a turn about (1, 1, 1), spinning */
+                double *r = q0 + md.n + (md.rotor == GA_SPACE_SE3 ? 3 : 0);
+                if (md.rotor == GA_SPACE_SO3_MATRIX) {
+                    const double R[9] = {0, 1, 0, 0, 0, 1, 1, 0, 0};
+                    memcpy(r, R, sizeof R);
+                } else {
+                    r[0] = r[1] = r[2] = r[3] = 0.5;
+                }
+                for (int i = md.n; i < md.nv; ++i)
+                    v0[i] = 0.5 + i - md.n;
+            }
+            /* (a rotor's storage perturbed: no rotation, refused) */
             if (pick(&md, 4) == 0)
-                q0[pick(&md, md.n)] += edge_value(&md);
+                q0[pick(&md, md.nq)] += edge_value(&md);
             if (pick(&md, 4) == 0)
-                v0[pick(&md, md.n)] += edge_value(&md);
+                v0[pick(&md, md.nv)] += edge_value(&md);
             const double t0 = pick(&md, 5) == 0 ? edge_value(&md) : 0.0;
             if (md.r && pick(&md, 4)) {
                 const double y0[1] = {pick(&md, 4) == 0 ? edge_value(&md) : 0.3};
@@ -735,7 +797,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             break;
         }
         case 27: {
-            double t = 0.0, q[NMAX], v[NMAX], lambda[MMAX];
+            double t = 0.0, q[QMAX], v[VMAX], lambda[MMAX];
             ga_get_t(s, &t);
             call = "ga_interpolate";
             changes = 0;
@@ -790,7 +852,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             ga_get_t(s, &t);
             switch (pick(&md, 5)) {
             case 4: {  /* the rate's own patterns (g_q zero, g_v at (0, 0)), or an index too far */
-                static const int zero[1] = {0}, far[1] = {NMAX};
+                static const int zero[1] = {0}, far[1] = {VMAX};
                 const int which = pick(&md, 3);  /* 2: unknown, refused */
                 call = "ga_set_coupling_pattern";
                 st = ga_set_coupling_pattern(s, which, which == 0 ? 0 : 1, zero,
@@ -811,7 +873,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             break;
         }
         case 37: {  /* sensitivities: reads, the adjoint sweep, late or bad settings */
-            double d[NMAX], J, dJ[2];
+            double d[VMAX], J, dJ[2];
             switch (pick(&md, 4)) {
             case 0:
                 call = "ga_get_sensitivity";
@@ -901,8 +963,8 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             st = ga_set_coupling(s, pick(&md, 2) ? coupling : NULL);
             break;
         case 43: {  /* the sensitivities' starts and derivative callbacks */
-            double dq0[NMAX], dv0[NMAX];
-            for (int i = 0; i < md.n; ++i)
+            double dq0[VMAX], dv0[VMAX];
+            for (int i = 0; i < md.nv; ++i)
                 dq0[i] = pick(&md, 8) ? 0.1 * uniform(&md) : edge_value(&md),
                 dv0[i] = pick(&md, 8) ? 0.1 * uniform(&md) : edge_value(&md);
             switch (pick(&md, 3)) {
@@ -950,7 +1012,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             break;
         }
         case 46: {  /* reads added since the first harness */
-            double t = 0.0, x[NMAX], y[1], yd[1], am, af, b, g;
+            double t = 0.0, x[VMAX], y[1], yd[1], am, af, b, g;
             int n = 0, m = 0;
             ga_get_t(s, &t);
             changes = 0;
@@ -970,7 +1032,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
             default:
                 call = "ga_get_size";
                 st = ga_get_size(s, &n, &m);
-                if (st == GA_OK && (n != md.n || m != md.m))
+                if (st == GA_OK && (n != md.nv || m != md.m))
                     SEQ_FAIL("sequence %d: ga_get_size said %d, %d", seq, n, m);
             }
             break;
@@ -993,7 +1055,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
                 md.ev_count = pick(&md, 4);
                 md.ev_lambda = pick(&md, 2);
                 /* levels next to the current values, so that the functions cross soon */
-                double q[NMAX] = {0}, lambda[MMAX] = {0};
+                double q[QMAX] = {0}, lambda[MMAX] = {0};
                 ga_get_q(s, q);
                 if (md.m)
                     ga_get_lambda(s, lambda);

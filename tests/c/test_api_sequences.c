@@ -13,7 +13,8 @@
  *     for bit (the restart twin).
  * Models: planar chains of 1 to 3 links in Cartesian coordinates (n = 2, 4 or 6; a constraint
  * per link), the same with the first constraint stated twice (one redundant), and free
- * particles (none);
+ * particles (none); each of them also with a free rotor on a group block (ga_create_space: a
+ * quaternion, a rotation matrix or an SE(3) pose);
  * a third of the runs declare sparsity patterns and take the sparse path, and pattern
  * declarations (valid ones, and invalid ones that must be refused) come at random too.
  * Every function of the header is called (events and events on y, first-order states and
@@ -36,14 +37,14 @@
 #define SEQ_REQUIRE(cond) assert_true(cond)
 #include "api_sequence.h"
 
-enum { SEQUENCES = 20000 };
+enum { SEQUENCES = 20000, ROTOR_SEQUENCES = 6000 };
 
 static void random_call_sequences_keep_the_contract(void **state)
 {
     (void)state;
     seq_stats stats = {0};
     for (int seq = 0; seq < SEQUENCES; ++seq)
-        run_sequence(seq, NULL, 0, &stats);
+        run_sequence(seq, NULL, 0, &stats, 0);
     const long long steps_ok = stats.steps_ok, sparse_ok = stats.sparse_ok;
     printf("  %d sequences, %lld calls, %lld accepted steps (%lld on the sparse path, %lld with "
            "sensitivities), %lld steps repeated from a restored checkpoint, %lld stops at "
@@ -62,6 +63,28 @@ static void random_call_sequences_keep_the_contract(void **state)
     assert_true(stats.adjoint_ok > SEQUENCES / 400);
     assert_true(stats.hook_calls > SEQUENCES / 10 && stats.hook_stops > SEQUENCES / 400);
     assert_true(stats.advance_ok > SEQUENCES / 100);
+}
+
+/* The same contract with a rotor on a group block beside the chain (a quaternion, a rotation
+ * matrix or an SE(3) pose): the group's step, its sparse path, checkpoints, events,
+ * sensitivities and the adjoint under the same careless calls. */
+static void random_call_sequences_with_a_rotor_keep_the_contract(void **state)
+{
+    (void)state;
+    seq_stats stats = {0};
+    for (int seq = 0; seq < ROTOR_SEQUENCES; ++seq)
+        run_sequence(SEQUENCES + seq, NULL, 0, &stats, 1);
+    printf("  %d sequences with a rotor, %lld calls, %lld accepted steps (%lld on the sparse "
+           "path, %lld with sensitivities), %lld steps repeated from a restored checkpoint, "
+           "%lld stops at events, %lld adjoint sweeps\n",
+           ROTOR_SEQUENCES, stats.calls, stats.steps_ok, stats.sparse_ok,
+           stats.sensitivity_steps_ok, stats.twin_steps_ok, stats.events, stats.adjoint_ok);
+    assert_true(stats.steps_ok > ROTOR_SEQUENCES / 2);
+    assert_true(stats.sparse_ok > ROTOR_SEQUENCES / 100);
+    assert_true(stats.twin_steps_ok > ROTOR_SEQUENCES / 100);
+    assert_true(stats.events > ROTOR_SEQUENCES / 400);
+    assert_true(stats.sensitivity_steps_ok > ROTOR_SEQUENCES / 100);
+    assert_true(stats.adjoint_ok > ROTOR_SEQUENCES / 400);
 }
 
 /* The sequences' model is exact: for every chain length, with and without the redundant
@@ -150,7 +173,8 @@ static void fuzzer_findings_stay_fixed(void **state)
         const size_t size = fread(data, 1, sizeof data, f);
         fclose(f);
         seq_stats stats = {0};
-        run_sequence(0, data, size, &stats);
+        run_sequence(0, data, size, &stats, 0);
+        run_sequence(0, data, size, &stats, 1);
         ++replayed;
     }
     closedir(dir);
@@ -206,6 +230,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(model_derivatives_agree_with_differences),
         cmocka_unit_test(random_call_sequences_keep_the_contract),
+        cmocka_unit_test(random_call_sequences_with_a_rotor_keep_the_contract),
         cmocka_unit_test(fuzzer_findings_stay_fixed),
         cmocka_unit_test(a_sliver_after_a_diverged_step_repeats_from_its_checkpoint),
     };
