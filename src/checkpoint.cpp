@@ -4,7 +4,8 @@
 //             they were central differences, as for sensitivities),
 //             theta_prev, refresh_steps_left, reuse_backoff, fd_tangents, c_count, c_dt]
 //   state    q (nq), v, qdd (nv each), lambda (m), a, a_prev, c, c_prev (nv each)
-//   matrix   the iterate it was factorized at: q (nq), v, qdd (nv), lambda (m); q of its B (nq)
+//   matrix   the iterate it was factorized at: q (nq), v, qdd (nv), lambda (m); q of its B (nq);
+//            on a group space the increment xi whose T(xi) it took (nv)
 //   active   the constraints in use (m flags; all 1 unless GA_REDUNDANT_DROP dropped some)
 //   pivots   blocks of pivot_state_size(N) (backend.hpp) for S_ (N = nv + m), S2_
 //            (2 nv + 2 m), P_ and O_ (nv + m each)
@@ -21,7 +22,9 @@
 // read as a state whose index-3 error estimate has no consistent accelerations yet.
 #include "stepper.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 
 namespace ga {
 
@@ -46,7 +49,7 @@ Layout layout(int nq, int nv, int m, bool layout3 = false)
                       M = static_cast<std::size_t>(m);
     Layout l;
     l.matrix = layout3 ? kHeader3 + Q + 4 * N + M : kHeader + Q + 6 * N + M;
-    l.active = l.matrix + 2 * Q + 2 * N + M;
+    l.active = l.matrix + 2 * Q + 2 * N + M + (nq != nv ? N : 0);  // (a group space: xi)
     l.pivots[0] = l.active + M;
     l.pivots[1] = l.pivots[0] + pivot_state_size(nv + m);
     l.pivots[2] = l.pivots[1] + pivot_state_size(2 * nv + 2 * m);
@@ -92,10 +95,14 @@ void Stepper::save_checkpoint(double *buf, const StepController &control) const
                                     s.c_count == 2 ? s.c_dt : 0.0};
     std::copy(header, header + kHeader, buf);
     double *p = buf + kHeader;
-    // (c and c_prev as zeros where they are not known: the same state, the same checkpoint)
+    // (c and c_prev as zeros where they are not known, and the recipe without a kept matrix:
+    // the same state, the same checkpoint; a stale recipe may hold a failed iterate's NaN)
+    const Vec *recipe[] = {&r.q, &r.v, &r.qdd, &r.lambda, &r.q_b, &r.xi};
     for (const Vec *x : {&s.q, &s.v, &s.qdd, &s.lambda, &s.a, &s.a_prev, &s.c, &s.c_prev, &r.q,
-                         &r.v, &r.qdd, &r.lambda, &r.q_b}) {
-        if ((x == &s.c && s.c_count < 1) || (x == &s.c_prev && s.c_count < 2))
+                         &r.v, &r.qdd, &r.lambda, &r.q_b, &r.xi}) {
+        const bool stale = !jacobian_valid_ && std::find(std::begin(recipe), std::end(recipe),
+                                                         x) != std::end(recipe);
+        if ((x == &s.c && s.c_count < 1) || (x == &s.c_prev && s.c_count < 2) || stale)
             Eigen::Map<Vec>(p, x->size()).setZero();
         else
             Eigen::Map<Vec>(p, x->size()) = *x;
@@ -109,7 +116,10 @@ void Stepper::save_checkpoint(double *buf, const StepController &control) const
     O_.save_pivots(buf + l.pivots[3]);
     p = buf + l.end;
     for (const Vec *x : {&s.y, &s.ydot, &s.w, &s.w_prev, &r.y, &r.ydot}) {
-        Eigen::Map<Vec>(p, x->size()) = *x;
+        if (!jacobian_valid_ && (x == &r.y || x == &r.ydot))
+            Eigen::Map<Vec>(p, x->size()).setZero();
+        else
+            Eigen::Map<Vec>(p, x->size()) = *x;
         p += x->size();
     }
 }
@@ -302,7 +312,7 @@ ga_status Stepper::load_checkpoint(const double *buf, bool internal, bool keep_m
         r.C = (tangents & 2) != 0;
         r.Z = (tangents & 4) != 0;
         r.central = (tangents & 8) != 0;
-        for (Vec *x : {&r.q, &r.v, &r.qdd, &r.lambda, &r.q_b}) {
+        for (Vec *x : {&r.q, &r.v, &r.qdd, &r.lambda, &r.q_b, &r.xi}) {
             *x = Eigen::Map<const Vec>(p, x->size());
             p += x->size();
         }
@@ -319,7 +329,7 @@ ga_status Stepper::load_checkpoint(const double *buf, bool internal, bool keep_m
         r.C = (tangents & 2) != 0;
         r.Z = (tangents & 4) != 0;
         r.central = (tangents & 8) != 0;
-        for (Vec *x : {&r.q, &r.v, &r.qdd, &r.lambda, &r.q_b}) {
+        for (Vec *x : {&r.q, &r.v, &r.qdd, &r.lambda, &r.q_b, &r.xi}) {
             *x = Eigen::Map<const Vec>(p, x->size());
             p += x->size();
         }
@@ -355,6 +365,8 @@ ga_status Stepper::rebuild_matrix()
         return diag.fail(GA_ERR_STATE, "the checkpoint's kept matrix holds %s, for which this "
                          "solver's sparse path has no pattern", r.K && unheld(K_) ? "K_t" : "C_t");
     State &x = trial_;  // scratch between steps
+    if (!model.space.euclidean())
+        xi_ = r.xi;  // the T(xi) the matrix took
     x.q = r.q;
     x.v = r.v;
     x.qdd = r.qdd;

@@ -161,6 +161,8 @@ Stepper::Stepper(const ConfigurationSpace &space, int m)
         x->setZero(nq_);
     for (Vec *x : {&recipe_.v, &recipe_.qdd})
         x->setZero(nv_);
+    if (!space.euclidean())
+        recipe_.xi.setZero(nv_);
     recipe_.lambda.setZero(m);
     M_.set_dense(nv_, nv_);
     J_.set_dense(m, nv_);
@@ -894,6 +896,12 @@ ga_status Stepper::factorize(double t, const State &x, double h, bool tangents_K
     r.v = x.v;
     r.qdd = x.qdd;
     r.lambda = x.lambda;
+    if (!model.space.euclidean()) {  // a rebuild takes the same T (checkpoint.cpp)
+        if (&x == &trial_)
+            r.xi = xi_;
+        else
+            r.xi.setZero();
+    }
     if (this->r() > 0) {
         r.y = x.y;
         r.ydot = x.ydot;

@@ -456,6 +456,7 @@ private:
         bool central = false;  // tangents by central differences (the sensitivities' matrix)
         Vec q, v, qdd, lambda, q_b;
         Vec y, ydot;  // first-order states
+        Vec xi;       // group spaces: the step's increment whose T(xi) it took (0: none)
     } recipe_;
     double b_t_ = 0.0;            // where B_ was evaluated last (index 2)
     const Vec *b_q_ = nullptr;
