@@ -236,7 +236,7 @@ struct Adjoint::Work {
     std::vector<int> slots;  // of the assembled entries, in order
     Eigen::VectorXd rhs;
 #endif
-    Mat D, Md, Jd, Kd, Cd, Bd, Zd;
+    Mat D, Md, Jd, Kd, Cd, Bd, Zd, J0;
     Vec xi;  // a group space's increment of the step (log(q_n^-1 q_{n+1}) block by block)
     Vec bt_eta;  // and B^T eta there
     Eigen::PartialPivLU<Mat> dense_lu;
@@ -450,12 +450,23 @@ ga_status Adjoint::step_back(long k, Work &w)
         if (index2 && m > 0) {
             dense_of(k_.B_matrix(), w.Bd);
             dense_of(k_.Z_matrix(), w.Zd);
+            if (group && !k_.Z_matrix().dense()) {
+                // a pattern's Z is the difference alone: its bracket Phi_q [., v] added here,
+                // with Phi_q before T (the block above, transposed), as the step adds it
+                w.J0 = D.block(0, n, n, m).transpose();
+                space.add_bracket(x.v, w.J0.data(), m, w.Zd.data());
+            }
             if (group)
                 space.right_multiply_tangent(w.xi, w.Zd.data(), m, m);
             if (K)
                 D.block(0, n + m, n, m) = -bh2 * (w.Kd * w.Bd.transpose());
             D.block(n, n + m, m, m) = -(w.Jd * w.Bd.transpose());
-            D.block(n + m, 0, m, n) = s3 * w.Zd + (group ? k_.jacobian_matrix().as_dense() : w.Jd);
+            // (on a group Phi_q without T: the transpose of the block above, since Phi_q's own
+            // values may be a pattern's, not a dense matrix)
+            if (group)
+                D.block(n + m, 0, m, n) = s3 * w.Zd + D.block(0, n, n, m).transpose();
+            else
+                D.block(n + m, 0, m, n) = s3 * w.Zd + w.Jd;
             D.block(n + m, n + m, m, m) = -s3 * (w.Zd * w.Bd.transpose());
         }
         if (R > 0) {
@@ -524,6 +535,11 @@ ga_status Adjoint::step_back(long k, Work &w)
     k_.jacobian_matrix().multiply_transpose_add(1.0, w.rl, w.qp);
     if (index2 && m > 0) {
         k_.Z_matrix().multiply_transpose_add(1.0, w.rv, w.qp);
+        if (group && !k_.Z_matrix().dense()) {  // and the bracket's transpose (as above)
+            w.tmp.setZero();
+            k_.jacobian_matrix().multiply_transpose_add(1.0, w.rv, w.tmp);
+            space.bracket_transpose_add(x.v, w.tmp, w.qp);
+        }
         k_.jacobian_matrix().multiply_transpose_add(1.0, w.rv, w.vp);
     }
     if (R > 0) {  // r^q sees y_p through -f_y; r^y = y'_p - g_q q_p - g_v v_p - g_y y_p

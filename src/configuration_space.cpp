@@ -454,6 +454,39 @@ void ConfigurationSpace::add_bracket(const Vec &v, const double *J, Eigen::Index
     }
 }
 
+void ConfigurationSpace::bracket(const Vec &w, const Vec &v, Vec &u) const
+{
+    u.setZero();
+    for (const Part &p : parts_) {
+        if (p.kind == Kind::Vector)
+            continue;
+        const Eigen::Index n = p.nv;
+        const Op A = ad(p.kind, v.data() + p.v0);
+        for (Eigen::Index l = 0; l < n; ++l) {
+            double s = 0.0;
+            for (Eigen::Index k = 0; k < n; ++k)
+                s += A[static_cast<std::size_t>(n * l + k)] * w[p.v0 + k];
+            u[p.v0 + l] = -s;
+        }
+    }
+}
+
+void ConfigurationSpace::bracket_transpose_add(const Vec &v, const Vec &u, Vec &out) const
+{
+    for (const Part &p : parts_) {
+        if (p.kind == Kind::Vector)
+            continue;
+        const Eigen::Index n = p.nv;
+        const Op A = ad(p.kind, v.data() + p.v0);
+        for (Eigen::Index k = 0; k < n; ++k) {
+            double s = 0.0;
+            for (Eigen::Index l = 0; l < n; ++l)
+                s += A[static_cast<std::size_t>(n * l + k)] * u[p.v0 + l];
+            out[p.v0 + k] -= s;
+        }
+    }
+}
+
 namespace {
 // How far a block's storage is from a rotation: |q| - 1 of a quaternion, the largest entry of
 // R^T R - I of a matrix (infinite with det <= 0); NaN stays NaN

@@ -86,6 +86,11 @@ public:
     // Z <- Z + J ad(., v) on the rotations' columns (J, Z: rows x nv, column-major, ld =
     // rows): Z w += J [w, v] with [w, v] = w x v on each rotation
     void add_bracket(const Vec &v, const double *J, Eigen::Index rows, double *Z) const;
+    // The same on a vector: u = [w, v] = -ad(v) w on every group block, 0 elsewhere (Phi_q u
+    // is what add_bracket adds to Z w)
+    void bracket(const Vec &w, const Vec &v, Vec &u) const;
+    // Its transpose: out += (-ad(v))^T u on every group block
+    void bracket_transpose_add(const Vec &v, const Vec &u, Vec &out) const;
     // The same bracket for matrices on patterns: -ad(v) T(xi) (xi null: -ad(v)) of every group
     // block, laid out as rotation_tangents (TangentProduct::add_bracket scatters J by them)
     void rotation_brackets(const Vec &v, const Vec *xi, double *G) const;

@@ -31,7 +31,8 @@ void Sensitivities::allocate(int nq, int n, int m, int r)  // (n: nv)
         x->setZero(r);
     xq.setZero(nq);  // points: the rest are tangents
     q_pert.setZero(nq);
-    for (Vec *x : {&rq, &d, &w, &f_plus, &f_minus, &bt, &a0, &xv, &cq, &cbt, &cq2, &cbt2})
+    for (Vec *x : {&rq, &d, &w, &f_plus, &f_minus, &bt, &a0, &xv, &cq, &cbt, &cq2, &cbt2,
+                   &bracket})
         x->setZero(n);
     seed_q.assign(np, Vec::Zero(n));
     seed_v.assign(np, Vec::Zero(n));
@@ -664,8 +665,15 @@ ga_status ForwardSensitivity::step(double h)
         k_.jacobian_matrix().multiply_add(1.0, s1.q, z.rl);
         if (index2) {
             z.rv = z.cv;
-            if (Z)
+            if (Z) {
                 k_.Z_matrix().multiply_add(1.0, s1.q, z.rv);
+                if (!space.euclidean() && !k_.Z_matrix().dense()) {
+                    // on a pattern Z is the difference alone: Phi_q [s, v] added here, as the
+                    // step matrix adds it (Model::velocity_constraint_tangent)
+                    space.bracket(s1.q, x.v, z.bracket);
+                    k_.jacobian_matrix().multiply_add(1.0, z.bracket, z.rv);
+                }
+            }
             k_.jacobian_matrix().multiply_add(1.0, s1.v, z.rv);
         }
         k_.solve_step_matrix(z.rq, z.rl, z.rv, h, z.d, z.w, z.dl, z.e);

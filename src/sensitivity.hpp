@@ -61,6 +61,7 @@ struct Sensitivities {
 
     // scratch of one step
     Vec rq, rl, rv, d, w, dl, e, f_plus, f_minus, bt, a0, xq, xv;
+    Vec bracket;  // [s, v] on a group (the curvature's part a pattern's Z leaves out)
     Vec q_pert;  // a point of q along a tangent (correction_derivative)
     Vec ry, dy, gy, w0, rate_plus, rate_minus;  // first-order states (r)
     // the constraints' parameter terms (GA_DEPENDS_CONSTRAINT): in r^q, Phi, the velocity
