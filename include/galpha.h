@@ -1167,6 +1167,55 @@ GA_API ga_status ga_check_derivatives(ga_solver *s, double t, const double *q, c
 GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value);
 /**@}*/
 
+/** @name Operating points: static equilibrium, linearization, vibration modes
+ *  From the callbacks of the dynamics (M, f, Phi, Phi_q and, where given, K_t and C_t; central
+ *  differences otherwise), at rest: v = 0, qdd = 0. Dense; on coordinates in R^n without
+ *  first-order states for now (GA_ERR_STATE otherwise). Callable before or after ga_init:
+ *  the solver's state and set-up are not touched, the evaluations are counted.
+ *  docs/algorithms.md sec. 17. */
+/**@{*/
+/** Static equilibrium at time t: f(q, 0, t) = Phi_q^T lambda, Phi(q, t) = 0, by Newton from
+ *  the q given, in the null space of Phi_q (redundant constraints take the minimum-norm
+ *  multipliers), with a backtracking line search on |f - Phi_q^T lambda|^2 + |Phi|^2. Converged
+ *  when a full Newton step moves q by at most tol max(1, |q|_inf). On GA_OK q holds the
+ *  equilibrium and lambda (length m, may be NULL) its multipliers; on failure both are
+ *  untouched. Load stepping: a load factor the callbacks read through `user`, raised between
+ *  calls, each started from the last equilibrium. Errors: GA_ERR_ARG (NULL q, tol not finite
+ *  and > 0, max_iter < 1, t or q not finite), GA_ERR_STATE (no callbacks, rotations,
+ *  first-order states, from a callback), GA_ERR_SINGULAR (the stiffness in the constraints'
+ *  free directions is singular: a limit point, or a motion nothing restrains),
+ *  GA_ERR_NEWTON (no equilibrium in max_iter iterations, or none in reach along Newton's
+ *  direction), callback errors. */
+GA_API ga_status ga_static_equilibrium(ga_solver *s, double t, double *q, double *lambda,
+                                       double tol, int max_iter);
+
+/** The small motions about (q, lambda) at rest in minimal coordinates q = q0 + N z, with
+ *  Phi_q N = 0: *dof = n - rank(Phi_q) and, each output optional (NULL), N (n x dof,
+ *  orthonormal columns), the reduced mass N^T M N, damping N^T C_t N and stiffness
+ *  N^T K_t N (dof x dof; K_t includes the constraints' d(Phi_q^T lambda)/dq), column-major
+ *  with ld = n for N and dof for the others. The system is M z'' + C z' + K z = 0 (about an
+ *  equilibrium). lambda NULL: the multipliers that balance f at q (least squares). Nothing is
+ *  written unless *dof <= max_dof. Errors: GA_ERR_ARG (NULL q or dof, a value not finite,
+ *  *dof > max_dof: the message says *dof), GA_ERR_STATE as ga_static_equilibrium, callback
+ *  errors. */
+GA_API ga_status ga_linearize(ga_solver *s, double t, const double *q, const double *lambda,
+                              int max_dof, int *dof, double *N, double *M, double *C, double *K);
+
+/** The `count` lowest undamped vibration modes at an equilibrium (q, lambda):
+ *  (N^T K_t N) z = omega^2 (N^T M N) z. omega2 (length count) ascending; a negative value is an
+ *  unstable direction of the equilibrium. shapes (may be NULL): n x count, column-major, the
+ *  modes in q (N z), with unit modal mass (shape^T M shape = 1). lambda NULL: the balancing
+ *  multipliers. Errors: GA_ERR_ARG (NULL q or omega2, count < 1 or above the degrees of
+ *  freedom -- zero when the constraints lock the mechanism --, a value not finite, a
+ *  non-symmetric reduced stiffness: a non-conservative force), GA_ERR_INCONSISTENT (q off
+ *  the constraints by more than 1e-8 max(1, |q|_inf), or not an equilibrium: the forces along
+ *  the free directions above 1e-8 of their size, or a lambda given that does not balance them),
+ *  GA_ERR_SINGULAR (a free direction that carries no mass), GA_ERR_STATE as
+ *  ga_static_equilibrium, callback errors. */
+GA_API ga_status ga_modes(ga_solver *s, double t, const double *q, const double *lambda,
+                          int count, double *omega2, double *shapes);
+/**@}*/
+
 /** @name Rotations: SO(3) as unit quaternions
  *  The rotation group's maps, for models whose rotations are rotation vectors or quaternions,
  *  so that their constraint gradients and tangents follow one convention:

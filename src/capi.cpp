@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "galpha.h"
+#include "operating_point.hpp"
 #include "params.hpp"
 #include "solver.hpp"
 
@@ -1285,6 +1286,84 @@ GA_API ga_status ga_reset_counters(ga_solver *s)
     return guarded(s, [&](ga::Solver &c) {
         c.kernel().counters.fill(0);
         return GA_OK;
+    });
+}
+
+}  // extern "C"
+
+// ---- operating points (operating_point.cpp) ----
+namespace {
+// What the static problem does not cover yet, refused by name.
+ga_status operating_point_refusal(ga::Solver &c, const char *name, double t)
+{
+    if (!c.model.ready())
+        return c.diag.fail(GA_ERR_STATE, "%s needs the callbacks (ga_set_callbacks)", name);
+    if (!c.model.space.euclidean())
+        return c.diag.fail(GA_ERR_STATE, "%s: on coordinates in R^n only (not yet on a space "
+                           "with rotations)", name);
+    if (c.kernel().r() > 0)
+        return c.diag.fail(GA_ERR_STATE, "%s: not yet with first-order states "
+                           "(ga_set_first_order)", name);
+    if (!std::isfinite(t))
+        return c.diag.fail(GA_ERR_ARG, "%s: t = %g is not finite", name, t);
+    return GA_OK;
+}
+}  // namespace
+
+extern "C" {
+
+GA_API ga_status ga_static_equilibrium(ga_solver *s, double t, double *q, double *lambda,
+                                       double tol, int max_iter)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (auto st = operating_point_refusal(c, "ga_static_equilibrium", t))
+            return st;
+        if (!q)
+            return c.diag.fail(GA_ERR_ARG, "ga_static_equilibrium: q is NULL");
+        if (!(tol > 0.0) || !std::isfinite(tol) || max_iter < 1)
+            return c.diag.fail(GA_ERR_ARG, "ga_static_equilibrium: tol = %g must be finite and "
+                               "> 0, max_iter = %d >= 1", tol, max_iter);
+        return ga::static_equilibrium(c.kernel(), t, q, lambda, tol, max_iter);
+    });
+}
+
+GA_API ga_status ga_linearize(ga_solver *s, double t, const double *q, const double *lambda,
+                              int max_dof, int *dof, double *N, double *M, double *C, double *K)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (auto st = operating_point_refusal(c, "ga_linearize", t))
+            return st;
+        if (!q || !dof)
+            return c.diag.fail(GA_ERR_ARG, "ga_linearize: q or dof is NULL");
+        ga::Linearization lin;
+        if (auto st = ga::linearize(c.kernel(), t, q, lambda, lin))
+            return st;
+        if (lin.dof > max_dof)
+            return c.diag.fail(GA_ERR_ARG, "ga_linearize: %d degrees of freedom, max_dof = %d",
+                               lin.dof, max_dof);
+        *dof = lin.dof;
+        const auto put = [](const ga::Mat &A, double *out) {
+            if (out)
+                Eigen::Map<ga::Mat>(out, A.rows(), A.cols()) = A;
+        };
+        put(lin.N, N);
+        put(lin.M, M);
+        put(lin.C, C);
+        put(lin.K, K);
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_modes(ga_solver *s, double t, const double *q, const double *lambda,
+                          int count, double *omega2, double *shapes)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (auto st = operating_point_refusal(c, "ga_modes", t))
+            return st;
+        if (!q || !omega2 || count < 1)
+            return c.diag.fail(GA_ERR_ARG, "ga_modes: q or omega2 is NULL, or count = %d < 1",
+                               count);
+        return ga::modes(c.kernel(), t, q, lambda, count, omega2, shapes);
     });
 }
 

@@ -411,6 +411,33 @@ module galpha
        real(c_double), intent(in) :: q(*), v(*)
        real(c_double), intent(out) :: worst
      end function ga_check_derivatives
+     ! operating points: lambda, shapes and the linearization's matrices may be c_null_ptr
+     integer(c_int) function ga_static_equilibrium(s, t, q, lambda, tol, max_iter) &
+          bind(C, name="ga_static_equilibrium")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s, lambda
+       real(c_double), value :: t, tol
+       real(c_double), intent(inout) :: q(*)
+       integer(c_int), value :: max_iter
+     end function ga_static_equilibrium
+     integer(c_int) function ga_linearize(s, t, q, lambda, max_dof, dof, n_basis, m_red, &
+          c_red, k_red) bind(C, name="ga_linearize")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s, lambda, n_basis, m_red, c_red, k_red
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*)
+       integer(c_int), value :: max_dof
+       integer(c_int), intent(out) :: dof
+     end function ga_linearize
+     integer(c_int) function ga_modes(s, t, q, lambda, count, omega2, shapes) &
+          bind(C, name="ga_modes")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s, lambda, shapes
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*)
+       integer(c_int), value :: count
+       real(c_double), intent(out) :: omega2(*)
+     end function ga_modes
      integer(c_int) function ga_set_redundant_constraints(s, mode) &
           bind(C, name="ga_set_redundant_constraints")
        import :: c_int, c_ptr
@@ -706,7 +733,7 @@ module galpha
        ga_set_jacobian_reuse, ga_set_constant_mass, ga_set_pattern, ga_set_pattern_csc, &
        ga_set_linear_solver, &
        ga_linear_solver_name, ga_set_formulation, ga_set_resolution_check, &
-       ga_check_derivatives, &
+       ga_check_derivatives, ga_static_equilibrium, ga_linearize, ga_modes, &
        ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
@@ -751,6 +778,17 @@ module galpha
      !> check_derivatives(t, q, v, worst [, qdd, lambda, y, tol]): the derivative callbacks
      !> against central differences (ga_check_derivatives; tol 1e-6 unless given)
      procedure :: check_derivatives => solver_check_derivatives
+     !> static_equilibrium(t, q [, lambda, tol, max_iter]): q (in: the start) becomes the
+     !> static equilibrium, lambda its multipliers (ga_static_equilibrium; tol 1e-10, max_iter
+     !> 50 unless given)
+     procedure :: static_equilibrium => solver_static_equilibrium
+     !> modes(t, q, omega2 [, lambda, shapes]): the size(omega2) lowest undamped modes at an
+     !> equilibrium, shapes(n, size(omega2)) with unit modal mass (ga_modes)
+     procedure :: modes => solver_modes
+     !> linearize(t, q, dof [, basis, mass, damping, stiffness, lambda]): the small motions at
+     !> rest in dof minimal coordinates (ga_linearize): basis(n, dof), the others (dof, dof);
+     !> without them only dof (call first to size them)
+     procedure :: linearize => solver_linearize
      !> set_pattern(which, rows, cols): the sparsity of GA_MATRIX_MASS, _JACOBIAN, _STIFFNESS or
      !> _DAMPING with Fortran (1-based) row and column numbers; the callback of that matrix then
      !> fills size(rows) values in this order (GA_ERR_ARG, without a message, if rows and cols
@@ -1447,6 +1485,78 @@ contains
     if (present(tol)) tolerance = tol
     status = ga_check_derivatives(this%handle, t, q, v, pqdd, plambda, py, tolerance, worst)
   end function solver_check_derivatives
+
+  integer(c_int) function solver_static_equilibrium(this, t, q, lambda, tol, max_iter) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t
+    real(c_double), intent(inout) :: q(:)
+    real(c_double), intent(inout), optional, target :: lambda(:)
+    real(c_double), intent(in), optional :: tol
+    integer, intent(in), optional :: max_iter
+    type(c_ptr) :: plambda
+    real(c_double) :: tolerance
+    integer(c_int) :: iterations
+    plambda = c_null_ptr
+    tolerance = 1d-10
+    iterations = 50
+    if (present(lambda)) plambda = c_loc(lambda)
+    if (present(tol)) tolerance = tol
+    if (present(max_iter)) iterations = int(max_iter, c_int)
+    status = ga_static_equilibrium(this%handle, t, q, plambda, tolerance, iterations)
+  end function solver_static_equilibrium
+
+  integer(c_int) function solver_modes(this, t, q, omega2, lambda, shapes) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t, q(:)
+    real(c_double), intent(out) :: omega2(:)
+    real(c_double), intent(in), optional, target :: lambda(:)
+    real(c_double), intent(out), optional, target :: shapes(:, :)
+    type(c_ptr) :: plambda, pshapes
+    plambda = c_null_ptr
+    pshapes = c_null_ptr
+    if (present(lambda)) plambda = c_loc(lambda)
+    if (present(shapes)) pshapes = c_loc(shapes)
+    status = ga_modes(this%handle, t, q, plambda, int(size(omega2), c_int), omega2, pshapes)
+  end function solver_modes
+
+  integer(c_int) function solver_linearize(this, t, q, dof, basis, mass, damping, stiffness, &
+       lambda) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t, q(:)
+    integer, intent(out) :: dof
+    real(c_double), intent(out), optional, target :: basis(:, :), mass(:, :), damping(:, :), &
+         stiffness(:, :)
+    real(c_double), intent(in), optional, target :: lambda(:)
+    type(c_ptr) :: pb, pm, pc, pk, plambda
+    integer(c_int) :: d, max_dof
+    pb = c_null_ptr
+    pm = c_null_ptr
+    pc = c_null_ptr
+    pk = c_null_ptr
+    plambda = c_null_ptr
+    max_dof = int(size(q), c_int)
+    if (present(basis)) then
+       pb = c_loc(basis)
+       max_dof = min(max_dof, int(size(basis, 2), c_int))
+    end if
+    if (present(mass)) then
+       pm = c_loc(mass)
+       max_dof = min(max_dof, int(size(mass, 1), c_int))
+    end if
+    if (present(damping)) then
+       pc = c_loc(damping)
+       max_dof = min(max_dof, int(size(damping, 1), c_int))
+    end if
+    if (present(stiffness)) then
+       pk = c_loc(stiffness)
+       max_dof = min(max_dof, int(size(stiffness, 1), c_int))
+    end if
+    if (present(lambda)) plambda = c_loc(lambda)
+    d = 0
+    status = ga_linearize(this%handle, t, q, plambda, max_dof, d, pb, pm, pc, pk)
+    dof = int(d)
+  end function solver_linearize
 
   integer(c_int) function solver_set_resolution_check(this, limit) result(status)
     class(galpha_solver), intent(inout) :: this

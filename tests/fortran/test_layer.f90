@@ -442,6 +442,25 @@ program test_layer
   end do
   stiffness(1) = 4.0d0
   call expect(r%adjoint_gradient(x, q2(1:1)) == GA_ERR_ARG, 'adjoint_gradient needs a cost')
+  ! operating points: the unit pendulum rests below its pivot and swings at sqrt(g / L)
+  q2 = [0.3d0, -0.6d0]
+  call ok(s%static_equilibrium(0.0d0, q2, lam2), 'static_equilibrium')
+  call expect(abs(q2(1)) < 1d-14 .and. abs(q2(2) + 1.0d0) < 1d-14, 'equilibrium (0, -1)')
+  call expect(abs(lam2(1) - 9.81d0) < 1d-12 * 9.81d0, 'multiplier m g / L')
+  call ok(s%modes(0.0d0, q2, v2(1:1), lam2), 'modes')
+  call expect(abs(v2(1) - 9.81d0) < 1d-8 * 9.81d0, 'omega^2 = g / L')
+  call expect(s%modes(0.0d0, [0.6d0, -0.8d0], v2(1:1)) == GA_ERR_INCONSISTENT, &
+       'modes away from an equilibrium refused')
+  block
+    real(c_double) :: basis(2, 1), mr(1, 1), cr(1, 1), kr(1, 1)
+    call ok(s%linearize(0.0d0, q2, n), 'linearize: its size')
+    call expect(n == 1, 'one degree of freedom')
+    call ok(s%linearize(0.0d0, q2, n, basis, mr, cr, kr, lam2), 'linearize')
+    call expect(abs(abs(basis(1, 1)) - 1.0d0) < 1d-14 .and. abs(basis(2, 1)) < 1d-14, &
+         'the free direction is horizontal')
+    call expect(abs(kr(1, 1) / mr(1, 1) - 9.81d0) < 1d-8 * 9.81d0 .and. cr(1, 1) == 0.0d0, &
+         'K / M = g / L, no damping')
+  end block
 
   ! the rotation maps: a quarter turn about z takes the body's x axis to space y (R(:, 1) =
   ! e_y, Fortran's column-major), its logarithm gives the turn back, a NaN is refused

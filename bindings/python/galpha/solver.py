@@ -42,6 +42,14 @@ _HOOK = ctypes.CFUNCTYPE(_i, _vp, _d, _vp, _vp, _vp, _vp)
 
 # The derivatives of the accepted step in the sensitivity parameters (Solver.sensitivity).
 Sensitivity = collections.namedtuple("Sensitivity", "dq dv dqdd dlam dy dydot")
+# An equilibrium (ga_static_equilibrium): q, the multipliers lam
+Equilibrium = collections.namedtuple("Equilibrium", "q lam")
+# The small motions at rest in minimal coordinates q = q0 + N z (ga_linearize):
+# M z'' + C z' + K z = 0
+Linearization = collections.namedtuple("Linearization", "N M C K")
+# Undamped modes (ga_modes): omega2 ascending, shapes (n x count) in q with unit modal mass;
+# omega = sqrt(omega2) where omega2 >= 0 (NaN for an unstable direction)
+Modes = collections.namedtuple("Modes", "omega2 omega shapes")
 
 
 def _cast(fn, ctype):
@@ -1142,6 +1150,66 @@ class Solver:
             self._handle(), float(t), *[None if a is None else self._dp(a) for a in arrays],
             float(tol), ctypes.byref(worst)))
         return worst.value
+
+    def _rest_arrays(self, q, lam):
+        q = np.array(q, dtype=float).ravel()
+        if q.size != self.n:
+            raise ValueError(f"q: {self.n} values expected, got {q.size}")
+        if lam is not None:
+            lam = np.ascontiguousarray(lam, dtype=float).ravel()
+            if lam.size != self.m:
+                raise ValueError(f"lam: {self.m} values expected, got {lam.size}")
+        return q, lam
+
+    @_serialized
+    @_runs_callbacks
+    def static_equilibrium(self, q0, t=0.0, tol=1e-10, max_iter=50):
+        """The static equilibrium f(q, 0, t) = Phi_q^T lam, Phi(q, t) = 0 by Newton from q0
+        (ga_static_equilibrium): an Equilibrium(q, lam). Raises ConvergenceError (no
+        equilibrium in reach), SingularMatrixError (a limit point, or an unrestrained motion),
+        the callbacks' errors."""
+        q, _ = self._rest_arrays(q0, None)
+        lam = np.zeros(max(self.m, 1))
+        self._check(_ffi.ga_static_equilibrium(self._handle(), float(t), self._dp(q),
+                                               self._dp(lam), float(tol), int(max_iter)))
+        return Equilibrium(q, lam[:self.m].copy())
+
+    @_serialized
+    @_runs_callbacks
+    def linearize(self, q, lam=None, t=0.0):
+        """The small motions about (q, lam) at rest in minimal coordinates q = q0 + N z
+        (ga_linearize): a Linearization(N, M, C, K) with N (n x dof) orthonormal, Phi_q N = 0,
+        and M z'' + C z' + K z = 0. lam None: the multipliers that balance f at q."""
+        q, lam = self._rest_arrays(q, lam)
+        n = self.n
+        dof = ctypes.c_int()
+        mats = [np.zeros(n * n) for _ in range(4)]  # N (ld n), M, C, K (ld dof)
+        self._check(_ffi.ga_linearize(self._handle(), float(t), self._dp(q),
+                                      None if lam is None else self._dp(lam), n,
+                                      ctypes.byref(dof), *[self._dp(a) for a in mats]))
+        d = dof.value
+        N = mats[0][:n * d].reshape((n, d), order="F").copy()
+        return Linearization(N, *[a[:d * d].reshape((d, d), order="F").copy() for a in mats[1:]])
+
+    @_serialized
+    @_runs_callbacks
+    def modes(self, q, lam=None, count=None, t=0.0):
+        """The `count` lowest undamped vibration modes at an equilibrium (q, lam) (ga_modes;
+        count None: every degree of freedom): Modes(omega2, omega, shapes), shapes (n x count)
+        with unit modal mass. Raises InconsistentError when q is no equilibrium."""
+        q, lam = self._rest_arrays(q, lam)
+        if count is None:
+            count = self.linearize(q, lam, t).N.shape[1]
+        count = int(count)
+        omega2 = np.zeros(max(count, 1))
+        shapes = np.zeros(self.n * max(count, 1))
+        self._check(_ffi.ga_modes(self._handle(), float(t), self._dp(q),
+                                  None if lam is None else self._dp(lam), count,
+                                  self._dp(omega2), self._dp(shapes)))
+        w2 = omega2[:count].copy()
+        with np.errstate(invalid="ignore"):
+            omega = np.where(w2 >= 0.0, np.sqrt(np.abs(w2)), np.nan)
+        return Modes(w2, omega, shapes[:self.n * count].reshape((self.n, count), order="F").copy())
 
     @_serialized
     def info(self, key):

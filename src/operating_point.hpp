@@ -1,0 +1,32 @@
+// Operating points of the model (docs/algorithms.md sec. 17): its static equilibrium, the
+// linearization about one in minimal coordinates, and the undamped vibration modes there.
+// From the callbacks the dynamics already uses; the solver's state and set-up are not touched.
+#pragma once
+
+#include "stepper.hpp"
+
+namespace ga
+{
+
+// Newton on f(q, 0, t) = Phi_q^T lambda, Phi(q, t) = 0 from q, with a backtracking line
+// search; on GA_OK q and lambda (may be null) hold the equilibrium, else they are untouched.
+ga_status static_equilibrium(Stepper &kernel, double t, double *q, double *lambda, double tol,
+                             int max_iter);
+
+// The system of the small motions about (q, lambda) at rest in minimal coordinates
+// q = q0 + N z: dof = n - rank(Phi_q), N (n x dof, orthonormal columns), and the reduced
+// mass, damping and stiffness (dof x dof); lambda null: the static multipliers at q. Each
+// output may be null; none is written unless dof <= max_dof.
+struct Linearization {
+    int dof = 0;
+    Mat N, M, C, K;
+};
+ga_status linearize(Stepper &kernel, double t, const double *q, const double *lambda,
+                    Linearization &out);
+
+// The `count` lowest undamped modes at an equilibrium (q, lambda): K z = omega^2 M z,
+// omega^2 ascending (negative: unstable there), shapes N z in q with unit modal mass.
+ga_status modes(Stepper &kernel, double t, const double *q, const double *lambda, int count,
+                double *omega2, double *shapes);
+
+} // namespace ga
