@@ -1214,6 +1214,31 @@ GA_API ga_status ga_linearize(ga_solver *s, double t, const double *q, const dou
  *  ga_static_equilibrium, callback errors. */
 GA_API ga_status ga_modes(ga_solver *s, double t, const double *q, const double *lambda,
                           int count, double *omega2, double *shapes);
+
+/** A point of a static path: the load factor, q (n) and lambda (m; NULL when m = 0), with
+ *  the user pointer of ga_static_path. Return 0 to go on, nonzero to stop there. */
+typedef int (*ga_path_fn)(double load, const double *q, const double *lambda, void *user);
+
+/** The static equilibrium path in a load factor through limit points (snap-through), by
+ *  pseudo-arclength continuation: the callbacks read the load factor at *load, which this
+ *  call sets (between calls it holds what the caller put there). From the equilibrium at
+ *  *load near q (found first, as ga_static_equilibrium does), up to max_points points at arc
+ *  length |ds| apart in (q, load) -- the first along increasing load for ds > 0, decreasing
+ *  for ds < 0, each next one along the last tangent -- Newton in the null space of Phi_q
+ *  bordered by the arc-length equation, converged when a step moves q and the load by at most
+ *  tol max(1, |x|); a point Newton misses in 12 iterations is tried at half the arc length,
+ *  down to |ds|/1024, and the length grows back by 1.5 after easy points. d f / d load by
+ *  central differences in *load. fn (may be NULL) sees each point and may stop the path. On
+ *  return, whatever the status, *load, q and lambda (length m, may be NULL) hold the last
+ *  point reached, consistent with each other (the start on an early failure). Returns GA_OK
+ *  after max_points points, GA_STOPPED when fn stopped it. Errors: GA_ERR_ARG (NULL load or
+ *  q, ds = 0 or not finite, max_points < 1, tol not finite and > 0, a value not finite),
+ *  GA_ERR_STATE as ga_static_equilibrium, GA_ERR_NEWTON (the path does not go on: the message
+ *  says from which load), GA_ERR_SINGULAR (no tangent: a bifurcation), the start's errors,
+ *  callback errors. */
+GA_API ga_status ga_static_path(ga_solver *s, double t, double *load, double *q, double *lambda,
+                                double ds, int max_points, double tol, ga_path_fn fn,
+                                void *user);
 /**@}*/
 
 /** @name Rotations: SO(3) as unit quaternions

@@ -1354,6 +1354,24 @@ GA_API ga_status ga_linearize(ga_solver *s, double t, const double *q, const dou
     });
 }
 
+GA_API ga_status ga_static_path(ga_solver *s, double t, double *load, double *q, double *lambda,
+                                double ds, int max_points, double tol, ga_path_fn fn,
+                                void *user)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (auto st = operating_point_refusal(c, "ga_static_path", t))
+            return st;
+        if (!q || !load)
+            return c.diag.fail(GA_ERR_ARG, "ga_static_path: q or load is NULL");
+        if (!(ds != 0.0) || !std::isfinite(ds) || max_points < 1 || !(tol > 0.0) ||
+            !std::isfinite(tol))
+            return c.diag.fail(GA_ERR_ARG, "ga_static_path: ds = %g must be finite and nonzero, "
+                               "max_points = %d >= 1, tol = %g finite and > 0", ds, max_points,
+                               tol);
+        return ga::static_path(c.kernel(), t, load, q, lambda, ds, max_points, tol, fn, user);
+    });
+}
+
 GA_API ga_status ga_modes(ga_solver *s, double t, const double *q, const double *lambda,
                           int count, double *omega2, double *shapes)
 {

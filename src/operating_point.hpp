@@ -5,8 +5,7 @@
 
 #include "stepper.hpp"
 
-namespace ga
-{
+namespace ga {
 
 // Newton on f(q, 0, t) = Phi_q^T lambda, Phi(q, t) = 0 from q, with a backtracking line
 // search; on GA_OK q and lambda (may be null) hold the equilibrium, else they are untouched.
@@ -20,6 +19,7 @@ ga_status static_equilibrium(Stepper &kernel, double t, double *q, double *lambd
 struct Linearization {
     int dof = 0;
     Mat N, M, C, K;
+    double stiffness_size = 0.0;  // max |K_t| in q (a force scale: ga_modes)
 };
 ga_status linearize(Stepper &kernel, double t, const double *q, const double *lambda,
                     Linearization &out);
@@ -29,4 +29,9 @@ ga_status linearize(Stepper &kernel, double t, const double *q, const double *la
 ga_status modes(Stepper &kernel, double t, const double *q, const double *lambda, int count,
                 double *omega2, double *shapes);
 
-} // namespace ga
+// The equilibrium path in the load factor *load (which the callbacks read) from (q, *load) by
+// pseudo-arclength continuation, through limit points; fn (may be null) sees each point.
+ga_status static_path(Stepper &kernel, double t, double *load, double *q, double *lambda,
+                      double ds, int max_points, double tol, ga_path_fn fn, void *fn_user);
+
+}  // namespace ga

@@ -438,6 +438,15 @@ module galpha
        integer(c_int), value :: count
        real(c_double), intent(out) :: omega2(*)
      end function ga_modes
+     integer(c_int) function ga_static_path(s, t, load, q, lambda, ds, max_points, tol, fn, &
+          user) bind(C, name="ga_static_path")
+       import :: c_int, c_ptr, c_double, c_funptr
+       type(c_ptr), value :: s, load, lambda, user
+       real(c_double), value :: t, ds, tol
+       real(c_double), intent(inout) :: q(*)
+       integer(c_int), value :: max_points
+       type(c_funptr), value :: fn
+     end function ga_static_path
      integer(c_int) function ga_set_redundant_constraints(s, mode) &
           bind(C, name="ga_set_redundant_constraints")
        import :: c_int, c_ptr
@@ -733,7 +742,7 @@ module galpha
        ga_set_jacobian_reuse, ga_set_constant_mass, ga_set_pattern, ga_set_pattern_csc, &
        ga_set_linear_solver, &
        ga_linear_solver_name, ga_set_formulation, ga_set_resolution_check, &
-       ga_check_derivatives, ga_static_equilibrium, ga_linearize, ga_modes, &
+       ga_check_derivatives, ga_static_equilibrium, ga_linearize, ga_modes, ga_static_path, &
        ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
@@ -789,6 +798,10 @@ module galpha
      !> rest in dof minimal coordinates (ga_linearize): basis(n, dof), the others (dof, dof);
      !> without them only dof (call first to size them)
      procedure :: linearize => solver_linearize
+     !> static_path(t, load, q, ds, max_points [, lambda, tol, fn, user]): the equilibrium
+     !> path in the load factor `load` (a target the callbacks read) through limit points
+     !> (ga_static_path); fn: c_funloc of a bind(C) function (load, q, lambda, user)
+     procedure :: static_path => solver_static_path
      !> set_pattern(which, rows, cols): the sparsity of GA_MATRIX_MASS, _JACOBIAN, _STIFFNESS or
      !> _DAMPING with Fortran (1-based) row and column numbers; the callback of that matrix then
      !> fills size(rows) values in this order (GA_ERR_ARG, without a message, if rows and cols
@@ -1557,6 +1570,32 @@ contains
     status = ga_linearize(this%handle, t, q, plambda, max_dof, d, pb, pm, pc, pk)
     dof = int(d)
   end function solver_linearize
+
+  integer(c_int) function solver_static_path(this, t, load, q, ds, max_points, lambda, tol, fn, &
+       user) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t, ds
+    real(c_double), intent(inout), target :: load
+    real(c_double), intent(inout) :: q(:)
+    integer, intent(in) :: max_points
+    real(c_double), intent(inout), optional, target :: lambda(:)
+    real(c_double), intent(in), optional :: tol
+    type(c_funptr), intent(in), optional :: fn
+    type(c_ptr), intent(in), optional :: user
+    type(c_ptr) :: plambda, puser
+    type(c_funptr) :: pfn
+    real(c_double) :: tolerance
+    plambda = c_null_ptr
+    puser = c_null_ptr
+    pfn = c_null_funptr
+    tolerance = 1d-10
+    if (present(lambda)) plambda = c_loc(lambda)
+    if (present(tol)) tolerance = tol
+    if (present(fn)) pfn = fn
+    if (present(user)) puser = user
+    status = ga_static_path(this%handle, t, c_loc(load), q, plambda, ds, &
+         int(max_points, c_int), tolerance, pfn, puser)
+  end function solver_static_path
 
   integer(c_int) function solver_set_resolution_check(this, limit) result(status)
     class(galpha_solver), intent(inout) :: this

@@ -490,6 +490,182 @@ static void test_free_vibration_has_the_computed_period(void **state)
     ga_free(s);
 }
 
+/* ---- the static path through a limit point: the shallow two-bar (von Mises) truss ------ */
+/* Bars from (-a, 0) and (a, 0) to the apex q = (x, y), axial stiffness EA / L0 each, the
+ * apex on a vertical rail (x = 0, a constraint) under the load mu downwards. Equilibrium in
+ * closed form: mu(y) = 2 EA (L0 - L) y / (L0 L), L = sqrt(a^2 + y^2). */
+typedef struct {
+    double a, h, EA, mu;
+    int points;
+    double worst, max_mu, last_y, min_y_step;
+    int monotone;
+    int fail; /* the force callback fails below y = 0.1 */
+} Truss;
+
+static double truss_load(const Truss *p, double y)
+{
+    const double L0 = sqrt(p->a * p->a + p->h * p->h), L = sqrt(p->a * p->a + y * y);
+    return 2.0 * p->EA * (L0 - L) * y / (L0 * L);
+}
+
+static int truss_mass(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    M[0] = M[3] = 1.0;
+    M[1] = M[2] = 0.0;
+    return 0;
+}
+
+static int truss_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    const Truss *p = u;
+    (void)t, (void)v;
+    const double L0 = sqrt(p->a * p->a + p->h * p->h);
+    if (p->fail && q[1] < 0.1)
+        return -1;
+    f[0] = 0.0;
+    f[1] = -p->mu;
+    for (int side = -1; side <= 1; side += 2) {
+        const double dx = q[0] - side * p->a, dy = q[1], L = sqrt(dx * dx + dy * dy);
+        const double N = p->EA * (L - L0) / L0; /* tension */
+        f[0] -= N * dx / L;
+        f[1] -= N * dy / L;
+    }
+    return 0;
+}
+
+static int rail(double t, const double *q, double *phi, void *u)
+{
+    (void)t, (void)u;
+    phi[0] = q[0];
+    return 0;
+}
+
+static int rail_jacobian(double t, const double *q, double *J, void *u)
+{
+    (void)t, (void)q, (void)u;
+    J[0] = 1.0;
+    J[1] = 0.0;
+    return 0;
+}
+
+static int truss_point(double load, const double *q, const double *lambda, void *u)
+{
+    Truss *p = u;
+    (void)lambda;
+    p->points++;
+    p->worst = fmax(p->worst, fabs(load - truss_load(p, q[1])) + fabs(q[0]));
+    if (q[1] > 0.0) /* (the snap's limit; past the inverted rest the load rises again) */
+        p->max_mu = fmax(p->max_mu, load);
+    if (!(q[1] < p->last_y))
+        p->monotone = 0;
+    p->last_y = q[1];
+    return q[1] < -1.5 * p->h; /* past the inverted rest: enough */
+}
+
+static ga_solver *truss_solver(Truss *p)
+{
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(2, 1, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, truss_mass, truss_force, rail, rail_jacobian, p), GA_OK);
+    return s;
+}
+
+static void test_truss_snaps_through_along_its_closed_curve(void **state)
+{
+    (void)state;
+    Truss p = {1.0, 0.2, 1000.0, 0.0, 0, 0.0, 0.0, 0.2, 0.0, 1, 0};
+    /* the limit load from the closed form (golden section on mu(y), 0 < y < h) */
+    double lo = 0.0, hi = p.h;
+    for (int it = 0; it < 200; ++it) {
+        const double m1 = hi - 0.618033988749895 * (hi - lo),
+                     m2 = lo + 0.618033988749895 * (hi - lo);
+        if (truss_load(&p, m1) < truss_load(&p, m2))
+            lo = m1;
+        else
+            hi = m2;
+    }
+    const double mu_limit = truss_load(&p, 0.5 * (lo + hi));
+    ga_solver *s = truss_solver(&p);
+    double q[2] = {0.0, 0.2}, lambda[1];
+    const int st = ga_static_path(s, 0.0, &p.mu, q, lambda, 0.05, 5000, 1e-12, truss_point, &p);
+    assert_int_equal(st, GA_STOPPED);
+    print_message("  %d points, worst |mu - mu(y)| + |x| %.3g, limit %.6f (closed %.6f)\n",
+                  p.points, p.worst, p.max_mu, mu_limit);
+    assert_true(p.points > 100);
+    assert_true(p.worst <= 1e-10 * mu_limit);
+    /* through the limit point and down the unstable branch: the apex only goes down */
+    assert_true(p.monotone);
+    assert_true(p.max_mu <= mu_limit * (1.0 + 1e-12) && p.max_mu >= 0.99 * mu_limit);
+    /* the last point is left in q, lambda and the load */
+    assert_true(q[1] < -1.5 * p.h && fabs(p.mu - truss_load(&p, q[1])) <= 1e-10 * mu_limit);
+    assert_true(fabs(lambda[0]) <= 1e-10 * mu_limit); /* the rail carries nothing: symmetry */
+    /* ga_modes along it: stable before the limit, unstable after */
+    double w2[1];
+    double before[2] = {0.0, 0.18};
+    p.mu = truss_load(&p, 0.18);
+    assert_int_equal(ga_modes(s, 0.0, before, NULL, 1, w2, NULL), GA_OK);
+    assert_true(w2[0] > 0.0);
+    double after[2] = {0.0, 0.05};
+    p.mu = truss_load(&p, 0.05);
+    assert_int_equal(ga_modes(s, 0.0, after, NULL, 1, w2, NULL), GA_OK);
+    assert_true(w2[0] < 0.0);
+    ga_free(s);
+}
+
+/* Load stepping without arc length: each load from the last rest, up to the limit; past it
+ * Newton finds nothing in reach and says so, q untouched. Then ga_static_path's refusals. */
+static void test_load_stepping_stops_at_the_limit_point(void **state)
+{
+    (void)state;
+    Truss p = {1.0, 0.2, 1000.0, 0.0, 0, 0.0, 0.0, 0.2, 0.0, 1, 0};
+    ga_solver *s = truss_solver(&p);
+    double q[2] = {0.0, 0.2}, lambda[1];
+    for (int k = 0; k <= 11; ++k) { /* up to 2.75, below the limit 2.9605 */
+        p.mu = 0.25 * k;
+        assert_int_equal(ga_static_equilibrium(s, 0.0, q, lambda, 1e-12, 50), GA_OK);
+        assert_true(fabs(truss_load(&p, q[1]) - p.mu) <= 1e-12 * 3.0);
+    }
+    const double kept[2] = {q[0], q[1]};
+    p.mu = 3.0;
+    assert_int_equal(ga_static_equilibrium(s, 0.0, q, lambda, 1e-12, 50), GA_ERR_NEWTON);
+    assert_non_null(strstr(ga_last_error(s), "limit point"));
+    assert_true(q[0] == kept[0] && q[1] == kept[1]);
+    /* the path's arguments, each refused with nothing changed */
+    double load = 0.0, start[2] = {0.0, 0.2};
+    assert_int_equal(ga_static_path(s, 0.0, NULL, start, NULL, 0.05, 10, 1e-12, NULL, NULL),
+                     GA_ERR_ARG);
+    assert_int_equal(ga_static_path(s, 0.0, &load, NULL, NULL, 0.05, 10, 1e-12, NULL, NULL),
+                     GA_ERR_ARG);
+    assert_int_equal(ga_static_path(s, 0.0, &load, start, NULL, 0.0, 10, 1e-12, NULL, NULL),
+                     GA_ERR_ARG);
+    assert_int_equal(ga_static_path(s, 0.0, &load, start, NULL, NAN, 10, 1e-12, NULL, NULL),
+                     GA_ERR_ARG);
+    assert_int_equal(ga_static_path(s, 0.0, &load, start, NULL, 0.05, 0, 1e-12, NULL, NULL),
+                     GA_ERR_ARG);
+    assert_int_equal(ga_static_path(s, 0.0, &load, start, NULL, 0.05, 10, 0.0, NULL, NULL),
+                     GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "tol = 0"));
+    assert_true(load == 0.0 && start[0] == 0.0 && start[1] == 0.2);
+    /* without a callback: max_points points, downwards (ds < 0: the load decreasing first,
+     * the apex rising), the last one left in q and the load */
+    p.mu = 0.0;
+    assert_int_equal(ga_static_path(s, 0.0, &p.mu, start, NULL, -0.05, 20, 1e-12, NULL, NULL),
+                     GA_OK);
+    assert_true(p.mu < 0.0 && start[1] > 0.2);
+    assert_true(fabs(truss_load(&p, start[1]) - p.mu) <= 1e-12 * 3.0);
+    /* a callback that fails on the way: its status, the last point reached kept */
+    p.fail = 1;
+    p.mu = 0.0;
+    start[0] = 0.0;
+    start[1] = 0.2;
+    assert_int_equal(ga_static_path(s, 0.0, &p.mu, start, NULL, 0.05, 5000, 1e-12, NULL, NULL),
+                     GA_ERR_CALLBACK);
+    assert_true(start[1] >= 0.1 && start[1] < 0.2);
+    assert_true(fabs(truss_load(&p, start[1]) - p.mu) <= 1e-12 * 3.0);
+    ga_free(s);
+}
+
 /* ---- refusals ---------------------------------------------------------------------- */
 /* one coordinate, f = -(1 + x^2) (never zero), or a free mass pushed (no stiffness) */
 typedef struct {
@@ -744,6 +920,8 @@ int main(void)
         cmocka_unit_test(test_fourbar_with_a_spring_against_its_minimal_coordinate),
         cmocka_unit_test(test_a_run_started_in_the_equilibrium_stays_there),
         cmocka_unit_test(test_free_vibration_has_the_computed_period),
+        cmocka_unit_test(test_truss_snaps_through_along_its_closed_curve),
+        cmocka_unit_test(test_load_stepping_stops_at_the_limit_point),
         cmocka_unit_test(test_no_equilibrium_a_free_motion_and_a_follower_force_are_refused),
         cmocka_unit_test(test_modes_refuse_what_is_no_equilibrium),
         cmocka_unit_test(test_locked_mechanism),

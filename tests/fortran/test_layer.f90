@@ -7,6 +7,7 @@ module layer_events
   use galpha, only: GA_OK, ga_get_t, ga_get_q, ga_get_v, ga_get_lambda
   implicit none
   real(c_double), target, save :: stiffness(1) = [4.0d0]
+  real(c_double), target, save :: push = 0.0d0  ! the static path's load
   integer :: hook_calls = 0, hook_mismatches = 0, hook_stop_at = 0
 contains
   ! g(1) = x: the pendulum passes the vertical
@@ -38,6 +39,17 @@ contains
     watch_steps = 0
     if (hook_calls == hook_stop_at) watch_steps = 1
   end function watch_steps
+
+  ! the pendulum's weight and a horizontal push (the static path's load)
+  integer(c_int) function pushed_force(t, q, v, f, user) bind(C)
+    real(c_double), value :: t
+    real(c_double), intent(in) :: q(*), v(*)
+    real(c_double), intent(out) :: f(*)
+    type(c_ptr), value :: user
+    f(1) = push
+    f(2) = -9.81d0
+    pushed_force = 0
+  end function pushed_force
 
   ! first-order states: x'' = -x + y with y' = -2 y (y = exp(-2 t) from y0 = 1)
   integer(c_int) function unit_mass(t, q, M, user) bind(C)
@@ -461,6 +473,16 @@ program test_layer
     call expect(abs(kr(1, 1) / mr(1, 1) - 9.81d0) < 1d-8 * 9.81d0 .and. cr(1, 1) == 0.0d0, &
          'K / M = g / L, no damping')
   end block
+  ! the static path: the pendulum under a horizontal load mu, its angle atan(mu / (m g))
+  call r%free()
+  call ok(r%create(2, 1), 'create for the static path')
+  call ok(r%set_callbacks(p_mass, pushed_force, p_constraint, p_jacobian, c_loc(unit)), &
+       'callbacks for the static path')
+  q2 = [0.0d0, -1.0d0]
+  push = 0.0d0
+  call ok(r%static_path(0.0d0, push, q2, 0.1d0, 30, lam2), 'static_path')
+  call expect(push > 1.0d0 .and. abs(atan2(q2(1), -q2(2)) - atan(push / 9.81d0)) < 1d-10, &
+       'static_path: the angle of the horizontal load')
 
   ! the rotation maps: a quarter turn about z takes the body's x axis to space y (R(:, 1) =
   ! e_y, Fortran's column-major), its logarithm gives the turn back, a NaN is refused

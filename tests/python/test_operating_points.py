@@ -98,3 +98,32 @@ def test_no_equilibrium_is_a_convergence_error():
     with galpha.Solver(1, 0, lambda t, q, M: M.fill(1.0), pushed) as s:
         with pytest.raises(galpha.ConvergenceError, match="no equilibrium"):
             s.static_equilibrium([0.25])
+
+
+def test_two_bar_truss_snaps_through_along_its_closed_curve():
+    """The shallow von Mises truss, its apex on a rail: mu(y) = 2 EA (L0 - L) y / (L0 L)."""
+    a, h, EA = 1.0, 0.2, 1000.0
+    L0 = np.hypot(a, h)
+    load = np.zeros(1)
+
+    def force(t, q, v, f):
+        f[:] = (0.0, -load[0])
+        for side in (-1.0, 1.0):
+            d = q - (side * a, 0.0)
+            L = np.hypot(*d)
+            f[:] -= EA * (L - L0) / L0 * d / L
+
+    def closed(y):
+        L = np.hypot(a, y)
+        return 2.0 * EA * (L0 - L) * y / (L0 * L)
+    with galpha.Solver(2, 1, lambda t, q, M: M.__setitem__(slice(None), np.eye(2)), force,
+                       lambda t, q, phi: phi.__setitem__(0, q[0]),
+                       lambda t, q, J: J.__setitem__(slice(None), [[1.0, 0.0]])) as s:
+        path = s.static_path([0.0, h], load, 0.05, tol=1e-12,
+                             stop=lambda mu, q, lam: q[1] < -1.5 * h)
+    assert path.ended == "stopped" and len(path.load) > 100
+    np.testing.assert_allclose(path.load, closed(path.q[:, 1]), atol=1e-10 * 3.0)
+    assert np.all(np.diff(path.q[:, 1]) < 0.0)  # through the limit point, down and through
+    ys = np.linspace(0.0, h, 20001)
+    assert path.load[path.q[:, 1] > 0].max() <= closed(ys).max() * (1 + 1e-9)
+    assert load[0] == path.load[-1]

@@ -111,6 +111,8 @@ COST_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p
                            c_double_p, c_double_p, ctypes.c_void_p)
 STEP_HOOK_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double, c_double_p,
                                 c_double_p, c_double_p, ctypes.c_void_p)  # (s, t, q, v, lam, user)
+PATH_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p,
+                           ctypes.c_void_p)  # (load, q, lam, user)
 COUPLING_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, c_double_p, c_double_p, c_double_p,
                                c_double_p, c_double_p, c_double_p, c_double_p, ctypes.c_void_p)
 
@@ -210,6 +212,8 @@ _SIGNATURES = {
     "ga_linearize": (_I, [_S, _D, c_double_p, c_double_p, _I, _P(_I), c_double_p, c_double_p,
                           c_double_p, c_double_p]),
     "ga_modes": (_I, [_S, _D, c_double_p, c_double_p, _I, c_double_p, c_double_p]),
+    "ga_static_path": (_I, [_S, _D, c_double_p, c_double_p, c_double_p, _D, _I, _D, PATH_FN,
+                            ctypes.c_void_p]),
     "ga_set_jacobian_reuse": (_I, [_S, _I]),
     "ga_set_constant_mass": (_I, [_S, _I]),
     "ga_set_pattern": (_I, [_S, _I, _I, _P(_I), _P(_I)]),

@@ -50,6 +50,9 @@ Linearization = collections.namedtuple("Linearization", "N M C K")
 # Undamped modes (ga_modes): omega2 ascending, shapes (n x count) in q with unit modal mass;
 # omega = sqrt(omega2) where omega2 >= 0 (NaN for an unstable direction)
 Modes = collections.namedtuple("Modes", "omega2 omega shapes")
+# A static path (ga_static_path): the load factors (k), q (k x n) and lam (k x m) of its points
+# after the start, and the status that ended it ("done", "stopped")
+StaticPath = collections.namedtuple("StaticPath", "load q lam ended")
 
 
 def _cast(fn, ctype):
@@ -1190,6 +1193,45 @@ class Solver:
         d = dof.value
         N = mats[0][:n * d].reshape((n, d), order="F").copy()
         return Linearization(N, *[a[:d * d].reshape((d, d), order="F").copy() for a in mats[1:]])
+
+    @_serialized
+    @_runs_callbacks
+    def static_path(self, q0, load, ds, max_points=1000, tol=1e-10, t=0.0, stop=None):
+        """The equilibrium path in a load factor through limit points (ga_static_path):
+        `load` is a float array of one entry that the callbacks read (the call writes the
+        load there as it goes; afterwards it holds the last point's); from the equilibrium at
+        load[0] near q0, points at arc length |ds| apart (ds > 0: the load rising first), up
+        to max_points or until stop(load, q, lam) returns True. A StaticPath of the points
+        after the start. Raises as static_equilibrium; the points before a failure are lost
+        with it (the exception's solver state is the last point)."""
+        q, _ = self._rest_arrays(q0, None)
+        if not (isinstance(load, np.ndarray) and load.dtype == np.float64 and load.size == 1
+                and load.flags.c_contiguous):
+            raise TypeError("load must be a float64 numpy array of one entry, which the "
+                            "callbacks read")
+        lam = np.zeros(max(self.m, 1))
+        n, m = self.n, self.m
+        loads, qs, lams = [], [], []
+
+        def point(mu, qp, lp, u):
+            if self._pending is not None or self._interrupted:
+                return 1
+            try:
+                qq = np.ctypeslib.as_array(qp, shape=(n,)).copy()
+                ll = np.ctypeslib.as_array(lp, shape=(m,)).copy() if m else np.zeros(0)
+                loads.append(mu)
+                qs.append(qq)
+                lams.append(ll)
+                return 1 if stop is not None and stop(mu, qq, ll) else 0
+            except BaseException as e:  # re-raised by _check
+                self._pending = e
+                return 1
+        cb = _ffi.PATH_FN(point)
+        stopped = self._check(_ffi.ga_static_path(
+            self._handle(), float(t), load.ctypes.data_as(_ffi.c_double_p), self._dp(q),
+            self._dp(lam), float(ds), int(max_points), float(tol), cb, None))
+        return StaticPath(np.array(loads), np.array(qs).reshape(-1, n),
+                          np.array(lams).reshape(-1, m), "stopped" if stopped else "done")
 
     @_serialized
     @_runs_callbacks
