@@ -1215,6 +1215,19 @@ GA_API ga_status ga_linearize(ga_solver *s, double t, const double *q, const dou
 GA_API ga_status ga_modes(ga_solver *s, double t, const double *q, const double *lambda,
                           int count, double *omega2, double *shapes);
 
+/** The `count` modes of the linearized damped system at an equilibrium (q, lambda), which
+ *  may be non-conservative (a follower or circulatory force, gyroscopic terms in C_t): the
+ *  eigenvalues s of x' = [0, I; -M^-1 K, -M^-1 C] x in the minimal coordinates of
+ *  ga_linearize, 2 dof of them, taken by |s| ascending (a conjugate pair with its positive
+ *  imaginary part first): re[k] + i im[k]; Re s > 0 is an unstable mode (divergence or
+ *  flutter). shapes_re, shapes_im (each may be NULL): n x count, column-major, the
+ *  displacement part in q scaled so that its largest entry is 1. Errors as ga_modes
+ *  (count may be up to 2 dof; a non-symmetric stiffness is allowed), GA_ERR_SINGULAR (a
+ *  singular mass in the free directions). */
+GA_API ga_status ga_modes_damped(ga_solver *s, double t, const double *q, const double *lambda,
+                                 int count, double *re, double *im, double *shapes_re,
+                                 double *shapes_im);
+
 /** A point of a static path: the load factor, q (n) and lambda (m; NULL when m = 0), with
  *  the user pointer of ga_static_path. Return 0 to go on, nonzero to stop there. */
 typedef int (*ga_path_fn)(double load, const double *q, const double *lambda, void *user);

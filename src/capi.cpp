@@ -1372,6 +1372,20 @@ GA_API ga_status ga_static_path(ga_solver *s, double t, double *load, double *q,
     });
 }
 
+GA_API ga_status ga_modes_damped(ga_solver *s, double t, const double *q, const double *lambda,
+                                 int count, double *re, double *im, double *shapes_re,
+                                 double *shapes_im)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (auto st = operating_point_refusal(c, "ga_modes_damped", t))
+            return st;
+        if (!q || !re || !im || count < 1)
+            return c.diag.fail(GA_ERR_ARG, "ga_modes_damped: q, re or im is NULL, or count = "
+                               "%d < 1", count);
+        return ga::damped_modes(c.kernel(), t, q, lambda, count, re, im, shapes_re, shapes_im);
+    });
+}
+
 GA_API ga_status ga_modes(ga_solver *s, double t, const double *q, const double *lambda,
                           int count, double *omega2, double *shapes)
 {

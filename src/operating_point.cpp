@@ -6,6 +6,9 @@
 #include <cmath>
 #include <limits>
 
+#include <complex>
+#include <vector>
+
 #include <Eigen/Eigenvalues>
 
 #include "at_rest.hpp"
@@ -170,14 +173,20 @@ ga_status linearize(Stepper &kernel, double t, const double *q0, const double *l
     return GA_OK;
 }
 
-ga_status modes(Stepper &kernel, double t, const double *q0, const double *lambda0, int count,
-                double *omega2, double *shapes)
+namespace {
+
+// The linearization at (q, lambda) for the modes of `name`, once q is known to be an
+// equilibrium on the constraints whose dof degrees of freedom have `count` modes (per_dof
+// each: 1 undamped, 2 damped), else refused.
+ga_status equilibrium_linearization(Stepper &kernel, double t, const double *q0,
+                                    const double *lambda0, int count, int per_dof, const char *name,
+                                    Linearization &lin)
 {
     AtRest at(kernel, t);
     const int n = at.n(), m = at.m();
     const Vec q = Eigen::Map<const Vec>(q0, n);
     if (!all_finite(q) || (lambda0 && m > 0 && !all_finite(Eigen::Map<const Vec>(lambda0, m))))
-        return at.diag().fail(GA_ERR_ARG, "ga_modes: q or lambda is not finite");
+        return at.diag().fail(GA_ERR_ARG, "%s: q or lambda is not finite", name);
     // an equilibrium on the constraints, or the modes mean nothing
     Vec phi, f(n), r;
     Mat J;
@@ -193,9 +202,8 @@ ga_status modes(Stepper &kernel, double t, const double *q0, const double *lambd
         return st;
     const double phi_scale = std::max(1.0, max_abs(q));
     if (max_abs(phi) > 1e-8 * phi_scale)
-        return at.diag().fail(GA_ERR_INCONSISTENT,
-                              "ga_modes: q is off the constraints (|Phi| = %.3g)", max_abs(phi));
-    Linearization lin;
+        return at.diag().fail(GA_ERR_INCONSISTENT, "%s: q is off the constraints (|Phi| = %.3g)",
+                              name, max_abs(phi));
     if (auto st = linearize(kernel, t, q0, lambda.data(), lin))
         return st;
     // the forces' size: applied, constraint, and elastic (the stiffness over q's size), since
@@ -206,42 +214,119 @@ ga_status modes(Stepper &kernel, double t, const double *q0, const double *lambd
     const double unbalanced = lin.dof ? max_abs(lin.N.transpose() * r) : 0.0;
     if (unbalanced > 1e-8 * fscale)
         return at.diag().fail(GA_ERR_INCONSISTENT,
-                              "ga_modes: q is not an equilibrium: the forces along the free "
+                              "%s: q is not an equilibrium: the forces along the free "
                               "directions are %.3g of their size %.3g (ga_static_equilibrium "
                               "finds one)",
-                              unbalanced / fscale, fscale);
+                              name, unbalanced / fscale, fscale);
     if (lambda0 && m > 0 && max_abs(r) > 1e-8 * fscale)
         return at.diag().fail(GA_ERR_INCONSISTENT,
-                              "ga_modes: lambda does not balance the forces at q (%.3g of their "
+                              "%s: lambda does not balance the forces at q (%.3g of their "
                               "size; NULL takes the balancing multipliers)",
-                              max_abs(r) / fscale);
-    if (lin.dof == 0 || count > lin.dof)
+                              name, max_abs(r) / fscale);
+    if (lin.dof == 0 || count > per_dof * lin.dof)
         return at.diag().fail(GA_ERR_ARG,
-                              "ga_modes: %d modes asked for, the constraints leave %d degrees "
-                              "of freedom%s",
-                              count, lin.dof, lin.dof == 0 ? " (they lock the mechanism)" : "");
+                              "%s: %d modes asked for, the constraints leave %d degrees of "
+                              "freedom (%d modes)%s",
+                              name, count, lin.dof, per_dof * lin.dof,
+                              lin.dof == 0 ? " (they lock the mechanism)" : "");
+    return GA_OK;
+}
+
+}  // namespace
+
+ga_status modes(Stepper &kernel, double t, const double *q0, const double *lambda0, int count,
+                double *omega2, double *shapes)
+{
+    const int n = kernel.nv();
+    Linearization lin;
+    if (auto st = equilibrium_linearization(kernel, t, q0, lambda0, count, 1, "ga_modes", lin))
+        return st;
+    Diagnostics &diag = kernel.diag;
     const double kscale = std::max(lin.K.cwiseAbs().maxCoeff(), std::numeric_limits<double>::min());
     const double asym = (lin.K - lin.K.transpose()).cwiseAbs().maxCoeff() / kscale;
     if (asym > 1e-6)
-        return at.diag().fail(GA_ERR_ARG,
-                              "ga_modes: the stiffness in the free directions is not symmetric "
-                              "(by %.3g of its size): a non-conservative force, whose modes the "
-                              "undamped problem does not give",
-                              asym);
+        return diag.fail(GA_ERR_ARG,
+                         "ga_modes: the stiffness in the free directions is not symmetric "
+                         "(by %.3g of its size): a non-conservative force, whose modes the "
+                         "undamped problem does not give",
+                         asym);
     const Mat Ks = 0.5 * (lin.K + lin.K.transpose());
     const Mat Ms = 0.5 * (lin.M + lin.M.transpose());
     const Eigen::LLT<Mat> mass_factor(Ms);
     if (mass_factor.info() != Eigen::Success)
-        return at.diag().fail(GA_ERR_SINGULAR,
-                              "ga_modes: the mass in the free directions is not positive "
-                              "definite (a direction that carries no mass)");
+        return diag.fail(GA_ERR_SINGULAR,
+                         "ga_modes: the mass in the free directions is not positive "
+                         "definite (a direction that carries no mass)");
     const Eigen::GeneralizedSelfAdjointEigenSolver<Mat> eig(Ks, Ms);
     if (eig.info() != Eigen::Success)
-        return at.diag().fail(GA_ERR_INTERNAL, "ga_modes: the eigensolver did not converge");
+        return diag.fail(GA_ERR_INTERNAL, "ga_modes: the eigensolver did not converge");
     for (int k = 0; k < count; ++k)  // (ascending; eigenvectors with z^T M z = 1)
         omega2[k] = eig.eigenvalues()[k];
     if (shapes)
         Eigen::Map<Mat>(shapes, n, count) = lin.N * eig.eigenvectors().leftCols(count);
+    return GA_OK;
+}
+
+}  // namespace ga
+
+namespace ga {
+
+ga_status damped_modes(Stepper &kernel, double t, const double *q0, const double *lambda0,
+                       int count, double *re, double *im, double *shapes_re, double *shapes_im)
+{
+    const int n = kernel.nv();
+    Linearization lin;
+    if (auto st =
+            equilibrium_linearization(kernel, t, q0, lambda0, count, 2, "ga_modes_damped", lin))
+        return st;
+    const int d = lin.dof;
+    const Eigen::PartialPivLU<Mat> mass(lin.M);
+    const double mscale = std::max(lin.M.cwiseAbs().maxCoeff(), std::numeric_limits<double>::min());
+    if (!(std::fabs(lin.M.determinant()) > 0.0) || !(mass.rcond() > 1e-13))
+        return kernel.diag.fail(GA_ERR_SINGULAR,
+                                "ga_modes_damped: the mass in the free directions is singular "
+                                "(reciprocal condition %.3g, size %.3g)",
+                                mass.rcond(), mscale);
+    // x' = A x, x = (z, z'): A = [0, I; -M^-1 K, -M^-1 C]
+    Mat A = Mat::Zero(2 * d, 2 * d);
+    A.topRightCorner(d, d).setIdentity();
+    A.bottomLeftCorner(d, d) = -mass.solve(lin.K);
+    A.bottomRightCorner(d, d) = -mass.solve(lin.C);
+    const Eigen::EigenSolver<Mat> eig(A);
+    if (eig.info() != Eigen::Success)
+        return kernel.diag.fail(GA_ERR_INTERNAL, "ga_modes_damped: the eigensolver did not "
+                                                 "converge");
+    // by |s| ascending, a conjugate pair with its positive imaginary part first
+    std::vector<int> order(2 * d);
+    for (int k = 0; k < 2 * d; ++k)
+        order[k] = k;
+    const auto &s = eig.eigenvalues();
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+        const double ma = std::abs(s[a]), mb = std::abs(s[b]);
+        if (std::fabs(ma - mb) > 1e-12 * std::max(ma, mb))
+            return ma < mb;
+        return s[a].imag() > s[b].imag();
+    });
+    for (int k = 0; k < count; ++k) {
+        const int j = order[k];
+        re[k] = s[j].real();
+        im[k] = s[j].imag();
+        if (!shapes_re && !shapes_im)
+            continue;
+        // the displacement part in q, scaled so that its largest entry is 1
+        Eigen::VectorXcd shape =
+            lin.N.cast<std::complex<double>>() * eig.eigenvectors().col(j).head(d);
+        Eigen::Index big = 0;
+        shape.cwiseAbs().maxCoeff(&big);
+        if (std::abs(shape[big]) > 0.0)
+            shape /= shape[big];
+        for (int i = 0; i < n; ++i) {
+            if (shapes_re)
+                shapes_re[i + static_cast<std::size_t>(n) * k] = shape[i].real();
+            if (shapes_im)
+                shapes_im[i + static_cast<std::size_t>(n) * k] = shape[i].imag();
+        }
+    }
     return GA_OK;
 }
 

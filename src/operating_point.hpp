@@ -29,6 +29,12 @@ ga_status linearize(Stepper &kernel, double t, const double *q, const double *la
 ga_status modes(Stepper &kernel, double t, const double *q, const double *lambda, int count,
                 double *omega2, double *shapes);
 
+// The `count` modes of the damped, possibly non-conservative system there, of
+// x' = [0, I; -M^-1 K, -M^-1 C] x: eigenvalues s by |s| (a pair's positive imaginary part
+// first), displacement shapes N z in q with their largest entry 1 (each output may be null).
+ga_status damped_modes(Stepper &kernel, double t, const double *q, const double *lambda,
+                       int count, double *re, double *im, double *shapes_re, double *shapes_im);
+
 // The equilibrium path in the load factor *load (which the callbacks read) from (q, *load) by
 // pseudo-arclength continuation, through limit points; fn (may be null) sees each point.
 ga_status static_path(Stepper &kernel, double t, double *load, double *q, double *lambda,

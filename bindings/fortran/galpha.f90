@@ -438,6 +438,15 @@ module galpha
        integer(c_int), value :: count
        real(c_double), intent(out) :: omega2(*)
      end function ga_modes
+     integer(c_int) function ga_modes_damped(s, t, q, lambda, count, re, im, shapes_re, &
+          shapes_im) bind(C, name="ga_modes_damped")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s, lambda, shapes_re, shapes_im
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*)
+       integer(c_int), value :: count
+       real(c_double), intent(out) :: re(*), im(*)
+     end function ga_modes_damped
      integer(c_int) function ga_static_path(s, t, load, q, lambda, ds, max_points, tol, fn, &
           user) bind(C, name="ga_static_path")
        import :: c_int, c_ptr, c_double, c_funptr
@@ -743,6 +752,7 @@ module galpha
        ga_set_linear_solver, &
        ga_linear_solver_name, ga_set_formulation, ga_set_resolution_check, &
        ga_check_derivatives, ga_static_equilibrium, ga_linearize, ga_modes, ga_static_path, &
+       ga_modes_damped, &
        ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
@@ -798,6 +808,9 @@ module galpha
      !> rest in dof minimal coordinates (ga_linearize): basis(n, dof), the others (dof, dof);
      !> without them only dof (call first to size them)
      procedure :: linearize => solver_linearize
+     !> modes_damped(t, q, re, im [, lambda, shapes_re, shapes_im]): the size(re) modes of the
+     !> damped system at an equilibrium, s = re + i im by |s| (ga_modes_damped)
+     procedure :: modes_damped => solver_modes_damped
      !> static_path(t, load, q, ds, max_points [, lambda, tol, fn, user]): the equilibrium
      !> path in the load factor `load` (a target the callbacks read) through limit points
      !> (ga_static_path); fn: c_funloc of a bind(C) function (load, q, lambda, user)
@@ -1570,6 +1583,25 @@ contains
     status = ga_linearize(this%handle, t, q, plambda, max_dof, d, pb, pm, pc, pk)
     dof = int(d)
   end function solver_linearize
+
+  integer(c_int) function solver_modes_damped(this, t, q, re, im, lambda, shapes_re, shapes_im) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t, q(:)
+    real(c_double), intent(out) :: re(:), im(:)
+    real(c_double), intent(in), optional, target :: lambda(:)
+    real(c_double), intent(out), optional, target :: shapes_re(:, :), shapes_im(:, :)
+    type(c_ptr) :: plambda, pr, pi
+    plambda = c_null_ptr
+    pr = c_null_ptr
+    pi = c_null_ptr
+    if (present(lambda)) plambda = c_loc(lambda)
+    if (present(shapes_re)) pr = c_loc(shapes_re)
+    if (present(shapes_im)) pi = c_loc(shapes_im)
+    status = GA_ERR_ARG
+    if (size(im) < size(re)) return
+    status = ga_modes_damped(this%handle, t, q, plambda, int(size(re), c_int), re, im, pr, pi)
+  end function solver_modes_damped
 
   integer(c_int) function solver_static_path(this, t, load, q, ds, max_points, lambda, tol, fn, &
        user) result(status)

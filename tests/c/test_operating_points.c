@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
+#include <complex.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -490,6 +491,117 @@ static void test_free_vibration_has_the_computed_period(void **state)
     ga_free(s);
 }
 
+/* ---- damped and non-conservative modes ------------------------------------------------ */
+/* The pendulum with a viscous damper c on its bob: m s^2 + c s + m g / L = 0 in its angle. */
+typedef struct {
+    double m, L, c;
+} Damped;
+
+static int damped_mass(double t, const double *q, double *M, void *u)
+{
+    const Damped *p = u;
+    (void)t, (void)q;
+    M[0] = M[3] = p->m;
+    M[1] = M[2] = 0.0;
+    return 0;
+}
+
+static int damped_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    const Damped *p = u;
+    (void)t, (void)q;
+    f[0] = -p->c * v[0];
+    f[1] = -p->m * g_acc - p->c * v[1];
+    return 0;
+}
+
+static int circle(double t, const double *q, double *phi, void *u)
+{
+    const Damped *p = u;
+    (void)t;
+    phi[0] = 0.5 * (q[0] * q[0] + q[1] * q[1] - p->L * p->L);
+    return 0;
+}
+
+static int circle_jacobian(double t, const double *q, double *J, void *u)
+{
+    (void)t, (void)u;
+    J[0] = q[0];
+    J[1] = q[1];
+    return 0;
+}
+
+static void test_damped_pendulum_roots_in_closed_form(void **state)
+{
+    (void)state;
+    for (int over = 0; over < 2; ++over) {
+        Damped p = {1.5, 0.7, over ? 30.0 : 0.8};
+        ga_solver *s = NULL;
+        assert_int_equal(ga_create(2, 1, &s), GA_OK);
+        assert_int_equal(
+            ga_set_callbacks(s, damped_mass, damped_force, circle, circle_jacobian, &p), GA_OK);
+        const double q[2] = {0.0, -0.7};
+        double re[2], im[2], sr[4], si[4];
+        assert_int_equal(ga_modes_damped(s, 0.0, q, NULL, 2, re, im, sr, si), GA_OK);
+        const double k = p.m * g_acc / p.L, disc = p.c * p.c - 4.0 * p.m * k;
+        if (!over) { /* a decaying oscillation: -c/2m +- i sqrt(4 m k - c^2)/2m */
+            assert_rel(re[0], -p.c / (2.0 * p.m), 1e-13);
+            assert_rel(im[0], sqrt(-disc) / (2.0 * p.m), 1e-13);
+            assert_true(re[1] == re[0] && im[1] == -im[0]);
+        } else { /* overdamped: two real roots, the slow one first */
+            assert_rel(re[0], (-p.c + sqrt(disc)) / (2.0 * p.m), 1e-13);
+            assert_rel(re[1], (-p.c - sqrt(disc)) / (2.0 * p.m), 1e-13);
+            assert_true(im[0] == 0.0 && im[1] == 0.0);
+        }
+        /* the shape: the horizontal direction, its largest entry 1 */
+        assert_true(fabs(sr[0] - 1.0) <= 1e-12 && fabs(sr[1]) <= 1e-12 && fabs(si[0]) <= 1e-12);
+        ga_free(s);
+    }
+}
+
+/* f = -K q with K = [2 1; -1 2] (a circulatory force): s^2 = -(2 +- i), one root with
+ * Re s > 0, flutter; ga_modes refuses (not symmetric), ga_modes_damped says it. */
+static int circulatory(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)v, (void)u;
+    f[0] = -(2.0 * q[0] + q[1]);
+    f[1] = -(-q[0] + 2.0 * q[1]);
+    return 0;
+}
+
+static void test_circulatory_force_flutters(void **state)
+{
+    (void)state;
+    Damped unit = {1.0, 1.0, 0.0}; /* (its mass: the identity) */
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(2, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, damped_mass, circulatory, NULL, NULL, &unit), GA_OK);
+    const double q[2] = {0.0, 0.0};
+    double re[4], im[4], w2[2];
+    assert_int_equal(ga_modes(s, 0.0, q, NULL, 2, w2, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_modes_damped(s, 0.0, q, NULL, 4, re, im, NULL, NULL), GA_OK);
+    /* the roots of s^4 + 4 s^2 + 5 = 0: s = +-sqrt(-(2 +- i)), all of modulus 5^(1/4) (K_t and
+     * C_t by differences of forces linear in q and v: round-off) */
+    double complex want[4];
+    want[0] = csqrt(-(2.0 + I));
+    want[1] = -want[0];
+    want[2] = csqrt(-(2.0 - I));
+    want[3] = -want[2];
+    int flutter = 0;
+    for (int k = 0; k < 4; ++k) {
+        double best = 1e300;
+        for (int j = 0; j < 4; ++j)
+            best = fmin(best, cabs(re[k] + I * im[k] - want[j]));
+        assert_true(best <= 1e-13);
+        assert_rel(cabs(re[k] + I * im[k]), pow(5.0, 0.25), 1e-13);
+        flutter += re[k] > 1e-6;
+    }
+    assert_int_equal(flutter, 2); /* a conjugate pair grows */
+    assert_int_equal(ga_modes_damped(s, 0.0, q, NULL, 5, re, im, NULL, NULL), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "(4 modes)"));
+    ga_free(s);
+}
+
 /* ---- the static path through a limit point: the shallow two-bar (von Mises) truss ------ */
 /* Bars from (-a, 0) and (a, 0) to the apex q = (x, y), axial stiffness EA / L0 each, the
  * apex on a vertical rail (x = 0, a constraint) under the load mu downwards. Equilibrium in
@@ -920,6 +1032,8 @@ int main(void)
         cmocka_unit_test(test_fourbar_with_a_spring_against_its_minimal_coordinate),
         cmocka_unit_test(test_a_run_started_in_the_equilibrium_stays_there),
         cmocka_unit_test(test_free_vibration_has_the_computed_period),
+        cmocka_unit_test(test_damped_pendulum_roots_in_closed_form),
+        cmocka_unit_test(test_circulatory_force_flutters),
         cmocka_unit_test(test_truss_snaps_through_along_its_closed_curve),
         cmocka_unit_test(test_load_stepping_stops_at_the_limit_point),
         cmocka_unit_test(test_no_equilibrium_a_free_motion_and_a_follower_force_are_refused),

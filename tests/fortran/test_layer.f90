@@ -463,6 +463,10 @@ program test_layer
   call expect(abs(v2(1) - 9.81d0) < 1d-8 * 9.81d0, 'omega^2 = g / L')
   call expect(s%modes(0.0d0, [0.6d0, -0.8d0], v2(1:1)) == GA_ERR_INCONSISTENT, &
        'modes away from an equilibrium refused')
+  ! undamped: s = +-i sqrt(g / L), the positive imaginary part first
+  call ok(s%modes_damped(0.0d0, q2, a, v), 'modes_damped')
+  call expect(abs(a(1)) < 1d-12 .and. abs(v(1) - sqrt(9.81d0)) < 1d-8 .and. &
+       abs(v(2) + sqrt(9.81d0)) < 1d-8, 'modes_damped: +-i sqrt(g / L)')
   block
     real(c_double) :: basis(2, 1), mr(1, 1), cr(1, 1), kr(1, 1)
     call ok(s%linearize(0.0d0, q2, n), 'linearize: its size')

@@ -127,3 +127,21 @@ def test_two_bar_truss_snaps_through_along_its_closed_curve():
     ys = np.linspace(0.0, h, 20001)
     assert path.load[path.q[:, 1] > 0].max() <= closed(ys).max() * (1 + 1e-9)
     assert load[0] == path.load[-1]
+
+
+def test_damped_modes_of_a_circulatory_force_flutter():
+    """f = -K q, K = [2 1; -1 2]: s^2 = -(2 +- i), a growing pair"""
+    def circulatory(t, q, v, f):
+        f[:] = -np.array([[2.0, 1.0], [-1.0, 2.0]]) @ q
+    with galpha.Solver(2, 0, lambda t, q, M: M.__setitem__(slice(None), np.eye(2)),
+                       circulatory) as s:
+        with pytest.raises(galpha.ArgumentError, match="not symmetric"):
+            s.modes([0.0, 0.0])
+        dm = s.damped_modes([0.0, 0.0])
+    want = np.concatenate([np.sqrt(-(2 + 1j)) * np.array([1, -1]),
+                           np.sqrt(-(2 - 1j)) * np.array([1, -1])])
+    assert len(dm.s) == 4
+    for root in dm.s:
+        assert np.min(np.abs(want - root)) <= 1e-13
+    assert np.sum(dm.s.real > 1e-6) == 2
+    np.testing.assert_allclose(np.abs(dm.shapes).max(axis=0), 1.0, rtol=1e-14)

@@ -33,8 +33,8 @@ from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceErr
                      OutOfMemoryError, RecoverableError, SingularMatrixError, StateError,
                      StepSizeError, UnresolvedError)
 from .integrate import IntegrateResult, OdeSolution, integrate  # noqa: F401
-from .solver import (Equilibrium, Linearization, Modes, Sensitivity, Solver,  # noqa: F401
-                     StaticPath)
+from .solver import (DampedModes, Equilibrium, Linearization, Modes,  # noqa: F401
+                     Sensitivity, Solver, StaticPath)
 from . import se3, so3  # noqa: F401,E402
 
 

@@ -50,6 +50,9 @@ Linearization = collections.namedtuple("Linearization", "N M C K")
 # Undamped modes (ga_modes): omega2 ascending, shapes (n x count) in q with unit modal mass;
 # omega = sqrt(omega2) where omega2 >= 0 (NaN for an unstable direction)
 Modes = collections.namedtuple("Modes", "omega2 omega shapes")
+# Damped modes (ga_modes_damped): the eigenvalues s (complex, by |s|; Re s > 0 unstable) and
+# the displacement shapes (complex, n x count, largest entry 1)
+DampedModes = collections.namedtuple("DampedModes", "s shapes")
 # A static path (ga_static_path): the load factors (k), q (k x n) and lam (k x m) of its points
 # after the start, and the status that ended it ("done", "stopped")
 StaticPath = collections.namedtuple("StaticPath", "load q lam ended")
@@ -1232,6 +1235,23 @@ class Solver:
             self._dp(lam), float(ds), int(max_points), float(tol), cb, None))
         return StaticPath(np.array(loads), np.array(qs).reshape(-1, n),
                           np.array(lams).reshape(-1, m), "stopped" if stopped else "done")
+
+    @_serialized
+    @_runs_callbacks
+    def damped_modes(self, q, lam=None, count=None, t=0.0):
+        """The `count` modes of the linearized damped (possibly non-conservative) system at an
+        equilibrium (ga_modes_damped; count None: all 2 dof): DampedModes(s, shapes)."""
+        q, lam = self._rest_arrays(q, lam)
+        if count is None:
+            count = 2 * self.linearize(q, lam, t).N.shape[1]
+        count = int(count)
+        re, im = np.zeros(max(count, 1)), np.zeros(max(count, 1))
+        sr, si = np.zeros(self.n * max(count, 1)), np.zeros(self.n * max(count, 1))
+        self._check(_ffi.ga_modes_damped(self._handle(), float(t), self._dp(q),
+                                         None if lam is None else self._dp(lam), count,
+                                         self._dp(re), self._dp(im), self._dp(sr), self._dp(si)))
+        shapes = (sr + 1j * si)[:self.n * count].reshape((self.n, count), order="F")
+        return DampedModes((re + 1j * im)[:count], shapes)
 
     @_serialized
     @_runs_callbacks
