@@ -80,7 +80,10 @@ void apply_update(const ConfigurationSpace &space, const Vec &dq, const Vec &dw,
     }
     if (xi) {
         space.step_to(q_n, *xi, x.q);
-        size.q = space.max_magnitude(x.q);
+        // (a finite xi can still give a NaN rotation: exp of an increment beyond 1e154
+        // overflows |xi|^2; max_magnitude would pass the NaN by)
+        size.q = all_finite(x.q) ? space.max_magnitude(x.q)
+                                 : std::numeric_limits<double>::infinity();
     }
     if (!separate_dw)
         size.dw = size.dq;
@@ -969,8 +972,10 @@ ga_status Stepper::newton(double h, double tol, bool refresh, bool &converged, b
         v = v_n.segment(i, len) + h * ((1.0 - p.gamma) * an + p.gamma * a);            // eq. (5)
         finite = finite && all_finite(v.data(), len) && all_finite(qdd.data(), len);
     }
-    if (group)
+    if (group) {
         model.space.step_to(s.q, xi_, x.q);  // eq. (4) on the group: q_n o exp(xi)
+        finite = finite && all_finite(x.q);
+    }
     if (start == Zero)
         x.lambda.setZero();
     else

@@ -1094,6 +1094,42 @@ static int sp_jacobian(double time, const double *q, double *J, void *user)
     return 0;
 }
 
+/* A spherical rotor spun so fast that a step's increment, finite, has |xi|^2 beyond the
+ * largest double: exp gives NaN, and the step must say so (the fuzzer found it accepted with
+ * GA_OK), leaving the solver as it was */
+static int unit_inertia(double time, const double *q, double *M, void *user)
+{
+    (void)time, (void)q, (void)user;
+    for (int k = 0; k < 9; ++k)
+        M[k] = (k % 4 == 0) ? 1.0 : 0.0;
+    return 0;
+}
+
+static void test_a_step_beyond_exp_range_is_not_finite(void **state)
+{
+    (void)state;
+    const int kinds[1] = {GA_SPACE_SO3_QUATERNION}, counts[1] = {1};
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create_space(1, kinds, counts, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, unit_inertia, NULL, NULL, NULL, NULL), GA_OK);
+    const double q0[4] = {1, 0, 0, 0}, w0[3] = {1e100, 0, 0};
+    assert_int_equal(ga_init(s, 0.0, q0, w0), GA_OK);
+    size_t len = 0;
+    assert_int_equal(ga_state_size(s, &len), GA_OK);
+    double before[256], after[256];
+    assert_true(len <= 256);
+    assert_int_equal(ga_get_state(s, before, len), GA_OK);
+    assert_int_equal(ga_step(s, 1e100), GA_ERR_NONFINITE);
+    assert_int_equal(ga_get_state(s, after, len), GA_OK);
+    assert_memory_equal(before, after, len * sizeof(double));
+    /* a step it can take still goes: half a turn */
+    assert_int_equal(ga_step(s, M_PI / 1e100), GA_OK);
+    double q[4];
+    assert_int_equal(ga_get_q(s, q), GA_OK);
+    assert_true(fabs(fabs(q[1]) - 1.0) <= 1e-12);
+    ga_free(s);
+}
+
 /* Phi_q of the sensitivity top on its pattern */
 static int st_sp_jacobian(double time, const double *q, double *J, void *user)
 {
@@ -1408,6 +1444,7 @@ int main(void)
         cmocka_unit_test(test_sensitivities_equal_differences_of_runs),
         cmocka_unit_test(test_adjoint_equals_forward),
         cmocka_unit_test(test_adjoint_with_a_jacobian_pattern_on_the_dense_solver),
+        cmocka_unit_test(test_a_step_beyond_exp_range_is_not_finite),
         cmocka_unit_test(test_first_order_states_on_the_group),
         cmocka_unit_test(test_fault_at_every_callback_call),
         cmocka_unit_test(test_create_space_refuses_bad_blocks),
