@@ -1177,7 +1177,8 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value);
 /** Static equilibrium at time t: f(q, 0, t) = Phi_q^T lambda, Phi(q, t) = 0, by Newton from
  *  the q given, in the null space of Phi_q (redundant constraints take the minimum-norm
  *  multipliers), with a backtracking line search on |f - Phi_q^T lambda|^2 + |Phi|^2. Converged
- *  when a full Newton step moves q by at most tol max(1, |q|_inf). On GA_OK q holds the
+ *  when a full Newton step moves q by at most tol max(1, |q|_inf), or when the residuals are
+ *  within 8 ulps of the forces (applied, constraint, elastic) and of q. On GA_OK q holds the
  *  equilibrium and lambda (length m, may be NULL) its multipliers; on failure both are
  *  untouched. Load stepping: a load factor the callbacks read through `user`, raised between
  *  calls, each started from the last equilibrium. Errors: GA_ERR_ARG (NULL q, tol not finite
