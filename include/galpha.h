@@ -1169,7 +1169,7 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value);
 
 /** @name Operating points: static equilibrium, linearization, vibration modes
  *  From the callbacks of the dynamics (M, f, Phi, Phi_q and, where given, K_t and C_t; central
- *  differences otherwise), at rest: v = 0, qdd = 0. Dense; on coordinates in R^n without
+ *  differences otherwise), at rest: v = 0, qdd = 0. Dense, but for ga_modes_near and the static solve of a model on the sparse path; on coordinates in R^n without
  *  first-order states for now (GA_ERR_STATE otherwise). Callable before or after ga_init:
  *  the solver's state and set-up are not touched, the evaluations are counted.
  *  docs/algorithms.md sec. 17. */
@@ -1215,6 +1215,27 @@ GA_API ga_status ga_linearize(ga_solver *s, double t, const double *q, const dou
  *  ga_static_equilibrium, callback errors. */
 GA_API ga_status ga_modes(ga_solver *s, double t, const double *q, const double *lambda,
                           int count, double *omega2, double *shapes);
+
+/** The `count` undamped vibration modes at an equilibrium (q, lambda) whose omega^2 lie
+ *  nearest the shift sigma, for large models: Lanczos on the shift-inverted operator
+ *  (K_t - sigma M)^-1 M restricted to the constraints, through one factorization of
+ *  [K_t - sigma M, Phi_q^T; Phi_q, 0] -- sparse where the solver's linear algebra is (declared
+ *  patterns of M, Phi_q and K_t; GA_LINEAR_AUTO from n + m >= 10, or GA_LINEAR_SPARSE), dense
+ *  otherwise; nothing n x n on the sparse path. sigma = 0 gives the lowest modes of a stable
+ *  equilibrium. omega2 (length count) ascending; shapes (may be NULL): n x count,
+ *  column-major, unit modal mass (shape^T M shape = 1), the largest entry positive, Phi_q
+ *  shape = 0. Converged when each Ritz pair's residual is within 1e-11 of its eigenvalue
+ *  (|theta| = 1 / |omega^2 - sigma|). A multiple eigenvalue may appear fewer times than its
+ *  multiplicity (as in every single-vector Krylov method). lambda NULL: the multipliers of
+ *  [M, Phi_q^T; Phi_q, 0] [a; lambda] = [f; 0], which balance f at an equilibrium. The
+ *  constraints must be independent here (they are not dropped). Errors: GA_ERR_ARG (NULL q or
+ *  omega2, count < 1 or above n - m, a value not finite, a non-symmetric stiffness in the free
+ *  directions), GA_ERR_INCONSISTENT (as ga_modes: off the constraints, not an equilibrium,
+ *  lambda unbalanced), GA_ERR_SINGULAR (sigma an eigenvalue, redundant constraints, a free
+ *  direction without mass), GA_ERR_INTERNAL (no convergence in 200 restarts), GA_ERR_STATE as
+ *  ga_static_equilibrium, callback errors. */
+GA_API ga_status ga_modes_near(ga_solver *s, double t, const double *q, const double *lambda,
+                               double sigma, int count, double *omega2, double *shapes);
 
 /** The `count` modes of the linearized damped system at an equilibrium (q, lambda), which
  *  may be non-conservative (a follower or circulatory force, gyroscopic terms in C_t): the

@@ -1399,4 +1399,17 @@ GA_API ga_status ga_modes(ga_solver *s, double t, const double *q, const double 
     });
 }
 
+GA_API ga_status ga_modes_near(ga_solver *s, double t, const double *q, const double *lambda,
+                               double sigma, int count, double *omega2, double *shapes)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (auto st = operating_point_refusal(c, "ga_modes_near", t))
+            return st;
+        if (!q || !omega2 || count < 1 || !std::isfinite(sigma))
+            return c.diag.fail(GA_ERR_ARG, "ga_modes_near: q or omega2 is NULL, count = %d < 1, "
+                               "or sigma = %g is not finite", count, sigma);
+        return ga::modes_near(c.kernel(), t, q, lambda, sigma, count, omega2, shapes);
+    });
+}
+
 }  // extern "C"

@@ -21,6 +21,8 @@ using namespace rest;
 ga_status static_equilibrium(Stepper &kernel, double t, double *q_io, double *lambda_out,
                              double tol, int max_iter)
 {
+    if (kernel.sparse_wanted() && !kernel.matrix(GA_MATRIX_STIFFNESS).dense())
+        return static_equilibrium_saddle(kernel, t, q_io, lambda_out, tol, max_iter);
     AtRest at(kernel, t);
     const int n = at.n(), m = at.m();
     Vec q = Eigen::Map<const Vec>(q_io, n);
@@ -92,6 +94,9 @@ ga_status static_equilibrium(Stepper &kernel, double t, double *q_io, double *la
                                   "ga_static_equilibrium: the Newton increment is not finite "
                                   "at iteration %d",
                                   it);
+        // Newton's own estimate of the distance to the root: within tol, q is converged even
+        // where round-off keeps every step from reducing the residual
+        const bool within_tol = max_abs(dq) <= tol * std::max(1.0, max_abs(q));
         // backtracking on |r|^2 + |Phi|^2, down which the Newton direction goes
         double alpha = 1.0, m1 = 0.0;
         Vec qn(n), ln, rn, phin, fn(n);
@@ -108,7 +113,7 @@ ga_status static_equilibrium(Stepper &kernel, double t, double *q_io, double *la
             if (m1 <= (1.0 - 1e-4 * alpha) * m0 || m1 == 0.0)
                 break;
             alpha *= 0.5;
-            if (alpha < 1.0 / 1024.0 && at_roundoff())
+            if (alpha < 1.0 / 1024.0 && (within_tol || at_roundoff()))
                 return accept();
             if (alpha < 1.0 / 1024.0)
                 return at.diag().fail(

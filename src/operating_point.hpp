@@ -12,6 +12,11 @@ namespace ga {
 ga_status static_equilibrium(Stepper &kernel, double t, double *q, double *lambda, double tol,
                              int max_iter);
 
+// The same on [K_t, Phi_q^T; Phi_q, 0] (static_saddle.cpp): for models the solver takes on
+// its sparse path, where the null space would be dense; static_equilibrium goes there itself.
+ga_status static_equilibrium_saddle(Stepper &kernel, double t, double *q, double *lambda,
+                                    double tol, int max_iter);
+
 // The system of the small motions about (q, lambda) at rest in minimal coordinates
 // q = q0 + N z: dof = n - rank(Phi_q), N (n x dof, orthonormal columns), and the reduced
 // mass, damping and stiffness (dof x dof); lambda null: the static multipliers at q. Each
@@ -28,6 +33,12 @@ ga_status linearize(Stepper &kernel, double t, const double *q, const double *la
 // omega^2 ascending (negative: unstable there), shapes N z in q with unit modal mass.
 ga_status modes(Stepper &kernel, double t, const double *q, const double *lambda, int count,
                 double *omega2, double *shapes);
+
+// The `count` undamped modes at an equilibrium whose omega^2 lie nearest sigma, by
+// shift-invert Lanczos on the saddle-point factorization (modes_near.cpp): omega2 ascending,
+// shapes (may be null) in q with unit modal mass and their largest entry positive.
+ga_status modes_near(Stepper &kernel, double t, const double *q, const double *lambda,
+                     double sigma, int count, double *omega2, double *shapes);
 
 // The `count` modes of the damped, possibly non-conservative system there, of
 // x' = [0, I; -M^-1 K, -M^-1 C] x: eigenvalues s by |s| (a pair's positive imaginary part

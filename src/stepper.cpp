@@ -204,28 +204,32 @@ ga_status Stepper::setup()
     return GA_OK;
 }
 
+// Sparse needs declared patterns of M and Phi_q, and K_t, C_t either declared (possibly
+// empty), not needed, or neglected.
+bool Stepper::sparse_possible() const
+{
+    return !M_.dense() && (m_ == 0 || !J_.dense()) &&
+           (!model.stiffness_needed(K_) || !K_.dense()) &&
+           (!model.damping_needed(C_) || !C_.dense());
+}
+
+bool Stepper::sparse_wanted() const
+{
+    switch (linear_solver) {
+    case GA_LINEAR_SPARSE: return sparse_possible();
+    case GA_LINEAR_AUTO: return sparse_possible() && nv_ + m_ >= kSparseMinSize;
+    default: return false;
+    }
+}
+
 ga_status Stepper::setup_workspace()
 {
-    // Which linear algebra: sparse needs declared patterns of M and Phi_q, and K_t, C_t either
-    // declared (possibly empty), not needed, or neglected.
-    const bool sparse_possible = !M_.dense() && (m_ == 0 || !J_.dense()) &&
-                                 (!model.stiffness_needed(K_) || !K_.dense()) &&
-                                 (!model.damping_needed(C_) || !C_.dense());
-    bool sparse = false;
-    switch (linear_solver) {
-    case GA_LINEAR_SPARSE:
-        if (!sparse_possible)
-            return diag.fail(GA_ERR_ARG,
-                             "the sparse solver needs the patterns of M and Phi_q, and of K_t "
-                             "and C_t unless they are neglected (ga_set_pattern; an empty "
-                             "pattern declares a zero matrix)");
-        sparse = true;
-        break;
-    case GA_LINEAR_AUTO:
-        sparse = sparse_possible && nv_ + m_ >= kSparseMinSize;
-        break;
-    default: sparse = false;
-    }
+    if (linear_solver == GA_LINEAR_SPARSE && !sparse_possible())
+        return diag.fail(GA_ERR_ARG,
+                         "the sparse solver needs the patterns of M and Phi_q, and of K_t "
+                         "and C_t unless they are neglected (ga_set_pattern; an empty "
+                         "pattern declares a zero matrix)");
+    const bool sparse = sparse_wanted();
     std::unique_ptr<LinearBackend> backend;
     if (sparse) {
         backend = make_sparse_backend();

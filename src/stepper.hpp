@@ -116,6 +116,10 @@ public:
     // throws std::bad_alloc.
     void setup_index2();
     const char *linear_backend() const;
+    // Whether setup chooses (or chose) the sparse backend for these options and layouts (before
+    // setup too: the operating points follow it); possible: the layouts allow it.
+    bool sparse_wanted() const;
+    bool sparse_possible() const;
 
     bool initialized() const { return initialized_; }
     // Constraints in use (1) or dropped as redundant (0); all 1 unless GA_REDUNDANT_DROP.

@@ -438,6 +438,15 @@ module galpha
        integer(c_int), value :: count
        real(c_double), intent(out) :: omega2(*)
      end function ga_modes
+     integer(c_int) function ga_modes_near(s, t, q, lambda, sigma, count, omega2, shapes) &
+          bind(C, name="ga_modes_near")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s, lambda, shapes
+       real(c_double), value :: t, sigma
+       real(c_double), intent(in) :: q(*)
+       integer(c_int), value :: count
+       real(c_double), intent(out) :: omega2(*)
+     end function ga_modes_near
      integer(c_int) function ga_modes_damped(s, t, q, lambda, count, re, im, shapes_re, &
           shapes_im) bind(C, name="ga_modes_damped")
        import :: c_int, c_ptr, c_double
@@ -752,7 +761,7 @@ module galpha
        ga_set_linear_solver, &
        ga_linear_solver_name, ga_set_formulation, ga_set_resolution_check, &
        ga_check_derivatives, ga_static_equilibrium, ga_linearize, ga_modes, ga_static_path, &
-       ga_modes_damped, &
+       ga_modes_damped, ga_modes_near, &
        ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
@@ -804,6 +813,10 @@ module galpha
      !> modes(t, q, omega2 [, lambda, shapes]): the size(omega2) lowest undamped modes at an
      !> equilibrium, shapes(n, size(omega2)) with unit modal mass (ga_modes)
      procedure :: modes => solver_modes
+     !> modes_near(t, q, sigma, omega2 [, lambda, shapes]): the size(omega2) undamped modes
+     !> whose omega^2 lie nearest sigma, by shift-invert Lanczos on the solver's (sparse)
+     !> factorization (ga_modes_near)
+     procedure :: modes_near => solver_modes_near
      !> linearize(t, q, dof [, basis, mass, damping, stiffness, lambda]): the small motions at
      !> rest in dof minimal coordinates (ga_linearize): basis(n, dof), the others (dof, dof);
      !> without them only dof (call first to size them)
@@ -1545,6 +1558,22 @@ contains
     if (present(shapes)) pshapes = c_loc(shapes)
     status = ga_modes(this%handle, t, q, plambda, int(size(omega2), c_int), omega2, pshapes)
   end function solver_modes
+
+  integer(c_int) function solver_modes_near(this, t, q, sigma, omega2, lambda, shapes) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t, q(:), sigma
+    real(c_double), intent(out) :: omega2(:)
+    real(c_double), intent(in), optional, target :: lambda(:)
+    real(c_double), intent(out), optional, target :: shapes(:, :)
+    type(c_ptr) :: plambda, pshapes
+    plambda = c_null_ptr
+    pshapes = c_null_ptr
+    if (present(lambda)) plambda = c_loc(lambda)
+    if (present(shapes)) pshapes = c_loc(shapes)
+    status = ga_modes_near(this%handle, t, q, plambda, sigma, int(size(omega2), c_int), omega2, &
+         pshapes)
+  end function solver_modes_near
 
   integer(c_int) function solver_linearize(this, t, q, dof, basis, mass, damping, stiffness, &
        lambda) result(status)

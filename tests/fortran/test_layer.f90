@@ -463,6 +463,11 @@ program test_layer
   call expect(abs(v2(1) - 9.81d0) < 1d-8 * 9.81d0, 'omega^2 = g / L')
   call expect(s%modes(0.0d0, [0.6d0, -0.8d0], v2(1:1)) == GA_ERR_INCONSISTENT, &
        'modes away from an equilibrium refused')
+  ! the same by shift-invert Lanczos (dense here: no patterns); two modes of one refused
+  call ok(s%modes_near(0.0d0, q2, 0.0d0, v2(1:1), lam2), 'modes_near')
+  call expect(abs(v2(1) - 9.81d0) < 1d-8 * 9.81d0, 'modes_near: omega^2 = g / L')
+  call expect(s%modes_near(0.0d0, q2, 0.0d0, v2) == GA_ERR_ARG, &
+       'modes_near: more modes than degrees of freedom refused')
   ! undamped: s = +-i sqrt(g / L), the positive imaginary part first
   call ok(s%modes_damped(0.0d0, q2, a, v), 'modes_damped')
   call expect(abs(a(1)) < 1d-12 .and. abs(v(1) - sqrt(9.81d0)) < 1d-8 .and. &

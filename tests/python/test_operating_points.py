@@ -145,3 +145,42 @@ def test_damped_modes_of_a_circulatory_force_flutter():
         assert np.min(np.abs(want - root)) <= 1e-13
     assert np.sum(dm.s.real > 1e-6) == 2
     np.testing.assert_allclose(np.abs(dm.shapes).max(axis=0), 1.0, rtol=1e-14)
+
+
+def test_modes_near_on_the_sparse_path_equal_the_closed_form():
+    """The double pendulum with declared patterns (GA_LINEAR_SPARSE): the static solve on the
+    saddle-point factorization and shift-invert Lanczos, against the closed form and `modes`."""
+    patterns = {"mass": (np.arange(4), np.arange(4)),
+                "jacobian": ([0, 0, 1, 1, 1, 1], [0, 1, 0, 1, 2, 3]),
+                "stiffness": (np.tile(np.arange(4), 4), np.repeat(np.arange(4), 4)),
+                "damping": ([], [])}
+
+    def mass_v(t, q, M):
+        M[:] = (M1, M1, M2, M2)
+
+    def jacobian_v(t, q, J):
+        d1, d2 = q[:2], q[2:] - q[:2]
+        J[:] = (d1[0], d1[1], -d2[0], -d2[1], d2[0], d2[1])
+
+    def stiffness_v(t, q, v, qdd, lam, K):
+        D = np.zeros((4, 4))
+        stiffness(t, q, v, qdd, lam, D)
+        K[:] = D.ravel(order="F")
+
+    with galpha.Solver(4, 2, mass_v, force, constraint, jacobian_v, stiffness=stiffness_v,
+                       patterns=patterns, linear_solver=galpha.GA_LINEAR_SPARSE) as s:
+        eq = s.static_equilibrium([0.2, -0.7, -0.3, -2.0])
+        np.testing.assert_allclose(eq.q, [0.0, -L1, 0.0, -L1 - L2], atol=1e-14)
+        near = s.modes_near(eq.q, count=2)
+        assert isinstance(near, galpha.Modes)
+        np.testing.assert_allclose(near.omega2, closed_form(), rtol=1e-10)
+        Mq = np.diag([M1, M1, M2, M2])
+        np.testing.assert_allclose(near.shapes.T @ Mq @ near.shapes, np.eye(2), atol=1e-12)
+        # the shift picks the nearer: just below the higher one
+        upper = s.modes_near(eq.q, eq.lam, sigma=0.9 * closed_form()[1], count=1)
+        np.testing.assert_allclose(upper.omega2, closed_form()[1:], rtol=1e-10)
+        with pytest.raises(galpha.InconsistentError, match="not an equilibrium"):
+            s.modes_near([L1 * np.sin(0.3), -L1 * np.cos(0.3), L1 * np.sin(0.3),
+                          -L1 * np.cos(0.3) - L2], count=1)
+        with pytest.raises(galpha.ArgumentError, match="2 degrees of freedom"):
+            s.modes_near(eq.q, count=3)

@@ -212,6 +212,7 @@ _SIGNATURES = {
     "ga_linearize": (_I, [_S, _D, c_double_p, c_double_p, _I, _P(_I), c_double_p, c_double_p,
                           c_double_p, c_double_p]),
     "ga_modes": (_I, [_S, _D, c_double_p, c_double_p, _I, c_double_p, c_double_p]),
+    "ga_modes_near": (_I, [_S, _D, c_double_p, c_double_p, _D, _I, c_double_p, c_double_p]),
     "ga_modes_damped": (_I, [_S, _D, c_double_p, c_double_p, _I, c_double_p, c_double_p,
                              c_double_p, c_double_p]),
     "ga_static_path": (_I, [_S, _D, c_double_p, c_double_p, c_double_p, _D, _I, _D, PATH_FN,

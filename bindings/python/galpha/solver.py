@@ -1274,6 +1274,25 @@ class Solver:
         return Modes(w2, omega, shapes[:self.n * count].reshape((self.n, count), order="F").copy())
 
     @_serialized
+    @_runs_callbacks
+    def modes_near(self, q, lam=None, sigma=0.0, count=6, t=0.0):
+        """The `count` undamped modes at an equilibrium (q, lam) whose omega^2 lie nearest
+        `sigma`, by shift-invert Lanczos on the solver's (sparse, when patterns are declared)
+        factorization (ga_modes_near): Modes(omega2, omega, shapes), omega2 ascending, shapes
+        (n x count) with unit modal mass. For large models, where `modes` would be dense."""
+        q, lam = self._rest_arrays(q, lam)
+        count = int(count)
+        omega2 = np.zeros(max(count, 1))
+        shapes = np.zeros(self.n * max(count, 1))
+        self._check(_ffi.ga_modes_near(self._handle(), float(t), self._dp(q),
+                                       None if lam is None else self._dp(lam), float(sigma),
+                                       count, self._dp(omega2), self._dp(shapes)))
+        w2 = omega2[:count].copy()
+        with np.errstate(invalid="ignore"):
+            omega = np.where(w2 >= 0.0, np.sqrt(np.abs(w2)), np.nan)
+        return Modes(w2, omega, shapes[:self.n * count].reshape((self.n, count), order="F").copy())
+
+    @_serialized
     def info(self, key):
         x = ctypes.c_double()
         self._check(_ffi.ga_get_info(self._handle(), int(key), ctypes.byref(x)))
