@@ -1169,15 +1169,20 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value);
 
 /** @name Operating points: static equilibrium, linearization, vibration modes
  *  From the callbacks of the dynamics (M, f, Phi, Phi_q and, where given, K_t and C_t; central
- *  differences otherwise), at rest: v = 0, qdd = 0. Dense, but for ga_modes_near and the static solve of a model on the sparse path; on coordinates in R^n without
- *  first-order states for now (GA_ERR_STATE otherwise). Callable before or after ga_init:
+ *  differences otherwise), at rest: v = 0, qdd = 0. Dense, but for ga_modes_near and the
+ *  static solve of a model on the sparse path; on coordinates in R^n without first-order
+ *  states for now (GA_ERR_STATE otherwise). Callable before or after ga_init:
  *  the solver's state and set-up are not touched, the evaluations are counted.
  *  docs/algorithms.md sec. 17. */
 /**@{*/
 /** Static equilibrium at time t: f(q, 0, t) = Phi_q^T lambda, Phi(q, t) = 0, by Newton from
  *  the q given, in the null space of Phi_q (redundant constraints take the minimum-norm
- *  multipliers), with a backtracking line search on |f - Phi_q^T lambda|^2 + |Phi|^2. Converged
- *  when a full Newton step moves q by at most tol max(1, |q|_inf), or when the residuals are
+ *  multipliers) -- for a model on the sparse path (declared patterns of M, Phi_q and K_t, as
+ *  the solver's linear-solver option chooses) on the sparse [K_t, Phi_q^T; Phi_q, 0] instead,
+ *  where redundant constraints are GA_ERR_SINGULAR --, with a backtracking line search on
+ *  |f - Phi_q^T lambda|^2 + |Phi|^2. Converged when a full Newton step moves q by at most
+ *  tol max(1, |q|_inf) (taken, or not taken where round-off keeps it from reducing the
+ *  residual), or when the residuals are
  *  within 8 ulps of the forces (applied, constraint, elastic) and of q. On GA_OK q holds the
  *  equilibrium and lambda (length m, may be NULL) its multipliers; on failure both are
  *  untouched. Load stepping: a load factor the callbacks read through `user`, raised between

@@ -102,6 +102,9 @@ if command -v valgrind >/dev/null; then
 fi
 echo "linear algebra"
 "$b/linear_algebra" > "$out/linear_algebra.csv"
+
+echo "the lattice's lowest modes (ga_modes_near) against a dynamic step; LAPACK at 10^4 unknowns"
+{ "$b/lattice_modes" 36 verify; "$b/lattice_modes" 112 | tail -n +2; } > "$out/lattice_modes.csv"
 echo "work-precision against IDA"
 if [ -x "$b/ida_workprecision" ]; then
     "$b/ida_workprecision" andrews > "$out/wp_andrews.csv" 2>/dev/null

@@ -142,6 +142,39 @@ static void test_lattice_sags_to_a_root_and_its_lowest_modes_equal_lapack(void *
     lattice_free(&l);
 }
 
+/* Newton's line search on the residual needs load steps where a stiff part rotates: the
+ * two-material lattice at contrast 1e3 from its unstressed start (GA_ERR_NEWTON, nothing
+ * written), then gravity in 100 steps, each from the last rest: a root. */
+static void test_a_stiff_lattice_needs_load_steps(void **state)
+{
+    (void)state;
+    lattice l;
+    assert_int_equal(lattice_make(&l, 32, 8, 1e6, 1e3), 0);
+    const int n = l.n;
+    ga_solver *s = lattice_solver(&l, GA_LINEAR_AUTO);
+    double *q = calloc((size_t)n, sizeof(double)), *f = malloc(sizeof(double) * (size_t)n);
+    assert_int_equal(ga_static_equilibrium(s, 0.0, q, NULL, 1e-12, 50), GA_ERR_NEWTON);
+    assert_non_null(strstr(ga_last_error(s), "no equilibrium"));
+    for (int i = 0; i < n; ++i)
+        assert_true(q[i] == 0.0);
+    const double g = l.gravity;
+    for (int k = 1; k <= 100; ++k) {
+        l.gravity = g * k / 100.0;
+        assert_int_equal(ga_static_equilibrium(s, 0.0, q, NULL, 1e-12, 50), GA_OK);
+    }
+    lattice_force(0.0, q, NULL, f, &l);
+    double *K = dense_stiffness(&l, q);
+    const double floor = DBL_EPSILON * max_abs(K, n * n) * l.nx;
+    printf("  contrast 1e3 in 100 load steps: tip sag %.6g m, |f| = %.2g eps |K| nx\n",
+           q[n - 1], max_abs(f, n) / floor);
+    assert_true(max_abs(f, n) <= 8 * floor && fabs(q[n - 1]) > 1e-3);
+    free(K);
+    free(f);
+    free(q);
+    ga_free(s);
+    lattice_free(&l);
+}
+
 /* ---- the double pendulum, declared sparse ------------------------------------------------ */
 typedef struct {
     double m[2], L[2];
@@ -479,6 +512,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_lattice_sags_to_a_root_and_its_lowest_modes_equal_lapack),
+        cmocka_unit_test(test_a_stiff_lattice_needs_load_steps),
         cmocka_unit_test(test_double_pendulum_on_the_sparse_path_in_closed_form),
         cmocka_unit_test(test_redundant_constraints_are_refused_on_the_sparse_path),
         cmocka_unit_test(test_modes_nearest_a_shift_are_the_nearest),
