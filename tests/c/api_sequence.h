@@ -547,9 +547,94 @@ static void check_transaction(const model *md, ga_solver *s, ga_status st,
                  ga_strerror(st), ga_last_error(s));
 }
 
+/* Operating points, in a phase of their own after the calls above (so that the bytes of
+ * those decode as before): the static problem, linearization and modes at the current q
+ * (or the chain's start before ga_init), with edge-value arguments and the armed faults.
+ * None of them changes the solver's state, whatever it returns; a failed one writes none of
+ * its outputs. */
+static long long operating_points_phase(model *md, ga_solver *s, int seq)
+{
+    long long ok = 0;
+    for (int k = 0; k < 3 && !md->exhausted; ++k) {
+        double before[STATE_MAX], after[STATE_MAX], t = 0.0, q[QMAX] = {0}, keep[QMAX];
+        double lambda[MMAX] = {0}, w2[2 * VMAX], im[2 * VMAX], shapes[2 * VMAX * VMAX],
+               shapes_im[2 * VMAX * VMAX], stiff[VMAX * VMAX];
+        const int len = snapshot(md, s, before);
+        if (ga_get_t(s, &t) != GA_OK || ga_get_q(s, q) != GA_OK) {
+            t = 0.0;
+            for (int l = 0; l < md->links; ++l) {
+                q[2 * l] = sin(0.4) + l;
+                q[2 * l + 1] = -cos(0.4);
+            }
+        }
+        if (pick(md, 4) == 0)
+            q[pick(md, md->nq)] += edge_value(md);
+        memcpy(keep, q, sizeof q);
+        for (int i = 0; i < 2 * VMAX; ++i)
+            w2[i] = im[i] = -7.0;
+        const double sentinel = w2[0];
+        double *lam = pick(md, 2) && md->m ? lambda : NULL;
+        const int count = pick(md, md->nv + 2) - 1;
+        ga_status st = GA_OK;
+        const char *call = "";
+        int writes_q = 0;
+        switch (pick(md, 6)) {
+        case 0:
+            call = "ga_static_equilibrium";
+            st = ga_static_equilibrium(s, t, q, lam, pick(md, 2) ? 1e-10 : edge_value(md),
+                                       pick(md, 30) - 2);
+            writes_q = 1;
+            break;
+        case 1:
+            call = "ga_modes";
+            st = ga_modes(s, t, q, lam, count, w2, pick(md, 2) ? shapes : NULL);
+            break;
+        case 2:
+            call = "ga_modes_near";
+            st = ga_modes_near(s, t, q, lam, pick(md, 2) ? 0.0 : edge_value(md), count, w2,
+                               pick(md, 2) ? shapes : NULL);
+            break;
+        case 3:
+            call = "ga_modes_damped";
+            st = ga_modes_damped(s, t, q, lam, count, w2, im, pick(md, 2) ? shapes : NULL,
+                                 pick(md, 2) ? shapes_im : NULL);
+            break;
+        case 4: {
+            int dof = -1;
+            call = "ga_linearize";
+            st = ga_linearize(s, t, q, lam, count, &dof, shapes_im, shapes, NULL,
+                              pick(md, 2) ? stiff : NULL);
+            break;
+        }
+        default: {
+            double load = md->p[0];
+            call = "ga_static_path";
+            st = ga_static_path(s, t, &load, q, lam, pick(md, 2) ? 0.05 : edge_value(md),
+                                pick(md, 5) - 1, 1e-10, NULL, NULL);
+            writes_q = -1; /* the path's last point, consistent, whatever the status */
+            break;
+        }
+        }
+        check(s, st, 1, call, seq);
+        ok += st == GA_OK;
+        if (len && (snapshot(md, s, after) != len ||
+                    memcmp(before, after, sizeof(double) * (size_t)len) != 0))
+            SEQ_FAIL("sequence %d: %s (%s) changed the solver's state", seq, call,
+                     ga_strerror(st));
+        if (st != GA_OK && writes_q >= 0 &&
+            (memcmp(q, keep, sizeof q) != 0 || (writes_q == 0 && w2[0] != sentinel)))
+            SEQ_FAIL("sequence %d: %s failed (%s: %s) but wrote its outputs", seq, call,
+                     ga_strerror(st), ga_last_error(s));
+#ifdef SEQ_TRACE
+        fprintf(stderr, "%s: %d %s\n", call, st, st ? ga_last_error(s) : "");
+#endif
+    }
+    return ok;
+}
+
 typedef struct seq_stats {
     long long calls, steps_ok, sparse_ok, twin_steps_ok, events, sensitivity_steps_ok,
-        adjoint_ok, hook_calls, hook_stops, advance_ok;
+        adjoint_ok, hook_calls, hook_stops, advance_ok, operating_points_ok;
 } seq_stats;
 
 /* The restart twin: a few steps from a checkpoint, then the checkpoint restored in the same
@@ -1101,6 +1186,7 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
 #endif
         ++stats->calls;
     }
+    stats->operating_points_ok += operating_points_phase(&md, s, seq);
     if (md.reentry_allowed)
         SEQ_FAIL("sequence %d: a callback's ga_step on its own solver was not refused", seq);
     if (md.hook_wrong)

@@ -49,10 +49,10 @@ static void random_call_sequences_keep_the_contract(void **state)
     printf("  %d sequences, %lld calls, %lld accepted steps (%lld on the sparse path, %lld with "
            "sensitivities), %lld steps repeated from a restored checkpoint, %lld stops at "
            "events, %lld adjoint sweeps, %lld step hook calls, %lld stops by it, %lld "
-           "ga_advance calls that reached t_out\n",
+           "ga_advance calls that reached t_out, %lld operating-point calls with GA_OK\n",
            SEQUENCES, stats.calls, steps_ok, sparse_ok, stats.sensitivity_steps_ok,
-           stats.twin_steps_ok, stats.events, stats.adjoint_ok, stats.hook_calls,
-           stats.hook_stops, stats.advance_ok);
+           stats.twin_steps_ok, stats.events, stats.adjoint_ok, stats.hook_calls, stats.hook_stops,
+           stats.advance_ok, stats.operating_points_ok);
     /* the sequences must reach the stepping code, dense and sparse, not only the checks of
      * arguments and of the call order */
     assert_true(steps_ok > SEQUENCES / 2);
@@ -63,6 +63,7 @@ static void random_call_sequences_keep_the_contract(void **state)
     assert_true(stats.adjoint_ok > SEQUENCES / 400);
     assert_true(stats.hook_calls > SEQUENCES / 10 && stats.hook_stops > SEQUENCES / 400);
     assert_true(stats.advance_ok > SEQUENCES / 100);
+    assert_true(stats.operating_points_ok > SEQUENCES / 100);
 }
 
 /* The same contract with a rotor on a group block beside the chain (a quaternion, a rotation
@@ -200,8 +201,8 @@ static void a_sliver_after_a_diverged_step_repeats_from_its_checkpoint(void **st
     assert_int_equal(ga_set_callbacks(s, mass, force, constraint, jacobian, &md), GA_OK);
     assert_int_equal(ga_set_tangents(s, stiffness, NULL), GA_OK);
     assert_int_equal(ga_set_initial_step(s, 0.7), GA_OK);
-    const double q0[6] = {0.37706637854462755, -0.22618623730394516, 1.3770663785446275,
-                          -0.92618623730394511, 2.3770663785446278, -0.92618623730394511};
+    const double q0[6] = {0.37706637854462755,  -0.22618623730394516, 1.3770663785446275,
+                          -0.92618623730394511, 2.3770663785446278,   -0.92618623730394511};
     const double v0[6] = {0.0};
     assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
     /* (a step of h = 1 does not resolve this motion: let it be taken, as before the check) */
@@ -219,7 +220,7 @@ static void a_sliver_after_a_diverged_step_repeats_from_its_checkpoint(void **st
         assert_int_equal(ga_get_h_last(s, &h[run]), GA_OK);
         assert_int_equal(ga_get_state(s, end[run], len), GA_OK);
     }
-    assert_true(h[0] < 1e-3);  /* shrunk from the sliver of 5e-3 that it tried first */
+    assert_true(h[0] < 1e-3); /* shrunk from the sliver of 5e-3 that it tried first */
     assert_memory_equal(&h[0], &h[1], sizeof h[0]);
     assert_memory_equal(end[0], end[1], sizeof(double) * len);
     ga_free(s);
