@@ -64,7 +64,7 @@ static void test_lattice_sags_to_a_root_and_its_lowest_modes_equal_lapack(void *
 {
     (void)state;
     lattice l;
-    assert_int_equal(lattice_make(&l, 32, 8, 1e6, 10.0), 0);
+    assert_int_equal(lattice_make(&l, 24, 6, 1e6, 10.0), 0);
     const int n = l.n;
     ga_solver *s = lattice_solver(&l, GA_LINEAR_AUTO);
     double *q = calloc((size_t)n, sizeof(double)), *f = malloc(sizeof(double) * (size_t)n);
@@ -149,7 +149,7 @@ static void test_a_stiff_lattice_needs_load_steps(void **state)
 {
     (void)state;
     lattice l;
-    assert_int_equal(lattice_make(&l, 32, 8, 1e6, 1e3), 0);
+    assert_int_equal(lattice_make(&l, 16, 4, 1e6, 1e3), 0);
     const int n = l.n;
     ga_solver *s = lattice_solver(&l, GA_LINEAR_AUTO);
     double *q = calloc((size_t)n, sizeof(double)), *f = malloc(sizeof(double) * (size_t)n);
