@@ -70,6 +70,8 @@ void Stepper::save_checkpoint(double *buf, const StepController &control) const
     const State &s = accepted_;
     const MatrixRecipe &r = recipe_;
     std::fill(buf, buf + l.end, 0.0);
+    const double tangents =
+        (r.K ? 1.0 : 0.0) + (r.C ? 2.0 : 0.0) + (r.Z ? 4.0 : 0.0) + (r.central ? 8.0 : 0.0);
     const double header[kHeader] = {kStateMagic,
                                     kStateVersion,
                                     static_cast<double>(nv_),
@@ -81,11 +83,12 @@ void Stepper::save_checkpoint(double *buf, const StepController &control) const
                                     control.grew ? 1.0 : 0.0,
                                     s.sliver_span,
                                     jacobian_valid_ ? 1.0 : 0.0,
-                                    r.t,
-                                    r.h,
-                                    r.t_b,
-                                    (r.K ? 1.0 : 0.0) + (r.C ? 2.0 : 0.0) + (r.Z ? 4.0 : 0.0) +
-                                        (r.central ? 8.0 : 0.0),
+                                    // the recipe only with a kept matrix (a failed step may
+                                    // have factorized and left its time there)
+                                    jacobian_valid_ ? r.t : 0.0,
+                                    jacobian_valid_ ? r.h : 0.0,
+                                    jacobian_valid_ ? r.t_b : 0.0,
+                                    jacobian_valid_ ? tangents : 0.0,
                                     // without a matrix the rate is stale and unused
                                     jacobian_valid_ ? theta_prev_ : -1.0,
                                     static_cast<double>(refresh_steps_left_),

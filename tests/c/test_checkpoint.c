@@ -342,6 +342,34 @@ static void failed_rebuild_restores_as_a_restart(void **state)
     ga_free(r);
 }
 
+/* A step that factorizes and then fails (Newton's iteration limit) keeps no matrix, and its
+ * checkpoint holds nothing of the failed attempt's recipe: the same state, the same
+ * checkpoint, as the one a solver restored from it gives back. */
+static void failed_step_leaves_no_recipe_in_the_checkpoint(void **state)
+{
+    (void)state;
+    double q[2], v[2], a[LEN], b[LEN];
+    pendulum_state(&P, 1.2, 0.8, q, v);
+    ga_solver *s = make();
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    steps(s, 30);
+    assert_int_equal(ga_set_jacobian_reuse(s, GA_REUSE_NEVER), GA_OK);
+    assert_int_equal(ga_set_newton(s, 1e-14, 1), GA_OK);
+    assert_int_equal(ga_step(s, 0.2), GA_ERR_NEWTON);
+    assert_int_equal(ga_get_state(s, a, LEN), GA_OK);
+    assert_true(a[10] == 0.0); /* no kept matrix */
+    for (int i = 11; i < 15; ++i)
+        assert_true(a[i] == 0.0); /* and no recipe time, step or tangents */
+    ga_solver *r = make();
+    assert_int_equal(ga_set_jacobian_reuse(r, GA_REUSE_NEVER), GA_OK);
+    assert_int_equal(ga_set_newton(r, 1e-14, 1), GA_OK);
+    assert_int_equal(ga_set_state(r, a, LEN), GA_OK);
+    assert_int_equal(ga_get_state(r, b, LEN), GA_OK);
+    assert_memory_equal(a, b, sizeof a);
+    ga_free(s);
+    ga_free(r);
+}
+
 /* The restart after a jump (an impact law, a switched force): ga_init on a running solver, at
  * a new state, continues exactly as a new solver with the same options started there does,
  * dense and sparse, index 3 and 2, fixed and adaptive steps (nothing of the run before is
@@ -445,6 +473,7 @@ int main(void)
         cmocka_unit_test(restart_between_slivers_is_bit_identical),
         cmocka_unit_test(taking_checkpoints_changes_nothing),
         cmocka_unit_test(failed_rebuild_restores_as_a_restart),
+        cmocka_unit_test(failed_step_leaves_no_recipe_in_the_checkpoint),
         cmocka_unit_test(restart_after_a_jump_is_a_new_solver),
         cmocka_unit_test(layout3_is_read_without_consistent_accelerations),
     };
