@@ -280,18 +280,6 @@ Sparse to_sparse(const ModelMatrix &A)
     return S;
 }
 
-// A user matrix as a dense one, into D.
-void dense_of(const ModelMatrix &A, Mat &D)
-{
-    if (A.dense()) {
-        D = A.as_dense();
-        return;
-    }
-    D.setZero(A.rows(), A.cols());
-    for (int k = 0; k < A.nnz(); ++k)
-        D(A.row_index()[k], A.col_index()[k]) += A.data()[k];
-}
-
 void add_block(std::vector<Eigen::Triplet<double>> &t, const Sparse &A, double scale, int row0,
                int col0, bool transposed = false)
 {
@@ -366,7 +354,7 @@ ga_status Adjoint::step_back(long k, Work &w)
         Gw = -(gq + c.gamma_prime * b.g_v);
         Gy = c1 * Mat::Identity(R, R) - b.g_y;
         if (index2 && m > 0) {
-            dense_of(k_.B_matrix(), w.Bd);
+            k_.B_matrix().to_dense(w.Bd);
             Ge = gq * w.Bd.transpose();
         }
     }
@@ -430,17 +418,17 @@ ga_status Adjoint::step_back(long k, Work &w)
     } else {
         Mat &D = w.D;
         D.setZero(N + R, N + R);
-        dense_of(k_.mass_matrix(), w.Md);
-        dense_of(k_.jacobian_matrix(), w.Jd);
+        k_.mass_matrix().to_dense(w.Md);
+        k_.jacobian_matrix().to_dense(w.Jd);
         D.topLeftCorner(n, n) = (bh2 * c.beta_prime) * w.Md;
         if (K) {
-            dense_of(k_.stiffness_matrix(), w.Kd);
+            k_.stiffness_matrix().to_dense(w.Kd);
             if (group)
                 space.right_multiply_tangent(w.xi, w.Kd.data(), n, n);
             D.topLeftCorner(n, n) += bh2 * w.Kd;
         }
         if (C) {
-            dense_of(k_.damping_matrix(), w.Cd);
+            k_.damping_matrix().to_dense(w.Cd);
             D.topLeftCorner(n, n) += (bh2 * c.gamma_prime) * w.Cd;
         }
         D.block(0, n, n, m) = w.Jd.transpose();
@@ -448,8 +436,8 @@ ga_status Adjoint::step_back(long k, Work &w)
             space.right_multiply_tangent(w.xi, w.Jd.data(), m, m);
         D.block(n, 0, m, n) = w.Jd;
         if (index2 && m > 0) {
-            dense_of(k_.B_matrix(), w.Bd);
-            dense_of(k_.Z_matrix(), w.Zd);
+            k_.B_matrix().to_dense(w.Bd);
+            k_.Z_matrix().to_dense(w.Zd);
             if (group && !k_.Z_matrix().dense()) {
                 // a pattern's Z is the difference alone: its bracket Phi_q [., v] added here,
                 // with Phi_q before T (the block above, transposed), as the step adds it

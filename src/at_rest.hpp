@@ -16,11 +16,8 @@ namespace rest {
 
 inline Mat dense_of(const ModelMatrix &A)
 {
-    if (A.dense())
-        return A.as_dense();
-    Mat D = Mat::Zero(A.rows(), A.cols());
-    for (int e = 0; e < A.nnz(); ++e)  // repeated entries add up
-        D(A.row_index()[e], A.col_index()[e]) += A.data()[e];
+    Mat D;
+    A.to_dense(D);
     return D;
 }
 

@@ -33,6 +33,17 @@ void ModelMatrix::allocate()
     values_.setZero(size);
 }
 
+void ModelMatrix::to_dense(Mat &D) const
+{
+    if (dense_) {
+        D = as_dense();
+        return;
+    }
+    D.setZero(rows_, cols_);
+    for (std::size_t k = 0; k < row_.size(); ++k)
+        D(row_[k], col_[k]) += values_[static_cast<Eigen::Index>(k)];
+}
+
 void ModelMatrix::copy_layout(const ModelMatrix &other)
 {
     rows_ = other.rows_;

@@ -38,6 +38,9 @@ public:
     // y += A x and s_i += sum_j |A_ij|, in one pass
     void multiply_add_row_abs_sums(const Vec &x, Vec &y, Vec &s) const;
 
+    // The matrix as a dense one, into D (a pattern's repeated entries add up).
+    void to_dense(Mat &D) const;
+
     // Same layout (and pattern) as another matrix, for scratch copies.
     void copy_layout(const ModelMatrix &other);
 
