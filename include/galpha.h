@@ -1170,8 +1170,8 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value);
 /** @name Operating points: static equilibrium, linearization, vibration modes
  *  From the callbacks of the dynamics (M, f, Phi, Phi_q and, where given, K_t and C_t; central
  *  differences otherwise), at rest: v = 0, qdd = 0. Dense, but for ga_modes_near and the
- *  static solve of a model on the sparse path; on coordinates in R^n without first-order
- *  states for now (GA_ERR_STATE otherwise). Callable before or after ga_init:
+ *  static solve of a model on the sparse path; on coordinates in R^n, and with first-order
+ *  states only in ga_static_equilibrium_y and ga_state_space (GA_ERR_STATE otherwise). Callable before or after ga_init:
  *  the solver's state and set-up are not touched, the evaluations are counted.
  *  docs/algorithms.md sec. 17. */
 /**@{*/
@@ -1206,6 +1206,35 @@ GA_API ga_status ga_static_equilibrium(ga_solver *s, double t, double *q, double
  *  errors. */
 GA_API ga_status ga_linearize(ga_solver *s, double t, const double *q, const double *lambda,
                               int max_dof, int *dof, double *N, double *M, double *C, double *K);
+
+/** Static equilibrium with first-order states (ga_set_first_order) as unknowns too:
+ *  f(q, 0, y, t) = Phi_q^T lambda, g(q, 0, y, t) = 0, Phi(q, t) = 0, by Newton from (q, y) in
+ *  the null space of Phi_q, the coupling blocks g_q, g_y, f_y by their callback
+ *  (ga_set_coupling) or central differences; otherwise as ga_static_equilibrium (dense), also
+ *  converged when the rates are within 8 ulps of their terms and a step moves y by at most
+ *  tol max(1, |y|_inf). y (length r) holds the states' start and, on GA_OK, their rest; with
+ *  r = 0 y may be NULL and this is ga_static_equilibrium's dense path. On failure q, y and
+ *  lambda are untouched. Errors as ga_static_equilibrium (GA_ERR_ARG also for a NULL y with
+ *  r > 0). */
+GA_API ga_status ga_static_equilibrium_y(ga_solver *s, double t, double *q, double *y,
+                                         double *lambda, double tol, int max_iter);
+
+/** The first-order (state-space) form of the small motions about (q, y, lambda) at rest, in
+ *  the minimal coordinates q = q0 + N z of ga_linearize and with the first-order states:
+ *  x = (z, z', y), x' = A x with
+ *      A = [0, I, 0; -M^-1 K, -M^-1 C, M^-1 N^T f_y; g_q N, g_v N, g_y]
+ *  (M, C, K the reduced matrices of ga_linearize, f_y, g_q, g_v, g_y the coupling blocks at
+ *  (q, 0, y) by their callback or central differences). *dim = 2 dof + r; N (n x dof, may be
+ *  NULL) and A (dim x dim, column-major, may be NULL) written only if *dim <= max_dim. About
+ *  an equilibrium its eigenvalues are the damped modes' s with the states' own; about another
+ *  point at rest it is the tangent system there. y may be NULL when r = 0; lambda NULL: the
+ *  balancing multipliers. Errors: GA_ERR_ARG (NULL q or dim, NULL y with r > 0, a value not
+ *  finite, *dim > max_dim: the message says *dim), GA_ERR_SINGULAR (a singular mass in the
+ *  free directions), GA_ERR_STATE (no callbacks, rotations, from a callback), callback
+ *  errors. */
+GA_API ga_status ga_state_space(ga_solver *s, double t, const double *q, const double *y,
+                                const double *lambda, int max_dim, int *dim, double *N,
+                                double *A);
 
 /** The `count` lowest undamped vibration modes at an equilibrium (q, lambda):
  *  (N^T K_t N) z = omega^2 (N^T M N) z. omega2 (length count) ascending; a negative value is an

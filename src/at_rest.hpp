@@ -37,15 +37,80 @@ class AtRest {
 public:
     AtRest(Stepper &kernel, double t)
         : k_(kernel), model_(kernel.model), t_(t), n_(kernel.nv()), m_(kernel.m()),
-          zero_(Vec::Zero(kernel.nv())), f_(kernel.nv())
+          r_(kernel.r()), zero_(Vec::Zero(kernel.nv())), f_(kernel.nv()),
+          y_before_(kernel.model.y_now)
     {
         M_.copy_layout(kernel.matrix(GA_MATRIX_MASS));
         J_.copy_layout(kernel.matrix(GA_MATRIX_JACOBIAN));
         K_.copy_layout(kernel.matrix(GA_MATRIX_STIFFNESS));
         C_.copy_layout(kernel.matrix(GA_MATRIX_DAMPING));
     }
+    ~AtRest() { model_.y_now = y_before_; }
+    AtRest(const AtRest &) = delete;
+    AtRest &operator=(const AtRest &) = delete;
     int n() const { return n_; }
     int m() const { return m_; }
+    int r() const { return r_; }
+
+    // First-order states (docs/algorithms.md sec. 11): the force sees y, which stays alive
+    // while this is used; y' = g(q, 0, y).
+    void states(const Vec &y) { model_.y_now = &y; }
+    ga_status rate(const Vec &q, const Vec &y, Vec &g)
+    {
+        g.resize(r_);
+        return model_.rate(t_, q, zero_, y, g);
+    }
+    // g_q, g_v, g_y and f_y at (q, 0, y): the coupling callback, or central differences
+    ga_status coupling(const Vec &q, const Vec &y, CouplingBlocks &B)
+    {
+        B.allocate(n_, r_);
+        const Restore<const Vec *> keep(model_.y_now);
+        model_.y_now = &y;
+        if (model_.cb.coupling) {
+            Vec f, g;
+            return model_.coupling(t_, q, zero_, y, f, g, B);
+        }
+        Vec qq = q, v = zero_, yy = y, gp(r_), gm(r_), fp(n_), fm(n_);
+        const ConfigurationSpace &space = model_.space;
+        for (int j = 0; j < n_; ++j) {
+            const double e = step_for(q[j]);
+            space.shift_coordinate(qq, q, j, e);
+            if (auto st = model_.rate(t_, qq, zero_, y, gp))
+                return st;
+            space.shift_coordinate(qq, q, j, -e);
+            if (auto st = model_.rate(t_, qq, zero_, y, gm))
+                return st;
+            space.restore_coordinate(qq, q, j);
+            B.g_q.col(j) = (gp - gm) / (2.0 * e);
+            const double ev = step_for(0.0);
+            v[j] = ev;
+            if (auto st = model_.rate(t_, q, v, y, gp))
+                return st;
+            v[j] = -ev;
+            if (auto st = model_.rate(t_, q, v, y, gm))
+                return st;
+            v[j] = 0.0;
+            B.g_v.col(j) = (gp - gm) / (2.0 * ev);
+        }
+        model_.y_now = &yy;
+        for (int j = 0; j < r_; ++j) {
+            const double e = step_for(y[j]);
+            yy[j] = y[j] + e;
+            if (auto st = model_.rate(t_, q, zero_, yy, gp))
+                return st;
+            if (auto st = model_.force(t_, q, zero_, fp))
+                return st;
+            yy[j] = y[j] - e;
+            if (auto st = model_.rate(t_, q, zero_, yy, gm))
+                return st;
+            if (auto st = model_.force(t_, q, zero_, fm))
+                return st;
+            yy[j] = y[j];
+            B.g_y.col(j) = (gp - gm) / (2.0 * e);
+            B.f_y.col(j) = (fp - fm) / (2.0 * e);
+        }
+        return GA_OK;
+    }
 
     ga_status force(const Vec &q, Vec &f) { return model_.force(t_, q, zero_, f); }
     ga_status constraint(const Vec &q, Vec &phi)
@@ -159,8 +224,9 @@ private:
     Stepper &k_;
     Model &model_;
     double t_;
-    int n_, m_;
+    int n_, m_, r_;
     Vec zero_, f_;
+    const Vec *y_before_;
     ModelMatrix M_, J_, K_, C_;
 };
 

@@ -1293,17 +1293,19 @@ GA_API ga_status ga_reset_counters(ga_solver *s)
 
 // ---- operating points (operating_point.cpp) ----
 namespace {
-// What the static problem does not cover yet, refused by name.
-ga_status operating_point_refusal(ga::Solver &c, const char *name, double t)
+// What the static problem does not cover yet, refused by name (first_order: the call takes
+// the first-order states).
+ga_status operating_point_refusal(ga::Solver &c, const char *name, double t,
+                                  bool first_order = false)
 {
     if (!c.model.ready())
         return c.diag.fail(GA_ERR_STATE, "%s needs the callbacks (ga_set_callbacks)", name);
     if (!c.model.space.euclidean())
         return c.diag.fail(GA_ERR_STATE, "%s: on coordinates in R^n only (not yet on a space "
                            "with rotations)", name);
-    if (c.kernel().r() > 0)
-        return c.diag.fail(GA_ERR_STATE, "%s: not yet with first-order states "
-                           "(ga_set_first_order)", name);
+    if (c.kernel().r() > 0 && !first_order)
+        return c.diag.fail(GA_ERR_STATE, "%s: not with first-order states (ga_set_first_order): "
+                           "ga_static_equilibrium_y and ga_state_space take them", name);
     if (!std::isfinite(t))
         return c.diag.fail(GA_ERR_ARG, "%s: t = %g is not finite", name, t);
     return GA_OK;
@@ -1396,6 +1398,47 @@ GA_API ga_status ga_modes(ga_solver *s, double t, const double *q, const double 
             return c.diag.fail(GA_ERR_ARG, "ga_modes: q or omega2 is NULL, or count = %d < 1",
                                count);
         return ga::modes(c.kernel(), t, q, lambda, count, omega2, shapes);
+    });
+}
+
+GA_API ga_status ga_static_equilibrium_y(ga_solver *s, double t, double *q, double *y,
+                                         double *lambda, double tol, int max_iter)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (auto st = operating_point_refusal(c, "ga_static_equilibrium_y", t, true))
+            return st;
+        if (!q || (!y && c.kernel().r() > 0))
+            return c.diag.fail(GA_ERR_ARG, "ga_static_equilibrium_y: q or y is NULL");
+        if (!(tol > 0.0) || !std::isfinite(tol) || max_iter < 1)
+            return c.diag.fail(GA_ERR_ARG, "ga_static_equilibrium_y: tol = %g must be finite "
+                               "and > 0, max_iter = %d >= 1", tol, max_iter);
+        return ga::static_equilibrium_y(c.kernel(), t, q, c.kernel().r() > 0 ? y : nullptr,
+                                        lambda, tol, max_iter);
+    });
+}
+
+GA_API ga_status ga_state_space(ga_solver *s, double t, const double *q, const double *y,
+                                const double *lambda, int max_dim, int *dim, double *N,
+                                double *A)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        if (auto st = operating_point_refusal(c, "ga_state_space", t, true))
+            return st;
+        if (!q || !dim || (!y && c.kernel().r() > 0))
+            return c.diag.fail(GA_ERR_ARG, "ga_state_space: q, dim or y is NULL");
+        ga::StateSpace ss;
+        if (auto st = ga::state_space(c.kernel(), t, q, y, lambda, ss))
+            return st;
+        if (ss.dim > max_dim)
+            return c.diag.fail(GA_ERR_ARG, "ga_state_space: dimension %d (%d degrees of freedom, "
+                               "%d first-order states), max_dim = %d", ss.dim, ss.dof,
+                               c.kernel().r(), max_dim);
+        *dim = ss.dim;
+        if (N)
+            Eigen::Map<ga::Mat>(N, ss.N.rows(), ss.N.cols()) = ss.N;
+        if (A)
+            Eigen::Map<ga::Mat>(A, ss.dim, ss.dim) = ss.A;
+        return GA_OK;
     });
 }
 

@@ -12,6 +12,11 @@ namespace ga {
 ga_status static_equilibrium(Stepper &kernel, double t, double *q, double *lambda, double tol,
                              int max_iter);
 
+// With first-order states y (r of them) as unknowns too: f(q, 0, y) = Phi_q^T lambda,
+// g(q, 0, y) = 0, Phi = 0 (y null: static_equilibrium's problem, dense).
+ga_status static_equilibrium_y(Stepper &kernel, double t, double *q, double *y, double *lambda,
+                               double tol, int max_iter);
+
 // The same on [K_t, Phi_q^T; Phi_q, 0] (static_saddle.cpp): for models the solver takes on
 // its sparse path, where the null space would be dense; static_equilibrium goes there itself.
 ga_status static_equilibrium_saddle(Stepper &kernel, double t, double *q, double *lambda,
@@ -28,6 +33,15 @@ struct Linearization {
 };
 ga_status linearize(Stepper &kernel, double t, const double *q, const double *lambda,
                     Linearization &out);
+
+// The first-order form of the small motions about (q, y, lambda) at rest: x = (z, z', y),
+// x' = A x, dim = 2 dof + r (y, lambda may be null: no states; the balancing multipliers).
+struct StateSpace {
+    int dof = 0, dim = 0;
+    Mat N, A;
+};
+ga_status state_space(Stepper &kernel, double t, const double *q, const double *y,
+                      const double *lambda, StateSpace &out);
 
 // The `count` lowest undamped modes at an equilibrium (q, lambda): K z = omega^2 M z,
 // omega^2 ascending (negative: unstable there), shapes N z in q with unit modal mass.

@@ -420,6 +420,23 @@ module galpha
        real(c_double), intent(inout) :: q(*)
        integer(c_int), value :: max_iter
      end function ga_static_equilibrium
+     integer(c_int) function ga_static_equilibrium_y(s, t, q, y, lambda, tol, max_iter) &
+          bind(C, name="ga_static_equilibrium_y")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s, y, lambda
+       real(c_double), value :: t, tol
+       real(c_double), intent(inout) :: q(*)
+       integer(c_int), value :: max_iter
+     end function ga_static_equilibrium_y
+     integer(c_int) function ga_state_space(s, t, q, y, lambda, max_dim, dim, n_basis, a) &
+          bind(C, name="ga_state_space")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s, y, lambda, n_basis, a
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*)
+       integer(c_int), value :: max_dim
+       integer(c_int), intent(out) :: dim
+     end function ga_state_space
      integer(c_int) function ga_linearize(s, t, q, lambda, max_dof, dof, n_basis, m_red, &
           c_red, k_red) bind(C, name="ga_linearize")
        import :: c_int, c_ptr, c_double
@@ -761,7 +778,7 @@ module galpha
        ga_set_linear_solver, &
        ga_linear_solver_name, ga_set_formulation, ga_set_resolution_check, &
        ga_check_derivatives, ga_static_equilibrium, ga_linearize, ga_modes, ga_static_path, &
-       ga_modes_damped, ga_modes_near, &
+       ga_modes_damped, ga_modes_near, ga_static_equilibrium_y, ga_state_space, &
        ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
@@ -810,6 +827,13 @@ module galpha
      !> static equilibrium, lambda its multipliers (ga_static_equilibrium; tol 1e-10, max_iter
      !> 50 unless given)
      procedure :: static_equilibrium => solver_static_equilibrium
+     !> static_equilibrium_y(t, q, y [, lambda, tol, max_iter]): the same with the
+     !> first-order states y as unknowns too (ga_static_equilibrium_y)
+     procedure :: static_equilibrium_y => solver_static_equilibrium_y
+     !> state_space(t, q, dim [, y, lambda, basis, a]): the first-order form x' = A x of the
+     !> small motions at rest, x = (z, z', y), a(dim, dim), basis(n, dof) (ga_state_space);
+     !> without them only dim (call first to size them)
+     procedure :: state_space => solver_state_space
      !> modes(t, q, omega2 [, lambda, shapes]): the size(omega2) lowest undamped modes at an
      !> equilibrium, shapes(n, size(omega2)) with unit modal mass (ga_modes)
      procedure :: modes => solver_modes
@@ -1544,6 +1568,57 @@ contains
     if (present(max_iter)) iterations = int(max_iter, c_int)
     status = ga_static_equilibrium(this%handle, t, q, plambda, tolerance, iterations)
   end function solver_static_equilibrium
+
+  integer(c_int) function solver_static_equilibrium_y(this, t, q, y, lambda, tol, max_iter) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t
+    real(c_double), intent(inout) :: q(:)
+    real(c_double), intent(inout), target :: y(:)
+    real(c_double), intent(inout), optional, target :: lambda(:)
+    real(c_double), intent(in), optional :: tol
+    integer, intent(in), optional :: max_iter
+    type(c_ptr) :: plambda, py
+    real(c_double) :: tolerance
+    integer(c_int) :: iterations
+    plambda = c_null_ptr
+    py = c_null_ptr
+    tolerance = 1d-10
+    iterations = 50
+    if (size(y) > 0) py = c_loc(y)
+    if (present(lambda)) plambda = c_loc(lambda)
+    if (present(tol)) tolerance = tol
+    if (present(max_iter)) iterations = int(max_iter, c_int)
+    status = ga_static_equilibrium_y(this%handle, t, q, py, plambda, tolerance, iterations)
+  end function solver_static_equilibrium_y
+
+  integer(c_int) function solver_state_space(this, t, q, dim, y, lambda, basis, a) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t, q(:)
+    integer, intent(out) :: dim
+    real(c_double), intent(in), optional, target :: y(:), lambda(:)
+    real(c_double), intent(out), optional, target :: basis(:, :), a(:, :)
+    type(c_ptr) :: py, plambda, pbasis, pa
+    integer(c_int) :: d, max_dim
+    py = c_null_ptr
+    plambda = c_null_ptr
+    pbasis = c_null_ptr
+    pa = c_null_ptr
+    max_dim = huge(max_dim)
+    if (present(y)) then
+       if (size(y) > 0) py = c_loc(y)
+    end if
+    if (present(lambda)) plambda = c_loc(lambda)
+    if (present(basis)) pbasis = c_loc(basis)
+    if (present(a)) then
+       pa = c_loc(a)
+       max_dim = int(size(a, 1), c_int)
+    end if
+    d = 0
+    status = ga_state_space(this%handle, t, q, py, plambda, max_dim, d, pbasis, pa)
+    dim = int(d)
+  end function solver_state_space
 
   integer(c_int) function solver_modes(this, t, q, omega2, lambda, shapes) result(status)
     class(galpha_solver), intent(inout) :: this

@@ -557,7 +557,8 @@ static long long operating_points_phase(model *md, ga_solver *s, int seq)
     long long ok = 0;
     for (int k = 0; k < 3 && !md->exhausted; ++k) {
         double before[STATE_MAX], after[STATE_MAX], t = 0.0, q[QMAX] = {0}, keep[QMAX];
-        double lambda[MMAX] = {0}, w2[2 * VMAX], im[2 * VMAX], shapes[2 * VMAX * VMAX],
+        double lambda[MMAX] = {0}, w2[2 * VMAX], im[2 * VMAX],
+               shapes[(2 * VMAX + 1) * (2 * VMAX + 1)],
                shapes_im[2 * VMAX * VMAX], stiff[VMAX * VMAX];
         const int len = snapshot(md, s, before);
         if (ga_get_t(s, &t) != GA_OK || ga_get_q(s, q) != GA_OK) {
@@ -578,7 +579,25 @@ static long long operating_points_phase(model *md, ga_solver *s, int seq)
         ga_status st = GA_OK;
         const char *call = "";
         int writes_q = 0;
-        switch (pick(md, 6)) {
+        switch (pick(md, 8)) {
+        case 6: {
+            double y[1] = {pick(md, 2) ? 0.3 : edge_value(md)}, ykeep[1];
+            ykeep[0] = y[0];
+            call = "ga_static_equilibrium_y";
+            st = ga_static_equilibrium_y(s, t, q, md->r ? y : NULL, lam, 1e-10, pick(md, 30) - 2);
+            if (st != GA_OK && memcmp(y, ykeep, sizeof y) != 0)
+                SEQ_FAIL("sequence %d: %s failed but wrote y", seq, call);
+            writes_q = 1;
+            break;
+        }
+        case 7: {
+            double y[1] = {0.3};
+            int dim = -1;
+            call = "ga_state_space";
+            st = ga_state_space(s, t, q, y, lam, pick(md, 2 * md->nv + 3) - 1, &dim,
+                                pick(md, 2) ? shapes_im : NULL, pick(md, 2) ? shapes : NULL);
+            break;
+        }
         case 0:
             call = "ga_static_equilibrium";
             st = ga_static_equilibrium(s, t, q, lam, pick(md, 2) ? 1e-10 : edge_value(md),

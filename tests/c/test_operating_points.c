@@ -13,6 +13,7 @@
 #include <cmocka.h>
 #include <complex.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -1001,6 +1002,131 @@ static int fo_rate(double t, const double *q, const double *v, const double *y, 
     return 0;
 }
 
+/* ---- first-order states: a pendulum pushed by an actuator state ------------------------ */
+/* f = (y - c vx, -m g - c vy), y' = -y / tau + k x + u0 (no_root: y' = 1 + y^2) */
+static const double act_tau = 0.5, act_k = 2.0, act_u0 = 3.0, act_c = 0.3;
+static int act_no_root = 0;
+
+static int act_force(double t, const double *q, const double *v, const double *y, double *f,
+                     void *u)
+{
+    const Pendulums *p = u;
+    (void)t, (void)q;
+    f[0] = y[0] - act_c * v[0];
+    f[1] = -p->m[0] * g_acc - act_c * v[1];
+    return 0;
+}
+
+static int act_rate(double t, const double *q, const double *v, const double *y, double *ydot,
+                    void *u)
+{
+    (void)t, (void)v, (void)u;
+    ydot[0] = act_no_root ? 1.0 + y[0] * y[0] : -y[0] / act_tau + act_k * q[0] + act_u0;
+    return 0;
+}
+
+static int act_damping(double t, const double *q, const double *v, double *C, void *u)
+{
+    (void)t, (void)q, (void)v, (void)u;
+    C[0] = C[3] = act_c;
+    C[1] = C[2] = 0.0;
+    return 0;
+}
+
+static int act_coupling(double t, const double *q, const double *v, const double *y,
+                        double *g_q, double *g_v, double *g_y, double *f_y, void *u)
+{
+    (void)t, (void)q, (void)v, (void)y, (void)u;
+    g_q[0] = act_k; /* (r x n, column-major) */
+    g_q[1] = 0.0;
+    g_v[0] = g_v[1] = 0.0;
+    g_y[0] = -1.0 / act_tau;
+    f_y[0] = 1.0; /* (n x r) */
+    f_y[1] = 0.0;
+    return 0;
+}
+
+static double trace_of_power(const double *A, int d, int power)
+{
+    double P[9], Q[9];
+    memcpy(P, A, sizeof(double) * (size_t)(d * d));
+    for (int k = 1; k < power; ++k) {
+        for (int i = 0; i < d; ++i)
+            for (int j = 0; j < d; ++j) {
+                Q[i + d * j] = 0.0;
+                for (int l = 0; l < d; ++l)
+                    Q[i + d * j] += P[i + d * l] * A[l + d * j];
+            }
+        memcpy(P, Q, sizeof(double) * (size_t)(d * d));
+    }
+    double tr = 0.0;
+    for (int i = 0; i < d; ++i)
+        tr += P[i + d * i];
+    return tr;
+}
+
+/* Oracle in the angle theta: m L^2 theta'' = y L cos(theta) - m g L sin(theta) - c L^2
+ * theta', y' = -y / tau + k L sin(theta) + u0; at rest tan(theta) = y / (m g) with
+ * y = tau (k L sin(theta) + u0), by a scalar Newton here; the linearization's 3 x 3 matrix in
+ * (theta, theta', y) is similar to galpha's in (z, z', y) (z = +-L theta), so the traces of
+ * its powers agree. */
+static void test_an_actuated_pendulum_rests_and_its_state_space_is_the_closed_form(void **state)
+{
+    (void)state;
+    Pendulums p = {1, {1.3, 0}, {0.9, 0}, 0, 0};
+    const double m = p.m[0], L = p.L[0];
+    ga_solver *s = pendulums(&p);
+    assert_int_equal(ga_set_first_order(s, 1, act_force, act_rate), GA_OK);
+    double th = 0.0;
+    for (int it = 0; it < 50; ++it) {
+        const double F = act_tau * (act_k * L * sin(th) + act_u0) * cos(th) - m * g_acc * sin(th);
+        const double dF = act_tau * act_k * L * cos(th) * cos(th) -
+                          act_tau * (act_k * L * sin(th) + act_u0) * sin(th) - m * g_acc * cos(th);
+        th -= F / dF;
+    }
+    const double ystar = act_tau * (act_k * L * sin(th) + act_u0);
+    double q[2] = {0.1, -0.8}, y[1] = {0.0}, lambda[1];
+    assert_int_equal(ga_static_equilibrium_y(s, 0.0, q, y, lambda, 1e-13, 50), GA_OK);
+    assert_near(q[0], L * sin(th), 1e-13);
+    assert_near(q[1], -L * cos(th), 1e-13);
+    assert_rel(y[0], ystar, 1e-12);
+    assert_rel(lambda[0], m * g_acc / (L * cos(th)), 1e-12);
+    double A[9], N[2];
+    int dim = 0;
+    const double c = cos(th), sn = sin(th);
+    const double B[9] = {0.0, -(ystar * sn + m * g_acc * c) / (m * L), act_k * L * c,
+                         1.0, -act_c / m, 0.0,
+                         0.0, c / (m * L), -1.0 / act_tau}; /* column-major */
+    /* C_t and the coupling blocks by central differences: their round-off is eps |f| over
+     * the step (6e-6), 1e-10 of these entries; then by their callbacks, to round-off */
+    for (int exact = 0; exact < 2; ++exact) {
+        if (exact) {
+            assert_int_equal(ga_set_tangents(s, pend_stiff, act_damping), GA_OK);
+            assert_int_equal(ga_set_coupling(s, act_coupling), GA_OK);
+        }
+        assert_int_equal(ga_state_space(s, 0.0, q, y, lambda, 3, &dim, N, A), GA_OK);
+        assert_int_equal(dim, 3);
+        for (int k = 1; k <= 3; ++k) {
+            printf("  tr A^%d: %.15g against %.15g (%s)\n", k, trace_of_power(A, 3, k),
+                   trace_of_power(B, 3, k), exact ? "callbacks" : "differences");
+            assert_rel(trace_of_power(A, 3, k), trace_of_power(B, 3, k), exact ? 1e-13 : 1e-9);
+        }
+    }
+    assert_near(fabs(N[0]), 1.0 * fabs(c), 1e-13); /* N spans the tangent (cos, sin) */
+    /* refusals: y missing, the dimension too large for max_dim, no root of the rate */
+    assert_int_equal(ga_state_space(s, 0.0, q, NULL, NULL, 3, &dim, NULL, NULL), GA_ERR_ARG);
+    assert_int_equal(ga_state_space(s, 0.0, q, y, NULL, 2, &dim, N, A), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "dimension 3"));
+    double qs[2] = {0.1, -0.8}, ys[1] = {0.5};
+    assert_int_equal(ga_static_equilibrium_y(s, 0.0, qs, NULL, NULL, 1e-13, 50), GA_ERR_ARG);
+    act_no_root = 1;
+    assert_int_equal(ga_static_equilibrium_y(s, 0.0, qs, ys, NULL, 1e-13, 50), GA_ERR_NEWTON);
+    assert_non_null(strstr(ga_last_error(s), "no equilibrium"));
+    act_no_root = 0;
+    assert_true(qs[0] == 0.1 && qs[1] == -0.8 && ys[0] == 0.5);
+    ga_free(s);
+}
+
 static void test_rotations_and_first_order_states_are_refused_by_name(void **state)
 {
     (void)state;
@@ -1038,6 +1164,7 @@ int main(void)
         cmocka_unit_test(test_load_stepping_stops_at_the_limit_point),
         cmocka_unit_test(test_no_equilibrium_a_free_motion_and_a_follower_force_are_refused),
         cmocka_unit_test(test_modes_refuse_what_is_no_equilibrium),
+        cmocka_unit_test(test_an_actuated_pendulum_rests_and_its_state_space_is_the_closed_form),
         cmocka_unit_test(test_locked_mechanism),
         cmocka_unit_test(test_arguments_state_and_callbacks),
         cmocka_unit_test(test_a_running_solver_is_left_as_it_was),

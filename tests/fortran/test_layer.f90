@@ -463,6 +463,16 @@ program test_layer
   call expect(abs(v2(1) - 9.81d0) < 1d-8 * 9.81d0, 'omega^2 = g / L')
   call expect(s%modes(0.0d0, [0.6d0, -0.8d0], v2(1:1)) == GA_ERR_INCONSISTENT, &
        'modes away from an equilibrium refused')
+  ! the first-order form at rest: x = (z, z'), A = [0, 1; -g / L, 0]; no states here
+  block
+    real(c_double) :: ass(2, 2), ynone(0)
+    call ok(s%state_space(0.0d0, q2, n), 'state_space: its dimension')
+    call expect(n == 2, 'state_space: 2 dof + 0 states')
+    call ok(s%state_space(0.0d0, q2, n, lambda=lam2, a=ass), 'state_space')
+    call expect(abs(ass(1, 2) - 1.0d0) < 1d-14 .and. abs(ass(2, 1) + 9.81d0) < 1d-8 * 9.81d0 &
+         .and. abs(ass(1, 1)) < 1d-14 .and. abs(ass(2, 2)) < 1d-12, 'state_space: A')
+    call ok(s%static_equilibrium_y(0.0d0, q2, ynone, lam2), 'static_equilibrium_y without states')
+  end block
   ! the same by shift-invert Lanczos (dense here: no patterns); two modes of one refused
   call ok(s%modes_near(0.0d0, q2, 0.0d0, v2(1:1), lam2), 'modes_near')
   call expect(abs(v2(1) - 9.81d0) < 1d-8 * 9.81d0, 'modes_near: omega^2 = g / L')

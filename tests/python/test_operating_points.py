@@ -184,3 +184,55 @@ def test_modes_near_on_the_sparse_path_equal_the_closed_form():
                           -L1 * np.cos(0.3) - L2], count=1)
         with pytest.raises(galpha.ArgumentError, match="2 degrees of freedom"):
             s.modes_near(eq.q, count=3)
+
+
+def test_first_order_states_at_rest_and_their_state_space():
+    """A pendulum pushed horizontally by an actuator state y (y' = -y / tau + k x + u0): its
+    rest from a scalar Newton in the angle, and the state space's invariants against the
+    closed-form 3 x 3 linearization in (theta, theta', y)."""
+    m, L, tau, k, u0, c = 1.3, 0.9, 0.5, 2.0, 3.0, 0.3
+
+    def mass1(t, q, M):
+        M[:] = m * np.eye(2)
+
+    def constraint1(t, q, phi):
+        phi[0] = 0.5 * (q @ q - L * L)
+
+    def jacobian1(t, q, J):
+        J[0, :] = q
+
+    def stiffness1(t, q, v, qdd, lam, K):
+        K[:] = lam[0] * np.eye(2)
+
+    def damping1(t, q, v, C):
+        C[:] = c * np.eye(2)
+
+    def force_y(t, q, v, y, f):
+        f[:] = (y[0] - c * v[0], -m * G - c * v[1])
+
+    def rate(t, q, v, y, ydot):
+        ydot[0] = -y[0] / tau + k * q[0] + u0
+
+    th = 0.0
+    for _ in range(50):
+        F = tau * (k * L * np.sin(th) + u0) * np.cos(th) - m * G * np.sin(th)
+        dF = (tau * k * L * np.cos(th) ** 2 - tau * (k * L * np.sin(th) + u0) * np.sin(th)
+              - m * G * np.cos(th))
+        th -= F / dF
+    ystar = tau * (k * L * np.sin(th) + u0)
+    with galpha.Solver(2, 1, mass1, None, constraint1, jacobian1, stiffness=stiffness1,
+                       damping=damping1, r=1, rate=rate, force_y=force_y) as s:
+        eq = s.static_equilibrium_y([0.1, -0.8], [0.0])
+        assert isinstance(eq, galpha.EquilibriumY)
+        np.testing.assert_allclose(eq.q, [L * np.sin(th), -L * np.cos(th)], atol=1e-13)
+        np.testing.assert_allclose(eq.y, [ystar], rtol=1e-12)
+        ss = s.state_space(eq.q, eq.y, eq.lam)
+        assert ss.A.shape == (3, 3) and ss.N.shape == (2, 1)
+        B = np.array([[0.0, 1.0, 0.0],
+                      [-(ystar * np.sin(th) + m * G * np.cos(th)) / (m * L), -c / m,
+                       np.cos(th) / (m * L)],
+                      [k * L * np.cos(th), 0.0, -1.0 / tau]])
+        np.testing.assert_allclose(np.sort_complex(np.linalg.eigvals(ss.A)),
+                                   np.sort_complex(np.linalg.eigvals(B)), rtol=1e-8)
+        with pytest.raises(ValueError, match="first-order states"):
+            s.state_space(eq.q)

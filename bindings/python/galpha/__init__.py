@@ -33,8 +33,8 @@ from .errors import (ArgumentError, CallbackError, CallbackRetry, ConvergenceErr
                      OutOfMemoryError, RecoverableError, SingularMatrixError, StateError,
                      StepSizeError, UnresolvedError)
 from .integrate import IntegrateResult, OdeSolution, integrate  # noqa: F401
-from .solver import (DampedModes, Equilibrium, Linearization, Modes,  # noqa: F401
-                     Sensitivity, Solver, StaticPath)
+from .solver import (DampedModes, Equilibrium, EquilibriumY, Linearization,  # noqa: F401
+                     Modes, Sensitivity, Solver, StateSpace, StaticPath)
 from . import se3, so3  # noqa: F401,E402
 
 

@@ -56,6 +56,10 @@ DampedModes = collections.namedtuple("DampedModes", "s shapes")
 # A static path (ga_static_path): the load factors (k), q (k x n) and lam (k x m) of its points
 # after the start, and the status that ended it ("done", "stopped")
 StaticPath = collections.namedtuple("StaticPath", "load q lam ended")
+# With first-order states (ga_static_equilibrium_y): q, the states y and lam at rest
+EquilibriumY = collections.namedtuple("EquilibriumY", "q y lam")
+# The first-order form x' = A x of the small motions at rest, x = (z, z', y) (ga_state_space)
+StateSpace = collections.namedtuple("StateSpace", "N A")
 
 
 def _cast(fn, ctype):
@@ -1179,6 +1183,52 @@ class Solver:
         self._check(_ffi.ga_static_equilibrium(self._handle(), float(t), self._dp(q),
                                                self._dp(lam), float(tol), int(max_iter)))
         return Equilibrium(q, lam[:self.m].copy())
+
+    @_serialized
+    @_runs_callbacks
+    def static_equilibrium_y(self, q0, y0, t=0.0, tol=1e-10, max_iter=50):
+        """The static equilibrium with the first-order states as unknowns too (f(q, 0, y) =
+        Phi_q^T lam, g(q, 0, y) = 0, Phi = 0; ga_static_equilibrium_y) from (q0, y0): an
+        EquilibriumY(q, y, lam)."""
+        q, _ = self._rest_arrays(q0, None)
+        r = self.r
+        y = np.ascontiguousarray(np.array(y0, dtype=float).ravel())
+        if y.size != r:
+            raise ValueError(f"y0 has {y.size} entries, the model has {r} first-order states")
+        ybuf = np.zeros(max(r, 1))
+        ybuf[:r] = y
+        lam = np.zeros(max(self.m, 1))
+        self._check(_ffi.ga_static_equilibrium_y(self._handle(), float(t), self._dp(q),
+                                                 self._dp(ybuf), self._dp(lam), float(tol),
+                                                 int(max_iter)))
+        return EquilibriumY(q, ybuf[:r].copy(), lam[:self.m].copy())
+
+    @_serialized
+    @_runs_callbacks
+    def state_space(self, q, y=None, lam=None, t=0.0):
+        """The first-order form x' = A x of the small motions about (q, y, lam) at rest, x =
+        (z, z', y) in the minimal coordinates q = q0 + N z (ga_state_space): a StateSpace(N,
+        A), A (2 dof + r square). y: the first-order states (None without them); lam None:
+        the balancing multipliers."""
+        q, lam = self._rest_arrays(q, lam)
+        r = self.r
+        ybuf = np.zeros(max(r, 1))
+        if r:
+            if y is None:
+                raise ValueError(f"the model has {r} first-order states: y is needed")
+            ybuf[:r] = np.array(y, dtype=float).ravel()
+        dim = ctypes.c_int()
+        h = self._handle()
+        lp = None if lam is None else self._dp(lam)
+        max_dim = 2 * self.n + r
+        N = np.zeros(self.n * self.n)
+        A = np.zeros(max(max_dim * max_dim, 1))
+        self._check(_ffi.ga_state_space(h, float(t), self._dp(q), self._dp(ybuf), lp, max_dim,
+                                        ctypes.byref(dim), self._dp(N), self._dp(A)))
+        d = dim.value
+        dof = (d - r) // 2
+        return StateSpace(N[:self.n * dof].reshape((self.n, dof), order="F").copy(),
+                          A[:d * d].reshape((d, d), order="F").copy())
 
     @_serialized
     @_runs_callbacks
