@@ -437,6 +437,15 @@ module galpha
        integer(c_int), value :: max_dim
        integer(c_int), intent(out) :: dim
      end function ga_state_space
+     integer(c_int) function ga_state_space_motion(s, t, q, v, max_dim, dim, n_basis, a) &
+          bind(C, name="ga_state_space_motion")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s, n_basis, a
+       real(c_double), value :: t
+       real(c_double), intent(in) :: q(*), v(*)
+       integer(c_int), value :: max_dim
+       integer(c_int), intent(out) :: dim
+     end function ga_state_space_motion
      integer(c_int) function ga_linearize(s, t, q, lambda, max_dof, dof, n_basis, m_red, &
           c_red, k_red) bind(C, name="ga_linearize")
        import :: c_int, c_ptr, c_double
@@ -779,6 +788,7 @@ module galpha
        ga_linear_solver_name, ga_set_formulation, ga_set_resolution_check, &
        ga_check_derivatives, ga_static_equilibrium, ga_linearize, ga_modes, ga_static_path, &
        ga_modes_damped, ga_modes_near, ga_static_equilibrium_y, ga_state_space, &
+       ga_state_space_motion, &
        ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
        ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
@@ -834,6 +844,9 @@ module galpha
      !> small motions at rest, x = (z, z', y), a(dim, dim), basis(n, dof) (ga_state_space);
      !> without them only dim (call first to size them)
      procedure :: state_space => solver_state_space
+     !> state_space_motion(t, q, v, dim [, basis, a]): the same about a moving state on the
+     !> constraints, x = (z, w) (ga_state_space_motion)
+     procedure :: state_space_motion => solver_state_space_motion
      !> modes(t, q, omega2 [, lambda, shapes]): the size(omega2) lowest undamped modes at an
      !> equilibrium, shapes(n, size(omega2)) with unit modal mass (ga_modes)
      procedure :: modes => solver_modes
@@ -1619,6 +1632,27 @@ contains
     status = ga_state_space(this%handle, t, q, py, plambda, max_dim, d, pbasis, pa)
     dim = int(d)
   end function solver_state_space
+
+  integer(c_int) function solver_state_space_motion(this, t, q, v, dim, basis, a) &
+       result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: t, q(:), v(:)
+    integer, intent(out) :: dim
+    real(c_double), intent(out), optional, target :: basis(:, :), a(:, :)
+    type(c_ptr) :: pbasis, pa
+    integer(c_int) :: d, max_dim
+    pbasis = c_null_ptr
+    pa = c_null_ptr
+    max_dim = huge(max_dim)
+    if (present(basis)) pbasis = c_loc(basis)
+    if (present(a)) then
+       pa = c_loc(a)
+       max_dim = int(size(a, 1), c_int)
+    end if
+    d = 0
+    status = ga_state_space_motion(this%handle, t, q, v, max_dim, d, pbasis, pa)
+    dim = int(d)
+  end function solver_state_space_motion
 
   integer(c_int) function solver_modes(this, t, q, omega2, lambda, shapes) result(status)
     class(galpha_solver), intent(inout) :: this

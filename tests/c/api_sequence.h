@@ -579,7 +579,17 @@ static long long operating_points_phase(model *md, ga_solver *s, int seq)
         ga_status st = GA_OK;
         const char *call = "";
         int writes_q = 0;
-        switch (pick(md, 8)) {
+        switch (pick(md, 9)) {
+        case 8: {
+            double v[VMAX] = {0};
+            int dim = -1;
+            if (ga_get_v(s, v) != GA_OK || pick(md, 4) == 0)
+                v[pick(md, md->nv)] += edge_value(md);
+            call = "ga_state_space_motion";
+            st = ga_state_space_motion(s, t, q, v, pick(md, 2 * md->nv + 3) - 1, &dim,
+                                       pick(md, 2) ? shapes_im : NULL, pick(md, 2) ? shapes : NULL);
+            break;
+        }
         case 6: {
             double y[1] = {pick(md, 2) ? 0.3 : edge_value(md)}, ykeep[1];
             ykeep[0] = y[0];

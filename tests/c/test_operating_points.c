@@ -1127,6 +1127,49 @@ static void test_an_actuated_pendulum_rests_and_its_state_space_is_the_closed_fo
     ga_free(s);
 }
 
+/* About a moving state: the pendulum at angle th0 swinging at th0'. In the chart's
+ * coordinate z = L sin(theta - th0) (the projection on the tangent), with w = z',
+ * z'' = -g cos(D) sin(th0 + D) - sin(D) w^2 / (L cos(D)^2), D = theta - th0, whose derivatives
+ * at z = 0 give A = [0, 1; -(g cos(th0) + w0^2 / L) / L, 0]: the centripetal term w0^2 / L^2
+ * is what the tangent system at rest lacks. At rest in the equilibrium it equals
+ * ga_state_space's A. */
+static void test_a_swinging_pendulum_linearized_along_its_motion(void **state)
+{
+    (void)state;
+    Pendulums p = {1, {1.3, 0}, {0.9, 0}, 0, 0};
+    const double L = p.L[0], th0 = 0.7, rate = 1.9;
+    ga_solver *s = pendulums(&p);
+    const double q[2] = {L * sin(th0), -L * cos(th0)};
+    const double v[2] = {L * rate * cos(th0), L * rate * sin(th0)};
+    double A[4], N[2];
+    int dim = 0;
+    assert_int_equal(ga_state_space_motion(s, 0.0, q, v, 2, &dim, N, A), GA_OK);
+    assert_int_equal(dim, 2);
+    const double w0 = L * rate;
+    const double want = -(g_acc * cos(th0) + w0 * w0 / L) / L;
+    printf("  swinging: dz''/dz %.12g against %.12g, dz''/dw %.3g\n", A[1], want, A[3]);
+    assert_rel(A[1], want, 1e-8);
+    assert_near(A[3], 0.0, 1e-8 * fabs(want));
+    assert_true(A[0] == 0.0 && A[2] == 1.0);
+    assert_near(fabs(N[0]), cos(th0), 1e-14);
+    /* at rest in the equilibrium: the same as the tangent system */
+    const double qr[2] = {0.0, -L}, vr[2] = {0.0, 0.0};
+    double Ar[4], As[4];
+    assert_int_equal(ga_state_space_motion(s, 0.0, qr, vr, 2, &dim, NULL, Ar), GA_OK);
+    assert_int_equal(ga_state_space(s, 0.0, qr, NULL, NULL, 2, &dim, NULL, As), GA_OK);
+    for (int i = 0; i < 4; ++i)
+        assert_near(Ar[i], As[i], 1e-8 * g_acc / L);
+    /* refusals: v off the velocity constraint, q off the constraints, max_dim */
+    const double vbad[2] = {0.1, 0.5}, qbad[2] = {0.0, -1.2};
+    assert_int_equal(ga_state_space_motion(s, 0.0, q, vbad, 2, &dim, NULL, A), GA_ERR_INCONSISTENT);
+    assert_non_null(strstr(ga_last_error(s), "velocity constraint"));
+    assert_int_equal(ga_state_space_motion(s, 0.0, qbad, vr, 2, &dim, NULL, A), GA_ERR_INCONSISTENT);
+    assert_int_equal(ga_state_space_motion(s, 0.0, q, v, 1, &dim, NULL, A), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "dimension 2"));
+    assert_int_equal(ga_state_space_motion(s, 0.0, q, NULL, 2, &dim, NULL, A), GA_ERR_ARG);
+    ga_free(s);
+}
+
 static void test_rotations_and_first_order_states_are_refused_by_name(void **state)
 {
     (void)state;
@@ -1165,6 +1208,7 @@ int main(void)
         cmocka_unit_test(test_no_equilibrium_a_free_motion_and_a_follower_force_are_refused),
         cmocka_unit_test(test_modes_refuse_what_is_no_equilibrium),
         cmocka_unit_test(test_an_actuated_pendulum_rests_and_its_state_space_is_the_closed_form),
+        cmocka_unit_test(test_a_swinging_pendulum_linearized_along_its_motion),
         cmocka_unit_test(test_locked_mechanism),
         cmocka_unit_test(test_arguments_state_and_callbacks),
         cmocka_unit_test(test_a_running_solver_is_left_as_it_was),

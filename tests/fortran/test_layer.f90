@@ -472,6 +472,8 @@ program test_layer
     call expect(abs(ass(1, 2) - 1.0d0) < 1d-14 .and. abs(ass(2, 1) + 9.81d0) < 1d-8 * 9.81d0 &
          .and. abs(ass(1, 1)) < 1d-14 .and. abs(ass(2, 2)) < 1d-12, 'state_space: A')
     call ok(s%static_equilibrium_y(0.0d0, q2, ynone, lam2), 'static_equilibrium_y without states')
+    call ok(s%state_space_motion(0.0d0, q2, [0.0d0, 0.0d0], n, a=ass), 'state_space_motion')
+    call expect(abs(ass(2, 1) + 9.81d0) < 1d-7 * 9.81d0, 'state_space_motion at rest: -g / L')
   end block
   ! the same by shift-invert Lanczos (dense here: no patterns); two modes of one refused
   call ok(s%modes_near(0.0d0, q2, 0.0d0, v2(1:1), lam2), 'modes_near')

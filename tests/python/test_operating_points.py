@@ -236,3 +236,16 @@ def test_first_order_states_at_rest_and_their_state_space():
                                    np.sort_complex(np.linalg.eigvals(B)), rtol=1e-8)
         with pytest.raises(ValueError, match="first-order states"):
             s.state_space(eq.q)
+
+
+def test_state_space_along_a_motion_at_rest_equals_the_tangent_system(solver):
+    """ga_state_space_motion at v = 0 in the equilibrium is ga_state_space's A (the same
+    chart coordinates N); off the velocity constraint it raises."""
+    eq = solver.static_equilibrium([0.2, -0.7, -0.3, -2.0])
+    moving = solver.state_space_motion(eq.q, np.zeros(4))
+    rest = solver.state_space(eq.q, lam=eq.lam)
+    assert moving.A.shape == (4, 4)
+    np.testing.assert_allclose(moving.N, rest.N, atol=1e-14)
+    np.testing.assert_allclose(moving.A, rest.A, atol=1e-7 * np.abs(rest.A).max())
+    with pytest.raises(galpha.InconsistentError, match="velocity constraint"):
+        solver.state_space_motion(eq.q, [0.0, 1.0, 0.0, 0.0])

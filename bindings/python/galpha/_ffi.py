@@ -215,6 +215,8 @@ _SIGNATURES = {
     "ga_static_equilibrium_y": (_I, [_S, _D, c_double_p, c_double_p, c_double_p, _D, _I]),
     "ga_state_space": (_I, [_S, _D, c_double_p, c_double_p, c_double_p, _I, _P(_I), c_double_p,
                             c_double_p]),
+    "ga_state_space_motion": (_I, [_S, _D, c_double_p, c_double_p, _I, _P(_I), c_double_p,
+                                   c_double_p]),
     "ga_modes_near": (_I, [_S, _D, c_double_p, c_double_p, _D, _I, c_double_p, c_double_p]),
     "ga_modes_damped": (_I, [_S, _D, c_double_p, c_double_p, _I, c_double_p, c_double_p,
                              c_double_p, c_double_p]),

@@ -1232,6 +1232,26 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
+    def state_space_motion(self, q, v, t=0.0):
+        """The first-order form x' = A x of the small motions about a moving state (t, q, v)
+        on the constraints, x = (z, w) in the chart q + N z of the constraint manifold
+        (ga_state_space_motion): a StateSpace(N, A), with the centripetal and Coriolis
+        terms."""
+        q, _ = self._rest_arrays(q, None)
+        v, _ = self._rest_arrays(v, None)
+        dim = ctypes.c_int()
+        N = np.zeros(self.n * self.n)
+        A = np.zeros(max(4 * self.n * self.n, 1))
+        self._check(_ffi.ga_state_space_motion(self._handle(), float(t), self._dp(q),
+                                               self._dp(v), 2 * self.n, ctypes.byref(dim),
+                                               self._dp(N), self._dp(A)))
+        d = dim.value
+        dof = d // 2
+        return StateSpace(N[:self.n * dof].reshape((self.n, dof), order="F").copy(),
+                          A[:d * d].reshape((d, d), order="F").copy())
+
+    @_serialized
+    @_runs_callbacks
     def linearize(self, q, lam=None, t=0.0):
         """The small motions about (q, lam) at rest in minimal coordinates q = q0 + N z
         (ga_linearize): a Linearization(N, M, C, K) with N (n x dof) orthonormal, Phi_q N = 0,
