@@ -1171,7 +1171,8 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value);
  *  From the callbacks of the dynamics (M, f, Phi, Phi_q and, where given, K_t and C_t; central
  *  differences otherwise), at rest: v = 0, qdd = 0. Dense, but for ga_modes_near and the
  *  static solve of a model on the sparse path; on coordinates in R^n, and with first-order
- *  states only in ga_static_equilibrium_y and ga_state_space (GA_ERR_STATE otherwise). Callable before or after ga_init:
+ *  states only in ga_static_equilibrium_y, ga_state_space and ga_state_space_motion
+ *  (GA_ERR_STATE otherwise). Callable before or after ga_init:
  *  the solver's state and set-up are not touched, the evaluations are counted.
  *  docs/algorithms.md sec. 17. */
 /**@{*/
@@ -1236,23 +1237,25 @@ GA_API ga_status ga_state_space(ga_solver *s, double t, const double *q, const d
                                 const double *lambda, int max_dim, int *dim, double *N,
                                 double *A);
 
-/** The first-order form of the small motions about a moving state (t, q, v) on the
+/** The first-order form of the small motions about a moving state (t, q, v, y) on the
  *  constraints -- any point of a run --: in the chart q(z) = q + N z + R h(z) of the
  *  constraint manifold at q (N as in ga_linearize, R an orthonormal basis of Phi_q's rows'
  *  span, h keeping Phi = 0) with velocities N w + R k (k keeping Phi_q v + Phi_t = 0), the
- *  state x = (z, w) obeys x' = (w, N^T qdd) with qdd the consistent acceleration, and
- *  A = [0, I; d(N^T qdd)/dz, d(N^T qdd)/dw] at (0, N^T v) by central differences of qdd
- *  (steps 6.06e-6 max(1, |q|_inf) and max(1, |v|_inf)): with the centripetal and Coriolis
- *  terms, which ga_state_space's tangent system at rest lacks; at v = 0 about an equilibrium
- *  the two agree. *dim = 2 dof; N (n x dof) and A (dim x dim, column-major; each may be NULL)
- *  written only if *dim <= max_dim. On R^n without first-order states. Errors: GA_ERR_ARG
- *  (NULL q, v or dim, a value not finite, *dim > max_dim), GA_ERR_INCONSISTENT (q off the
+ *  state x = (z, w, y) obeys x' = (w, N^T qdd, g) with qdd the consistent acceleration and g
+ *  the first-order states' rate, and A = dx'/dx at (0, N^T v, y) by central differences
+ *  (steps 6.06e-6 max(1, |q|_inf), max(1, |v|_inf), max(1, |y_j|)): with the centripetal
+ *  and Coriolis terms, which ga_state_space's tangent system at rest lacks; at v = 0 about an
+ *  equilibrium the two agree. *dim = 2 dof + r; N (n x dof) and A (dim x dim, column-major;
+ *  each may be NULL) written only if *dim <= max_dim. y (length r) may be NULL when r = 0. On
+ *  R^n. Errors: GA_ERR_ARG (NULL q, v or dim, NULL y with r > 0, a value not finite,
+ *  *dim > max_dim), GA_ERR_INCONSISTENT (q off the
  *  constraints by more than 1e-8 max(1, |q|_inf), or v off the velocity constraint by more
  *  than 1e-8 max(1, |v|_inf)), GA_ERR_SINGULAR ([M, Phi_q^T; Phi_q, 0] singular near q),
  *  GA_ERR_NEWTON (the chart's projection did not converge), GA_ERR_STATE as
  *  ga_static_equilibrium, callback errors. */
 GA_API ga_status ga_state_space_motion(ga_solver *s, double t, const double *q, const double *v,
-                                       int max_dim, int *dim, double *N, double *A);
+                                       const double *y, int max_dim, int *dim, double *N,
+                                       double *A);
 
 /** The `count` lowest undamped vibration modes at an equilibrium (q, lambda):
  *  (N^T K_t N) z = omega^2 (N^T M N) z. omega2 (length count) ascending; a negative value is an

@@ -1443,19 +1443,21 @@ GA_API ga_status ga_state_space(ga_solver *s, double t, const double *q, const d
 }
 
 GA_API ga_status ga_state_space_motion(ga_solver *s, double t, const double *q, const double *v,
-                                       int max_dim, int *dim, double *N, double *A)
+                                       const double *y, int max_dim, int *dim, double *N,
+                                       double *A)
 {
     return guarded(s, [&](ga::Solver &c) {
-        if (auto st = operating_point_refusal(c, "ga_state_space_motion", t))
+        if (auto st = operating_point_refusal(c, "ga_state_space_motion", t, true))
             return st;
-        if (!q || !v || !dim)
-            return c.diag.fail(GA_ERR_ARG, "ga_state_space_motion: q, v or dim is NULL");
+        if (!q || !v || !dim || (!y && c.kernel().r() > 0))
+            return c.diag.fail(GA_ERR_ARG, "ga_state_space_motion: q, v, y or dim is NULL");
         ga::StateSpace ss;
-        if (auto st = ga::motion_state_space(c.kernel(), t, q, v, ss))
+        if (auto st = ga::motion_state_space(c.kernel(), t, q, v, y, ss))
             return st;
         if (ss.dim > max_dim)
             return c.diag.fail(GA_ERR_ARG, "ga_state_space_motion: dimension %d (%d degrees of "
-                               "freedom), max_dim = %d", ss.dim, ss.dof, max_dim);
+                               "freedom, %d first-order states), max_dim = %d", ss.dim, ss.dof,
+                               c.kernel().r(), max_dim);
         *dim = ss.dim;
         if (N)
             Eigen::Map<ga::Mat>(N, ss.N.rows(), ss.N.cols()) = ss.N;

@@ -163,14 +163,18 @@ private:
 }  // namespace
 
 ga_status motion_state_space(Stepper &kernel, double t, const double *q_in, const double *v_in,
-                             StateSpace &out)
+                             const double *y_in, StateSpace &out)
 {
     const char *name = "ga_state_space_motion";
     Diagnostics &diag = kernel.diag;
-    const int n = kernel.nv(), m = kernel.m();
+    const int n = kernel.nv(), m = kernel.m(), nr = kernel.r();
     const Vec q0 = Eigen::Map<const Vec>(q_in, n), v0 = Eigen::Map<const Vec>(v_in, n);
-    if (!all_finite(q0) || !all_finite(v0))
-        return diag.fail(GA_ERR_ARG, "%s: q or v is not finite", name);
+    Vec y = nr > 0 ? Vec(Eigen::Map<const Vec>(y_in, nr)) : Vec(0);
+    if (!all_finite(q0) || !all_finite(v0) || !all_finite(y))
+        return diag.fail(GA_ERR_ARG, "%s: q, v or y is not finite", name);
+    // the force sees y (first-order states, docs/algorithms.md sec. 11)
+    const Restore<const Vec *> keep(kernel.model.y_now);
+    kernel.model.y_now = &y;
     Chart chart(kernel, t);
     Mat J;
     Vec phi, pt;
@@ -200,32 +204,41 @@ ga_status motion_state_space(Stepper &kernel, double t, const double *q_in, cons
     const int d = static_cast<int>(chart.N.cols());
     const Vec w0 = chart.N.transpose() * v0;
     out.dof = d;
-    out.dim = 2 * d;
-    out.A.setZero(2 * d, 2 * d);
-    out.A.topRightCorner(d, d).setIdentity();
-    // central differences of N^T qdd in z_j and w_j (steps as for K_t and C_t)
-    Vec q, v, ap, am, z = Vec::Zero(d), w = w0;
-    const auto column = [&](bool of_z, int j, double e) -> ga_status {
-        Vec &x = of_z ? z : w;
+    out.dim = 2 * d + nr;
+    out.A.setZero(out.dim, out.dim);
+    out.A.block(0, d, d, d).setIdentity();
+    // central differences of (N^T qdd, g) in z_j, w_j and y_j (steps as for K_t and C_t)
+    enum Kind { Z, W, Y };
+    Vec q, v, ap, am, gp(nr), gm(nr), z = Vec::Zero(d), w = w0;
+    const auto column = [&](Kind kind, int j, double e) -> ga_status {
+        Vec &x = kind == Z ? z : kind == W ? w : y;
         const double x0 = x[j];
         for (int side = 0; side < 2; ++side) {
             x[j] = x0 + (side == 0 ? e : -e);
             ga_status st = chart.point(q0, z, w, q, v);
             if (!st)
                 st = chart.acceleration(q, v, side == 0 ? ap : am);
+            if (!st && nr > 0)
+                st = kernel.model.rate(t, q, v, y, side == 0 ? gp : gm);
             if (st) {
                 x[j] = x0;
                 return st;
             }
         }
         x[j] = x0;
-        out.A.block(d, of_z ? j : d + j, d, 1) = chart.N.transpose() * (ap - am) / (2.0 * e);
+        const int col = kind == Z ? j : kind == W ? d + j : 2 * d + j;
+        out.A.block(d, col, d, 1) = chart.N.transpose() * (ap - am) / (2.0 * e);
+        if (nr > 0)
+            out.A.block(2 * d, col, nr, 1) = (gp - gm) / (2.0 * e);
         return GA_OK;
     };
     for (int j = 0; j < d; ++j)
-        for (const bool of_z : {true, false})
-            if (auto st = column(of_z, j, rest::step_for(of_z ? qs : vs)))
+        for (const Kind kind : {Z, W})
+            if (auto st = column(kind, j, rest::step_for(kind == Z ? qs : vs)))
                 return st;
+    for (int j = 0; j < nr; ++j)
+        if (auto st = column(Y, j, rest::step_for(y[j])))
+            return st;
     out.N = chart.N;
     return GA_OK;
 }

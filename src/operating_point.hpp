@@ -43,10 +43,11 @@ struct StateSpace {
 ga_status state_space(Stepper &kernel, double t, const double *q, const double *y,
                       const double *lambda, StateSpace &out);
 
-// The same about a moving state (t, q, v) on the constraints, from the consistent
-// acceleration in a chart of the constraint manifold (motion_state_space.cpp): dim = 2 dof.
+// The same about a moving state (t, q, v, y) on the constraints, from the consistent
+// acceleration (and the rates) in a chart of the constraint manifold (motion_state_space.cpp):
+// dim = 2 dof + r; y may be null without first-order states.
 ga_status motion_state_space(Stepper &kernel, double t, const double *q, const double *v,
-                             StateSpace &out);
+                             const double *y, StateSpace &out);
 
 // The `count` lowest undamped modes at an equilibrium (q, lambda): K z = omega^2 M z,
 // omega^2 ascending (negative: unstable there), shapes N z in q with unit modal mass.

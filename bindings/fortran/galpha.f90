@@ -437,10 +437,10 @@ module galpha
        integer(c_int), value :: max_dim
        integer(c_int), intent(out) :: dim
      end function ga_state_space
-     integer(c_int) function ga_state_space_motion(s, t, q, v, max_dim, dim, n_basis, a) &
+     integer(c_int) function ga_state_space_motion(s, t, q, v, y, max_dim, dim, n_basis, a) &
           bind(C, name="ga_state_space_motion")
        import :: c_int, c_ptr, c_double
-       type(c_ptr), value :: s, n_basis, a
+       type(c_ptr), value :: s, y, n_basis, a
        real(c_double), value :: t
        real(c_double), intent(in) :: q(*), v(*)
        integer(c_int), value :: max_dim
@@ -844,8 +844,8 @@ module galpha
      !> small motions at rest, x = (z, z', y), a(dim, dim), basis(n, dof) (ga_state_space);
      !> without them only dim (call first to size them)
      procedure :: state_space => solver_state_space
-     !> state_space_motion(t, q, v, dim [, basis, a]): the same about a moving state on the
-     !> constraints, x = (z, w) (ga_state_space_motion)
+     !> state_space_motion(t, q, v, dim [, y, basis, a]): the same about a moving state on
+     !> the constraints, x = (z, w, y) (ga_state_space_motion)
      procedure :: state_space_motion => solver_state_space_motion
      !> modes(t, q, omega2 [, lambda, shapes]): the size(omega2) lowest undamped modes at an
      !> equilibrium, shapes(n, size(omega2)) with unit modal mass (ga_modes)
@@ -1633,24 +1633,29 @@ contains
     dim = int(d)
   end function solver_state_space
 
-  integer(c_int) function solver_state_space_motion(this, t, q, v, dim, basis, a) &
+  integer(c_int) function solver_state_space_motion(this, t, q, v, dim, y, basis, a) &
        result(status)
     class(galpha_solver), intent(inout) :: this
     real(c_double), intent(in) :: t, q(:), v(:)
     integer, intent(out) :: dim
+    real(c_double), intent(in), optional, target :: y(:)
     real(c_double), intent(out), optional, target :: basis(:, :), a(:, :)
-    type(c_ptr) :: pbasis, pa
+    type(c_ptr) :: py, pbasis, pa
     integer(c_int) :: d, max_dim
+    py = c_null_ptr
     pbasis = c_null_ptr
     pa = c_null_ptr
     max_dim = huge(max_dim)
+    if (present(y)) then
+       if (size(y) > 0) py = c_loc(y)
+    end if
     if (present(basis)) pbasis = c_loc(basis)
     if (present(a)) then
        pa = c_loc(a)
        max_dim = int(size(a, 1), c_int)
     end if
     d = 0
-    status = ga_state_space_motion(this%handle, t, q, v, max_dim, d, pbasis, pa)
+    status = ga_state_space_motion(this%handle, t, q, v, py, max_dim, d, pbasis, pa)
     dim = int(d)
   end function solver_state_space_motion
 

@@ -586,7 +586,8 @@ static long long operating_points_phase(model *md, ga_solver *s, int seq)
             if (ga_get_v(s, v) != GA_OK || pick(md, 4) == 0)
                 v[pick(md, md->nv)] += edge_value(md);
             call = "ga_state_space_motion";
-            st = ga_state_space_motion(s, t, q, v, pick(md, 2 * md->nv + 3) - 1, &dim,
+            const double y[1] = {0.3};
+            st = ga_state_space_motion(s, t, q, v, y, pick(md, 2 * md->nv + 3) - 1, &dim,
                                        pick(md, 2) ? shapes_im : NULL, pick(md, 2) ? shapes : NULL);
             break;
         }

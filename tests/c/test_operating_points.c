@@ -1113,6 +1113,13 @@ static void test_an_actuated_pendulum_rests_and_its_state_space_is_the_closed_fo
         }
     }
     assert_near(fabs(N[0]), 1.0 * fabs(c), 1e-13); /* N spans the tangent (cos, sin) */
+    /* along a motion at v = 0 in this rest: the same A (x = (z, w, y)), by differences */
+    double Am[9];
+    const double v0[2] = {0.0, 0.0};
+    assert_int_equal(ga_state_space_motion(s, 0.0, q, v0, y, 3, &dim, NULL, Am), GA_OK);
+    for (int i = 0; i < 9; ++i)
+        assert_near(Am[i], A[i], 1e-7 * (1.0 + fabs(A[i])));
+    assert_int_equal(ga_state_space_motion(s, 0.0, q, v0, NULL, 3, &dim, NULL, Am), GA_ERR_ARG);
     /* refusals: y missing, the dimension too large for max_dim, no root of the rate */
     assert_int_equal(ga_state_space(s, 0.0, q, NULL, NULL, 3, &dim, NULL, NULL), GA_ERR_ARG);
     assert_int_equal(ga_state_space(s, 0.0, q, y, NULL, 2, &dim, N, A), GA_ERR_ARG);
@@ -1143,7 +1150,7 @@ static void test_a_swinging_pendulum_linearized_along_its_motion(void **state)
     const double v[2] = {L * rate * cos(th0), L * rate * sin(th0)};
     double A[4], N[2];
     int dim = 0;
-    assert_int_equal(ga_state_space_motion(s, 0.0, q, v, 2, &dim, N, A), GA_OK);
+    assert_int_equal(ga_state_space_motion(s, 0.0, q, v, NULL, 2, &dim, N, A), GA_OK);
     assert_int_equal(dim, 2);
     const double w0 = L * rate;
     const double want = -(g_acc * cos(th0) + w0 * w0 / L) / L;
@@ -1155,18 +1162,18 @@ static void test_a_swinging_pendulum_linearized_along_its_motion(void **state)
     /* at rest in the equilibrium: the same as the tangent system */
     const double qr[2] = {0.0, -L}, vr[2] = {0.0, 0.0};
     double Ar[4], As[4];
-    assert_int_equal(ga_state_space_motion(s, 0.0, qr, vr, 2, &dim, NULL, Ar), GA_OK);
+    assert_int_equal(ga_state_space_motion(s, 0.0, qr, vr, NULL, 2, &dim, NULL, Ar), GA_OK);
     assert_int_equal(ga_state_space(s, 0.0, qr, NULL, NULL, 2, &dim, NULL, As), GA_OK);
     for (int i = 0; i < 4; ++i)
         assert_near(Ar[i], As[i], 1e-8 * g_acc / L);
     /* refusals: v off the velocity constraint, q off the constraints, max_dim */
     const double vbad[2] = {0.1, 0.5}, qbad[2] = {0.0, -1.2};
-    assert_int_equal(ga_state_space_motion(s, 0.0, q, vbad, 2, &dim, NULL, A), GA_ERR_INCONSISTENT);
+    assert_int_equal(ga_state_space_motion(s, 0.0, q, vbad, NULL, 2, &dim, NULL, A), GA_ERR_INCONSISTENT);
     assert_non_null(strstr(ga_last_error(s), "velocity constraint"));
-    assert_int_equal(ga_state_space_motion(s, 0.0, qbad, vr, 2, &dim, NULL, A), GA_ERR_INCONSISTENT);
-    assert_int_equal(ga_state_space_motion(s, 0.0, q, v, 1, &dim, NULL, A), GA_ERR_ARG);
+    assert_int_equal(ga_state_space_motion(s, 0.0, qbad, vr, NULL, 2, &dim, NULL, A), GA_ERR_INCONSISTENT);
+    assert_int_equal(ga_state_space_motion(s, 0.0, q, v, NULL, 1, &dim, NULL, A), GA_ERR_ARG);
     assert_non_null(strstr(ga_last_error(s), "dimension 2"));
-    assert_int_equal(ga_state_space_motion(s, 0.0, q, NULL, 2, &dim, NULL, A), GA_ERR_ARG);
+    assert_int_equal(ga_state_space_motion(s, 0.0, q, NULL, NULL, 2, &dim, NULL, A), GA_ERR_ARG);
     ga_free(s);
 }
 

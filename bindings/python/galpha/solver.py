@@ -1232,21 +1232,28 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def state_space_motion(self, q, v, t=0.0):
-        """The first-order form x' = A x of the small motions about a moving state (t, q, v)
-        on the constraints, x = (z, w) in the chart q + N z of the constraint manifold
-        (ga_state_space_motion): a StateSpace(N, A), with the centripetal and Coriolis
-        terms."""
+    def state_space_motion(self, q, v, y=None, t=0.0):
+        """The first-order form x' = A x of the small motions about a moving state
+        (t, q, v, y) on the constraints, x = (z, w, y) in the chart q + N z of the constraint
+        manifold (ga_state_space_motion): a StateSpace(N, A), with the centripetal and
+        Coriolis terms. y: the first-order states (None without them)."""
         q, _ = self._rest_arrays(q, None)
         v, _ = self._rest_arrays(v, None)
+        r = self.r
+        ybuf = np.zeros(max(r, 1))
+        if r:
+            if y is None:
+                raise ValueError(f"the model has {r} first-order states: y is needed")
+            ybuf[:r] = np.array(y, dtype=float).ravel()
         dim = ctypes.c_int()
+        max_dim = 2 * self.n + r
         N = np.zeros(self.n * self.n)
-        A = np.zeros(max(4 * self.n * self.n, 1))
+        A = np.zeros(max(max_dim * max_dim, 1))
         self._check(_ffi.ga_state_space_motion(self._handle(), float(t), self._dp(q),
-                                               self._dp(v), 2 * self.n, ctypes.byref(dim),
-                                               self._dp(N), self._dp(A)))
+                                               self._dp(v), self._dp(ybuf), max_dim,
+                                               ctypes.byref(dim), self._dp(N), self._dp(A)))
         d = dim.value
-        dof = d // 2
+        dof = (d - r) // 2
         return StateSpace(N[:self.n * dof].reshape((self.n, dof), order="F").copy(),
                           A[:d * d].reshape((d, d), order="F").copy())
 
