@@ -77,7 +77,7 @@ public:
         Mat J;
         for (int side = 0; side < 2; ++side) {
             const double sig = side == 0 ? s : -s;
-            qs = q + sig * v;
+            model_.space.shifted(q, sig, v, qs);
             if (auto st = jacobian(qs, J))
                 return st;
             if (auto st = phi_t(t_ + sig, qs, pt))
@@ -122,7 +122,8 @@ public:
     // (q, v) at chart point (z, w): Newton on Phi(q0 + N z + R h) = 0 in h, then k
     ga_status point(const Vec &q0, const Vec &z, const Vec &w, Vec &q, Vec &v)
     {
-        q = q0 + N * z;
+        const Vec dz = N * z;
+        model_.space.shifted(q0, 1.0, dz, q);
         Mat J;
         Vec phi, pt;
         const double scale = std::max(1.0, rest::max_abs(q0));
@@ -134,7 +135,8 @@ public:
             if (auto st = jacobian(q, J))
                 return st;
             const Mat JR = J * R;
-            q.noalias() += R * JR.completeOrthogonalDecomposition().solve(-phi);
+            const Vec dh = R * JR.completeOrthogonalDecomposition().solve(-phi), qk = q;
+            model_.space.shifted(qk, 1.0, dh, q);
             if (it == 29)
                 return diag_.fail(GA_ERR_NEWTON, "ga_state_space_motion: the chart's projection "
                                                  "onto the constraints did not converge near q");
