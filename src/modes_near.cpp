@@ -137,10 +137,6 @@ ga_status modes_near(Stepper &kernel, double t, const double *q0, const double *
                               name);
     if (auto st = at.stiffness(q, lambda))
         return st;
-    if (auto st = at.force(q))  // (differences leave f and Phi_q of shifted points)
-        return st;
-    if (auto st = at.jacobian(q))
-        return st;
     Vec r;
     at.residual(lambda, r);
     const double fscale =

@@ -31,7 +31,8 @@ public:
     // r = -f + Phi_q^T lambda from the f and Phi_q evaluated last (eq. 1 at rest)
     void residual(const Vec &lambda, Vec &r) const;
     // K_t at (q, lambda): the callback, or central differences of r grouped by K_t's pattern
-    // (every column alone when it has none). Leaves f and Phi_q evaluated at q.
+    // (every column alone when it has none), on scratch of its own: f and Phi_q stay as they
+    // were evaluated.
     ga_status stiffness(const Vec &q, const Vec &lambda);
 
     // S from the matrices as evaluated; false if it is singular.

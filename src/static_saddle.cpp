@@ -66,8 +66,6 @@ ga_status static_equilibrium_saddle(Stepper &kernel, double t, double *q_io, dou
     for (int it = 1; it <= max_iter; ++it) {
         if (auto st = at.stiffness(q, lambda))
             return st;
-        if (auto st = evaluate(q))  // (the differences left f, Phi_q of shifted points)
-            return st;
         if (at_roundoff())
             return accept();
         if (!at.factorize(0.0, 1.0))
@@ -126,8 +124,6 @@ ga_status static_equilibrium_saddle(Stepper &kernel, double t, double *q_io, dou
         return st;
     at.residual(lambda, r);
     if (auto st = at.stiffness(q, lambda))
-        return st;
-    if (auto st = evaluate(q))
         return st;
     if (at_roundoff())
         return accept();
