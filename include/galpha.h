@@ -580,6 +580,17 @@ GA_API ga_status ga_set_corrected_start(ga_solver *s, int on);
  *  Errors: GA_ERR_ARG (rtol or atol not positive and finite), GA_ERR_STATE. */
 GA_API ga_status ga_set_tolerances(ga_solver *s, double rtol, double atol);
 
+/** As ga_set_tolerances with an absolute tolerance for each coordinate (as SUNDIALS'
+ *  IDASVtolerances, SciPy's vector atol): atol holds 2 n + r numbers, the n positions (on a
+ *  space with rotations, the n coordinates of the tangent increments), the n velocities, then
+ *  the r first-order states. A coordinate whose scale differs from the others' by orders of
+ *  magnitude is then held to its own (tests/c/test_tolerance_vector.c). ga_set_tolerances
+ *  goes back to one atol. The states are those declared when it is called: ga_set_first_order
+ *  with another r afterwards is refused (GA_ERR_STATE).
+ *  Errors: GA_ERR_ARG (rtol or an atol entry not positive and finite, atol NULL; the message
+ *  names the entry), GA_ERR_STATE. */
+GA_API ga_status ga_set_tolerances_vector(ga_solver *s, double rtol, const double *atol);
+
 /** Bounds of adaptive step sizes: h_min (0: 16 eps max(|t|, 1)) and h_max (0: none).
  *  Errors: GA_ERR_ARG, GA_ERR_STATE. */
 GA_API ga_status ga_set_step_limits(ga_solver *s, double h_min, double h_max);

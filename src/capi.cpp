@@ -4,6 +4,7 @@
 #include <cfenv>
 #include <climits>
 #include <cmath>
+#include <cstddef>
 #include <exception>
 #include <new>
 #include <stdexcept>
@@ -672,6 +673,37 @@ GA_API ga_status ga_set_tolerances(ga_solver *s, double rtol, double atol)
                                "and finite", rtol, atol);
         c.control.rtol = rtol;
         c.control.atol = atol;
+        c.control.atol_q_each.clear();
+        c.control.atol_v_each.clear();
+        c.control.atol_y_each.clear();
+        return GA_OK;
+    });
+}
+
+GA_API ga_status ga_set_tolerances_vector(ga_solver *s, double rtol, const double *atol)
+{
+    return guarded(s, [&](ga::Solver &c) {
+        // 2 n + r may pass INT_MAX (n itself may be up to INT_MAX - m)
+        const std::ptrdiff_t nv = c.kernel().nv(), r = c.kernel().r(), count = 2 * nv + r;
+        if (!(rtol > 0.0 && std::isfinite(rtol)))
+            return c.diag.fail(GA_ERR_ARG, "tolerance rtol = %g must be positive and finite",
+                               rtol);
+        if (!atol)
+            return c.diag.fail(GA_ERR_ARG, "atol is NULL: 2 n + r = %td absolute tolerances "
+                               "expected", count);
+        for (std::ptrdiff_t i = 0; i < count; ++i)
+            if (!(atol[i] > 0.0 && std::isfinite(atol[i])))
+                return c.diag.fail(GA_ERR_ARG, "atol[%td] = %g (%s %td) must be positive and "
+                                   "finite", i, atol[i],
+                                   i < nv ? "position" : i < 2 * nv ? "velocity" : "state",
+                                   i < nv ? i : i < 2 * nv ? i - nv : i - 2 * nv);
+        // built aside first: a failed allocation leaves the tolerances as they were
+        std::vector<double> q(atol, atol + nv), v(atol + nv, atol + 2 * nv),
+            y(atol + 2 * nv, atol + count);
+        c.control.rtol = rtol;
+        c.control.atol_q_each.swap(q);
+        c.control.atol_v_each.swap(v);
+        c.control.atol_y_each.swap(y);
         return GA_OK;
     });
 }
@@ -843,6 +875,10 @@ GA_API ga_status ga_set_first_order(ga_solver *s, int r, ga_force_y_fn force, ga
         if (c.events().fn_y())
             return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after ga_set_events_y: the "
                                "event functions take the states declared before them");
+        if (!c.control.atol_q_each.empty() && r != c.kernel().r())
+            return c.diag.fail(GA_ERR_STATE, "ga_set_first_order(r = %d) after "
+                               "ga_set_tolerances_vector for r = %d states: declare the states "
+                               "first (the absolute tolerances cover them)", r, c.kernel().r());
         if (r > 0 && c.sens().active())
             return c.diag.fail(GA_ERR_STATE, "ga_set_first_order after ga_set_sensitivity: "
                                "declare the states first (the sensitivities include theirs)");

@@ -207,16 +207,17 @@ double Stepper::weighted_error_norm(const State &s, const State &x, const Vec &e
                                     const Vec &ev, double h, const StepController &control,
                                     double noise_q, double noise_v)
 {
-    const double rtol = control.rtol, atol = control.atol;
+    const double rtol = control.rtol;
     const double scale = control.calibration();
     double sum = 0.0;
     for (int i = 0; i < nv_; ++i) {
         const double wq =
-            scale * (atol + rtol * std::max(model.space.magnitude(s.q, i),
+            scale * (control.atol_q(i) + rtol * std::max(model.space.magnitude(s.q, i),
                                             model.space.magnitude(x.q, i))) +
             noise_q;
         const double wv =
-            scale * (atol + rtol * std::max(std::fabs(s.v[i]), std::fabs(x.v[i]))) + noise_v;
+            scale * (control.atol_v(i) + rtol * std::max(std::fabs(s.v[i]), std::fabs(x.v[i]))) +
+            noise_v;
         sum += (eq[i] / wq) * (eq[i] / wq) + (ev[i] / wv) * (ev[i] / wv);
     }
     if (r() > 0)

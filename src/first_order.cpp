@@ -257,8 +257,8 @@ double Stepper::first_order_error_sum(double h, double scale, const StepControll
     double sum = 0.0;
     for (int k = 0; k < r(); ++k) {
         const double e = c * ((x.w[k] - w_n[k]) / h - (s.w[k] - s.w_prev[k]) / s.h_last);
-        const double wk = scale * (control.atol + control.rtol * std::max(std::fabs(s.y[k]),
-                                                                         std::fabs(x.y[k])));
+        const double wk = scale * (control.atol_y(k) + control.rtol * std::max(std::fabs(s.y[k]),
+                                                                              std::fabs(x.y[k])));
         sum += (e / wk) * (e / wk);
     }
     return sum;

@@ -4,11 +4,18 @@
 // Its options and state are part of the solver's checkpoint (h_next, err_prev, grew).
 #pragma once
 
+#include <vector>
+
 namespace ga {
 
 class StepController {
 public:
     double rtol = 1e-6, atol = 1e-6;
+    // Per-coordinate absolute tolerances (ga_set_tolerances_vector), or empty: atol for all.
+    std::vector<double> atol_q_each, atol_v_each, atol_y_each;
+    double atol_q(int i) const { return atol_q_each.empty() ? atol : atol_q_each[i]; }
+    double atol_v(int i) const { return atol_v_each.empty() ? atol : atol_v_each[i]; }
+    double atol_y(int k) const { return atol_y_each.empty() ? atol : atol_y_each[k]; }
     double h_min = 0.0, h_max = 0.0, h_init = 0.0;  // 0: automatic / unlimited
     // controller state (part of the checkpoint)
     double h_next = 0.0, err_prev = 0.0;  // err_prev 0: none (step_controller.cpp)

@@ -168,7 +168,7 @@ ga_status Solver::adaptive_step(double t_stop)
         const int nv = k_.nv();
         for (int i = 0; i < nv; ++i) {
             const double w =
-                scale * (control.atol + control.rtol * k_.model.space.magnitude(accepted.q, i));
+                scale * (control.atol_q(i) + control.rtol * k_.model.space.magnitude(accepted.q, i));
             acc += (accepted.qdd[i] / w) * (accepted.qdd[i] / w);
             vel += (accepted.v[i] / w) * (accepted.v[i] / w);
         }

@@ -518,6 +518,13 @@ module galpha
        type(c_ptr), value :: s
        real(c_double), value :: rtol, atol
      end function ga_set_tolerances
+     integer(c_int) function ga_set_tolerances_vector(s, rtol, atol) &
+          bind(C, name="ga_set_tolerances_vector")
+       import :: c_int, c_ptr, c_double
+       type(c_ptr), value :: s
+       real(c_double), value :: rtol
+       real(c_double), intent(in) :: atol(*)
+     end function ga_set_tolerances_vector
      integer(c_int) function ga_set_step_limits(s, h_min, h_max) &
           bind(C, name="ga_set_step_limits")
        import :: c_int, c_ptr, c_double
@@ -791,7 +798,7 @@ module galpha
        ga_state_space_motion, &
        ga_set_redundant_constraints, &
        ga_get_active_constraints, ga_set_rescale, ga_set_corrected_start, &
-       ga_set_tolerances, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
+       ga_set_tolerances, ga_set_tolerances_vector, ga_set_step_limits, ga_set_initial_step, ga_step_adaptive, ga_advance, &
        ga_interpolate, ga_interpolate_qdd, ga_set_output, ga_set_events, ga_get_event_count, &
        ga_get_event, ga_set_first_order, ga_set_coupling, ga_set_coupling_exact, ga_init_y, &
        ga_get_y, ga_interpolate_y, ga_set_events_y, ga_set_coupling_pattern, &
@@ -827,6 +834,7 @@ module galpha
      procedure :: init => solver_init
      procedure :: step => solver_step
      procedure :: set_tolerances => solver_set_tolerances
+     procedure :: set_tolerances_vector => solver_set_tolerances_vector
      procedure :: set_formulation => solver_set_formulation
      !> set_resolution_check(limit): index 3's velocity-constraint limit (ga_set_resolution_check)
      procedure :: set_resolution_check => solver_set_resolution_check
@@ -1535,6 +1543,17 @@ contains
     real(c_double), intent(in) :: rtol, atol
     status = ga_set_tolerances(this%handle, rtol, atol)
   end function solver_set_tolerances
+
+  ! atol: 2 n + r entries (positions, velocities, first-order states)
+  integer(c_int) function solver_set_tolerances_vector(this, rtol, atol) result(status)
+    class(galpha_solver), intent(inout) :: this
+    real(c_double), intent(in) :: rtol, atol(:)
+    if (size(atol) /= 2 * this%n + this%r) then
+       status = GA_ERR_ARG
+       return
+    end if
+    status = ga_set_tolerances_vector(this%handle, rtol, atol)
+  end function solver_set_tolerances_vector
 
   integer(c_int) function solver_set_formulation(this, formulation) result(status)
     class(galpha_solver), intent(inout) :: this

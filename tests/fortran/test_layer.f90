@@ -232,6 +232,11 @@ program test_layer
   call ok(s%set_corrected_start(.true.), 'set_corrected_start')
   call ok(s%set_init_mode(GA_INIT_PROJECT, 1d-10), 'set_init_mode')
   call expect(s%set_init_mode(GA_INIT_PROJECT, -1d0) == GA_ERR_ARG, 'set_init_mode refuses')
+  call ok(s%set_tolerances_vector(1d-6, [1d-6, 1d-6, 1d-6, 1d-6]), 'set_tolerances_vector')
+  call expect(s%set_tolerances_vector(1d-6, [1d-6, 1d-6, 1d-6]) == GA_ERR_ARG, &
+              'set_tolerances_vector checks the length')
+  call expect(s%set_tolerances_vector(1d-6, [1d-6, 0d0, 1d-6, 1d-6]) == GA_ERR_ARG, &
+              'set_tolerances_vector refuses a zero entry')
   call ok(s%set_tolerances(1d-6, 1d-6), 'set_tolerances')
   call ok(s%set_step_limits(1d-10, 0.05d0), 'set_step_limits')
   call expect(s%set_step_limits(0.1d0, 0.05d0) == GA_ERR_ARG, 'set_step_limits refuses')

@@ -235,6 +235,7 @@ _SIGNATURES = {
     "ga_set_rescale": (_I, [_S, _I]),
     "ga_set_corrected_start": (_I, [_S, _I]),
     "ga_set_tolerances": (_I, [_S, _D, _D]),
+    "ga_set_tolerances_vector": (_I, [_S, _D, c_double_p]),
     "ga_set_step_limits": (_I, [_S, _D, _D]),
     "ga_set_initial_step": (_I, [_S, _D]),
     "ga_step_adaptive": (_I, [_S, _D]),
