@@ -63,7 +63,7 @@ def _package_files():
     files = []
     pkg = os.path.join(ROOT, NAME)
     for entry in sorted(os.listdir(pkg)):
-        if entry.endswith(".py") and entry != "_install.py":  # _install.py: cmake installs only
+        if (entry.endswith(".py") or entry == "py.typed") and entry != "_install.py":  # _install.py: cmake installs only
             with open(os.path.join(pkg, entry), "rb") as f:
                 files.append(("%s/%s" % (NAME, entry), f.read()))
     return files

@@ -28,6 +28,7 @@ import math
 import os
 import pickle
 import threading
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
@@ -180,8 +181,10 @@ def _chunks(runs, pieces):
     return [np.arange(a, min(a + size, runs)) for a in range(0, runs, size)]
 
 
-def run(model, parameters, times, *, initial=None, h=None, engine="serial", workers=None,
-        client=None, chunk_size=None, comm=None, progress=None):
+def run(model: Callable[[], "Case"], parameters: Any, times: Any, *, initial: Any = None,
+        h: Optional[float] = None, engine: str = "serial", workers: Optional[int] = None,
+        client: Any = None, chunk_size: Optional[int] = None, comm: Any = None,
+        progress: Optional[bool] = None) -> "EnsembleResult":
     """Run `model` once per row of `parameters` (runs x np) and record q, v, lam (and y) at
     `times` (increasing; a time equal to the start records the initial state).
 
@@ -356,7 +359,9 @@ def _stack(results, runs, times, partial=False):
 
 
 # ---- command line: python3 -m galpha.ensemble module:model params.npy --times ... ----------
-def main(argv=None):
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """`python3 -m galpha.ensemble MODULE:MODEL PARAMETERS.npy ...`: run() from the command
+    line (--help lists the options)."""
     import argparse
     import importlib
     parser = argparse.ArgumentParser(

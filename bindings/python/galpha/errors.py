@@ -15,14 +15,17 @@ class GalphaError(Exception):
 
 
 class ArgumentError(GalphaError, ValueError):
+    """An argument was refused (GA_ERR_ARG): out of range, NaN, a wrong size."""
     status = _ffi.GA_ERR_ARG
 
 
 class StateError(GalphaError, RuntimeError):
+    """A call out of order (GA_ERR_STATE), e.g. a step before init, or on a closed solver."""
     status = _ffi.GA_ERR_STATE
 
 
 class OutOfMemoryError(GalphaError, MemoryError):
+    """The library could not allocate (GA_ERR_NOMEM); nothing changed."""
     status = _ffi.GA_ERR_NOMEM
 
 
@@ -42,10 +45,12 @@ class CallbackRetry(RecoverableError):
 
 
 class NonFiniteError(RecoverableError, FloatingPointError):
+    """NaN or Inf in a callback's output or the iterates (GA_ERR_NONFINITE)."""
     status = _ffi.GA_ERR_NONFINITE
 
 
 class SingularMatrixError(RecoverableError, ArithmeticError):
+    """The iteration matrix (or a saddle-point system) is singular (GA_ERR_SINGULAR)."""
     status = _ffi.GA_ERR_SINGULAR
 
 
@@ -55,10 +60,13 @@ class ConvergenceError(RecoverableError):
 
 
 class InconsistentError(GalphaError, ValueError):
+    """Initial values violate the constraints and projecting was refused, or a point is
+    no equilibrium (GA_ERR_INCONSISTENT)."""
     status = _ffi.GA_ERR_INCONSISTENT
 
 
 class InternalError(GalphaError, RuntimeError):
+    """A defect inside galpha (GA_ERR_INTERNAL): please report it with the message."""
     status = _ffi.GA_ERR_INTERNAL
 
 

@@ -14,9 +14,12 @@ quaternion whose norm is not 1 within 1e-6, |psi| >= 2 pi for tangent_inverse).
     q = so3.exp(np.array([[0.0, 0.0, np.pi / 2]]))   # a quarter turn about z
     so3.matrix(q) @ [1.0, 0.0, 0.0]                  # -> [[0, 1, 0]]
 """
+from __future__ import annotations
+
 import numpy as np
 
 from . import _ffi
+from .solver import ArrayLike
 from .errors import error_for
 
 
@@ -42,17 +45,17 @@ def _call(fn, name, inputs, out_shape, refused=_REFUSED):
     return out
 
 
-def exp(psi):
+def exp(psi: ArrayLike) -> np.ndarray:
     """q = exp(psi) = (cos(t/2), sin(t/2) psi / t), t = |psi|: (..., 3) -> (..., 4)."""
     return _call(_ffi.ga_so3_exp, "so3.exp", [_items(psi, 3, "psi")], (4,))
 
 
-def log(q):
+def log(q: ArrayLike) -> np.ndarray:
     """The rotation vector psi with exp(psi) = +-q, |psi| <= pi: (..., 4) -> (..., 3)."""
     return _call(_ffi.ga_so3_log, "so3.log", [_items(q, 4, "q")], (3,))
 
 
-def compose(a, b):
+def compose(a: ArrayLike, b: ArrayLike) -> np.ndarray:
     """a o b, the quaternion product (first b, then a): (..., 4) x (..., 4) -> (..., 4)."""
     a, b = _items(a, 4, "a"), _items(b, 4, "b")
     a, b = (np.ascontiguousarray(x) for x in np.broadcast_arrays(a, b))
@@ -65,16 +68,16 @@ def _matrices(fn, name, x, width, size=3, refused=_REFUSED):
     return np.swapaxes(out.reshape(out.shape[:-1] + (size, size)), -1, -2)
 
 
-def matrix(q):
+def matrix(q: ArrayLike) -> np.ndarray:
     """R(q), the rotation matrix: (..., 4) -> (..., 3, 3)."""
     return _matrices(_ffi.ga_so3_matrix, "so3.matrix", q, 4)
 
 
-def tangent(psi):
+def tangent(psi: ArrayLike) -> np.ndarray:
     """T(psi): (..., 3) -> (..., 3, 3)."""
     return _matrices(_ffi.ga_so3_tangent, "so3.tangent", psi, 3)
 
 
-def tangent_inverse(psi):
+def tangent_inverse(psi: ArrayLike) -> np.ndarray:
     """T(psi)^-1 (|psi| < 2 pi): (..., 3) -> (..., 3, 3)."""
     return _matrices(_ffi.ga_so3_tangent_inverse, "so3.tangent_inverse", psi, 3)

@@ -12,16 +12,25 @@ this for speed: views of the library's buffers, valid during the call only). Mat
 A Python exception raised inside a callback makes the step fail cleanly (the solver stays at
 its last accepted state) and is re-raised, with its traceback, from the call that stepped.
 """
+from __future__ import annotations
+
 import collections
 import ctypes
 import functools
 import signal
 import threading
+from typing import Any, Callable, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
+try:  # numpy >= 1.20
+    from numpy.typing import ArrayLike
+except ImportError:  # pragma: no cover
+    ArrayLike = Any  # type: ignore
+
 from . import _ffi
-from .errors import error_for
+from ._callbacks import adapt
+from .errors import CallbackRetry, error_for
 
 _vp = ctypes.c_void_p
 _i = ctypes.c_int
@@ -62,11 +71,28 @@ EquilibriumY = collections.namedtuple("EquilibriumY", "q y lam")
 StateSpace = collections.namedtuple("StateSpace", "N A")
 
 
+Sensitivity.__doc__ = """Solver.sensitivity(): derivatives of the accepted step's q, v, qdd,
+lam, y and ydot with respect to the parameters, one column per parameter."""
+Equilibrium.__doc__ = """Solver.static_equilibrium(): the rest q and its multipliers lam."""
+EquilibriumY.__doc__ = """Solver.static_equilibrium_y(): the rest q, first-order states y and
+multipliers lam."""
+Linearization.__doc__ = """Solver.linearize(): the small motions at rest in minimal coordinates
+q = q0 + N z, M z'' + C z' + K z = 0."""
+Modes.__doc__ = """Solver.modes() and modes_near(): omega2 ascending, omega (NaN where
+omega2 < 0: an unstable direction), shapes (n x count) with unit modal mass."""
+DampedModes.__doc__ = """Solver.damped_modes(): eigenvalues s (complex; Re s > 0 unstable)
+and complex displacement shapes (n x count, largest entry 1)."""
+StaticPath.__doc__ = """Solver.static_path(): load factors, q and lam of the points after the
+start, and how the path ended ("done" or "stopped")."""
+StateSpace.__doc__ = """Solver.state_space() and state_space_motion(): x' = A x in
+x = (z, z', y), with q = q0 + N z."""
+
+
 def _cast(fn, ctype):
     return ctypes.cast(fn, ctype) if fn is not None else ctype()
 
 
-def native_address(fn):
+def native_address(fn: Any) -> Optional[int]:
     """The C address of a compiled callback -- a numba cfunc, a ctypes function pointer or an
     int address -- or None for a Python callable (or None)."""
     if fn is None or isinstance(fn, bool):
@@ -103,7 +129,7 @@ def _c_signature(kinds):
                        ", ".join(names.get(k, k) for k in kinds[1:]))
 
 
-def check_compiled_signature(fn, ctype, what="callback"):
+def check_compiled_signature(fn: Any, ctype: Any, what: str = "callback") -> None:
     """A numba cfunc carries its signature: one that is not the C callback's is refused by
     name (it was accepted and failed far from here, e.g. as a singular matrix)."""
     proto = getattr(fn, "ctypes", None)
@@ -119,7 +145,7 @@ def check_compiled_signature(fn, ctype, what="callback"):
                                                            _c_signature(want)))
 
 
-def user_pointer(user):
+def user_pointer(user: Any) -> Tuple[Optional[int], Any]:
     """(address, what keeps it alive) of the `user` argument passed to compiled callbacks: None
     (NULL), an int address, a numpy array (its data), or a ctypes object (its address)."""
     if user is None:
@@ -330,7 +356,8 @@ class Solver:
     collector.
     """
 
-    def __init__(self, n, m, mass, force=None, constraint=None, jacobian=None, *,
+    def __init__(self, n: int, m: int, mass: Any, force: Any = None, constraint: Any = None,
+                 jacobian: Any = None, *,
                  stiffness=None, damping=None, constraint_accel=None, constraint_dt=None,
                  rho_inf=None,
                  params=None, newton=None, tangent_mode=None, scaling=None, predictor=None,
@@ -342,7 +369,7 @@ class Solver:
                  coupling_patterns=None, parameters=None, depends=("force",),
                  parameter_scale=None, force_p=None, mass_p=None, constraint_p=None,
                  sensitivity_method=("forward",), max_steps=None, adjoint_checkpoints=None,
-                 zero_copy=False, user=None, space=None):
+                 zero_copy=False, user=None, space=None, args: Sequence[Any] = ()) -> None:
         self._ptr = None
         self._lock = threading.RLock()  # see _serialized
         self._pending = None          # exception raised inside a callback
@@ -411,6 +438,31 @@ class Solver:
 
         def shape(name, dense):
             return (nnz[name],) if name in nnz else dense
+        # Python callbacks that return their output, or take `args`, become ones that fill it
+        # (decided here, once; _callbacks.py)
+        self._args = args = tuple(args)
+
+        def adapted(fn, name, inputs, outputs):
+            if fn is None or native_address(fn) is not None:
+                return fn
+            return adapt(fn, name, inputs, outputs, args)
+        mass = adapted(mass, "mass", ["t", "q"], ["M"])
+        force = adapted(force, "force", ["t", "q", "v"], ["f"])
+        constraint = adapted(constraint, "constraint", ["t", "q"], ["phi"])
+        jacobian = adapted(jacobian, "jacobian", ["t", "q"], ["J"])
+        stiffness = adapted(stiffness, "stiffness", ["t", "q", "v", "qdd", "lam"], ["K"])
+        damping = adapted(damping, "damping", ["t", "q", "v"], ["C"])
+        constraint_accel = adapted(constraint_accel, "constraint_accel", ["t", "q", "v"],
+                                   ["out"])
+        constraint_dt = adapted(constraint_dt, "constraint_dt", ["t", "q"], ["out"])
+        rate = adapted(rate, "rate", ["t", "q", "v", "y"], ["ydot"])
+        force_y = adapted(force_y, "force_y", ["t", "q", "v", "y"], ["f"])
+        coupling = adapted(coupling, "coupling", ["t", "q", "v", "y"],
+                           ["g_q", "g_v", "g_y", "f_y"])
+        force_p = adapted(force_p, "force_p", ["t", "q", "v", "j"], ["f_p"])
+        mass_p = adapted(mass_p, "mass_p", ["t", "q", "j", "a"], ["out"])
+        constraint_p = adapted(constraint_p, "constraint_p", ["t", "q", "j"],
+                               ["phi_p", "Phi_q_p", "Phi_t_p"])
         self._user = {"mass": mass, "force": force, "constraint": constraint,
                       "jacobian": jacobian, "stiffness": stiffness, "damping": damping,
                       "constraint_accel": constraint_accel, "constraint_dt": constraint_dt}
@@ -458,6 +510,8 @@ class Solver:
                     for (a, sh), out in zip(places, outs):
                         v(a, sh, True)[...] = out
                 return rc
+            except CallbackRetry:  # raised by a callback: recoverable, as a positive return
+                return 1
             except BaseException as e:  # re-raised by the call that stepped
                 self._pending = e
                 return -1
@@ -579,7 +633,7 @@ class Solver:
             if value is not None:
                 self._check(setter(self._ptr, int(bool(value))))
         if tolerances is not None:
-            self._check(_ffi.ga_set_tolerances(self._ptr, float(tolerances[0]), float(tolerances[1])))
+            self.set_tolerances(*tolerances)
         if step_limits is not None:
             self._check(_ffi.ga_set_step_limits(self._ptr, float(step_limits[0]), float(step_limits[1])))
         if initial_step is not None:
@@ -637,7 +691,8 @@ class Solver:
                 self._ptr, _cast(cb, _ffi.CONSTRAINT_P_FN)))
 
     @_serialized
-    def set_sensitivity_start(self, j, dq0=None, dv0=None):
+    def set_sensitivity_start(self, j: int, dq0: Optional[ArrayLike] = None,
+                              dv0: Optional[ArrayLike] = None) -> None:
         """dq0/dp_j and dv0/dp_j (None: zero), for every later init() (see
         ga_set_sensitivity_start): initial values as parameters."""
         arrays = []
@@ -653,7 +708,7 @@ class Solver:
             self._handle(), int(j), *[None if a is None else self._dp(a) for a in arrays]))
 
     @_serialized
-    def sensitivity(self):
+    def sensitivity(self) -> Sensitivity:
         """Derivatives of the accepted step's q, v, qdd and lambda with respect to the
         parameters (ga_get_sensitivity, ga_get_sensitivity_y): a Sensitivity of arrays dq
         (n, np), dv (n, np), dqdd (n, np), dlam (m, np), dy and dydot (r, np); column j is
@@ -676,7 +731,9 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def adjoint_gradient(self, running=None, terminal=None):
+    def adjoint_gradient(self, running: Optional[Callable[..., float]] = None,
+                         terminal: Optional[Callable[..., float]] = None
+                         ) -> Tuple[float, np.ndarray]:
         """(J, dJ/dp) of J = terminal(x_N) + the trapezoidal sum of running(x_n) over the
         steps recorded since init() (ga_adjoint_gradient), by the discrete adjoint. Each cost is
         fn(t, q, v, qdd, lam, d_q, d_v, d_qdd, d_lam, d_p) -> value, filling the partial
@@ -776,7 +833,7 @@ class Solver:
 
     # ---- life cycle -------------------------------------------------------------------------
     @_serialized
-    def close(self):
+    def close(self) -> None:
         """Free the C solver (idempotent). Not from one of its own callbacks: ga_free ignores
         that call (the solver is in use), so it raises StateError instead of leaking it."""
         if self._in_callback:
@@ -786,7 +843,7 @@ class Solver:
             self._ptr = None
         self._views.clear()
 
-    def __enter__(self):
+    def __enter__(self) -> "Solver":
         return self
 
     # One object owns one C solver: a copy would free it twice.
@@ -801,9 +858,31 @@ class Solver:
         raise TypeError("a galpha.Solver cannot be pickled (it owns its C solver and Python "
                         "callbacks); pickle how to build it instead")
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: Any) -> bool:
         self.close()
         return False
+
+    def __repr__(self) -> str:
+        sizes = "n=%d, m=%d" % (self.n, self.m)
+        if self.nq != self.n:
+            sizes += ", nq=%d" % self.nq
+        if self.r:
+            sizes += ", r=%d" % self.r
+        if self._ptr is None:
+            return "<galpha.Solver %s, closed>" % sizes
+        # never wait for a run in another thread, nor call into C from one of its callbacks
+        if self._in_callback or not self._lock.acquire(blocking=False):
+            return "<galpha.Solver %s, running>" % sizes
+        try:
+            t = ctypes.c_double()
+            if _ffi.ga_get_t(self._ptr, ctypes.byref(t)) != _ffi.GA_OK:
+                return "<galpha.Solver %s, not initialized>" % sizes
+            steps = ctypes.c_longlong()
+            _ffi.ga_get_counter(self._ptr, 0, ctypes.byref(steps))
+            return "<galpha.Solver %s, t=%.6g, steps=%d, %s>" % (
+                sizes, t.value, steps.value, _ffi.ga_linear_solver_name(self._ptr).decode())
+        finally:
+            self._lock.release()
 
     def __del__(self):
         try:
@@ -813,20 +892,43 @@ class Solver:
 
     # ---- options ----------------------------------------------------------------------------
     @_serialized
-    def set_rho_inf(self, rho_inf):
+    def set_rho_inf(self, rho_inf: float) -> None:
+        """Chung-Hulbert parameters from the spectral radius at infinity, rho_inf in [0, 1]
+        (ga_set_rho_inf; default 0.9): 1 keeps every frequency, 0 damps the highest at once."""
         self._check(_ffi.ga_set_rho_inf(self._handle(), float(rho_inf)))
 
     @_serialized
-    def set_params(self, alpha_m, alpha_f, beta, gamma):
+    def set_params(self, alpha_m: float, alpha_f: float, beta: float, gamma: float) -> None:
+        """The method's four parameters directly (ga_set_params); refused unless second order
+        and stable (the message names the broken condition)."""
         self._check(_ffi.ga_set_params(self._handle(), alpha_m, alpha_f, beta, gamma))
 
     @_serialized
-    def set_newton(self, tol, max_iter=20):
+    def set_tolerances(self, rtol: float, atol: Union[float, ArrayLike]) -> None:
+        """Tolerances of adaptive steps (ga_set_tolerances): rtol a number; atol a number, or
+        one per coordinate (ga_set_tolerances_vector): 2 n + r numbers, the positions (on a
+        space with rotations, the n tangent coordinates), the velocities, then the
+        first-order states -- the rows of integrate's `y` on a vector space."""
+        a = np.asarray(atol, dtype=float)
+        if a.ndim == 0:
+            self._check(_ffi.ga_set_tolerances(self._handle(), float(rtol), float(a)))
+            return
+        a = np.ascontiguousarray(a.ravel())
+        if a.size != 2 * self.n + self.r:
+            raise error_for(_ffi.GA_ERR_ARG, "atol has %d entries; per coordinate it needs 2 n "
+                            "+ r = %d (positions, velocities, first-order states)"
+                            % (a.size, 2 * self.n + self.r))
+        self._check(_ffi.ga_set_tolerances_vector(self._handle(), float(rtol), self._dp(a)))
+
+    @_serialized
+    def set_newton(self, tol: float, max_iter: int = 20) -> None:
+        """Newton tolerance (on the increments, each quantity relative to itself) and iteration
+        limit (ga_set_newton)."""
         self._check(_ffi.ga_set_newton(self._handle(), float(tol), int(max_iter)))
 
     @property
     @_serialized
-    def params(self):
+    def params(self) -> Tuple[float, float, float, float]:
         """(alpha_m, alpha_f, beta, gamma)"""
         vals = [ctypes.c_double() for _ in range(4)]
         self._check(_ffi.ga_get_params(self._handle(), *[ctypes.byref(x) for x in vals]))
@@ -835,7 +937,8 @@ class Solver:
     # ---- stepping ---------------------------------------------------------------------------
     @_serialized
     @_runs_callbacks
-    def init(self, t0, q0, v0, y0=None):
+    def init(self, t0: float, q0: ArrayLike, v0: ArrayLike, y0: Optional[ArrayLike] = None
+             ) -> None:
         """Consistent initial values at t0 (see ga_init); with first-order states, y0 their
         initial values (ga_init_y; None on a running solver keeps the states it holds)."""
         q0 = np.ascontiguousarray(q0, dtype=float)
@@ -854,7 +957,7 @@ class Solver:
                                    self._dp(np.append(y0, 0.0))))
 
     @_serialized
-    def set_coupling_exact(self, exact):
+    def set_coupling_exact(self, exact: bool) -> None:
         """Whether g_q, g_v, f_y are in the iteration matrix (see ga_set_coupling_exact)."""
         self._check(_ffi.ga_set_coupling_exact(self._handle(), int(bool(exact))))
 
@@ -865,21 +968,27 @@ class Solver:
 
     @property
     @_serialized
-    def y(self):
+    def y(self) -> np.ndarray:
         """First-order states at the accepted step (copy)."""
         return self._y_pair(_ffi.ga_get_y)[0]
 
     @property
     @_serialized
-    def ydot(self):
+    def ydot(self) -> np.ndarray:
         """Their rates y' = g at the accepted step (copy)."""
         return self._y_pair(_ffi.ga_get_y)[1]
 
     @_serialized
     @_runs_callbacks
-    def interpolate_y(self, t):
-        """(y, ydot) at t inside the last step (see ga_interpolate_y)."""
-        return self._y_pair(_ffi.ga_interpolate_y, float(t))
+    def interpolate_y(self, t: Union[float, ArrayLike]) -> Tuple[np.ndarray, np.ndarray]:
+        """(y, ydot) at t inside the last step (see ga_interpolate_y): shapes (r,) for a
+        number t, (k, r) for k times."""
+        times = np.asarray(t, dtype=float)
+        pairs = [self._y_pair(_ffi.ga_interpolate_y, float(tk)) for tk in times.ravel()]
+        if times.ndim == 0:
+            return pairs[0]
+        return (np.array([p[0] for p in pairs]).reshape(times.size, self.r),
+                np.array([p[1] for p in pairs]).reshape(times.size, self.r))
 
     def _stepping(self, fn, x):
         """fn(handle, x) under the lock, with Ctrl-C deferred in the main thread (the work of
@@ -908,26 +1017,27 @@ class Solver:
                 return False
             return self._check(status)
 
-    def step(self, h):
+    def step(self, h: float) -> bool:
         """One step of size h. On failure raises; the state stays at the last accepted step.
         True if it stopped at a terminal event (see set_events) or the step hook asked to stop
         (set_step_hook), else False."""
         return self._stepping(_ffi.ga_step, h)
 
-    def step_adaptive(self, t_stop):
+    def step_adaptive(self, t_stop: float) -> bool:
         """One error-controlled step, not beyond t_stop (see ga_step_adaptive). True if it
         stopped at a terminal event or by the step hook."""
         return self._stepping(_ffi.ga_step_adaptive, t_stop)
 
-    def advance(self, t_out):
+    def advance(self, t_out: float) -> bool:
         """Error-controlled steps until t_out exactly (see ga_advance), or until a terminal
         event or the step hook asks to stop: True then (the solver at the end of that step),
         else False."""
         return self._stepping(_ffi.ga_advance, t_out)
 
     @_serialized
-    def set_events(self, functions, multipliers=False, states=False, direction=None,
-                   terminal=None):
+    def set_events(self, functions: Any, multipliers: bool = False, states: bool = False,
+                   direction: Optional[Sequence[int]] = None,
+                   terminal: Optional[Sequence[bool]] = None) -> None:
         """Watch event functions g(t, q, v, lam) -> float (see ga_set_events), each with the
         optional attributes of scipy's solve_ivp: `direction` (> 0 rising, < 0 falling, 0
         either; default 0) and `terminal` (true: step, step_adaptive and advance stop there
@@ -967,9 +1077,11 @@ class Solver:
         count, n, m, r, nq = len(functions), self.n, self.m, self.r, self.nq
         call = self._call
 
+        args = self._args
+
         def evaluate(t, q, v, lam, g, y=None):
             for k, fn in enumerate(functions):
-                value = fn(t, q, v, lam, y) if states else fn(t, q, v, lam)
+                value = fn(t, q, v, lam, y, *args) if states else fn(t, q, v, lam, *args)
                 # a number, or a 0-d or one-element array: None, strings and arrays of several
                 # values are said to be what they are (numpy took "0.5" as 0.5)
                 if isinstance(value, (str, bytes)) or value is None or np.size(value) != 1:
@@ -1005,7 +1117,7 @@ class Solver:
         self._event_cb, self._event_fns = cb, functions
 
     @_serialized
-    def set_step_hook(self, fn, multipliers=False, user=None):
+    def set_step_hook(self, fn: Any, multipliers: bool = False, user: Any = None) -> None:
         """Call fn after every accepted step of step, step_adaptive and advance (see
         ga_set_step_hook); None removes it. A Python fn is called as fn(t, q, v, lam) (lam None
         unless `multipliers`; arrays as the other callbacks get them) and returns a true value
@@ -1056,7 +1168,7 @@ class Solver:
 
     @property
     @_serialized
-    def events(self):
+    def events(self) -> list:
         """The events the last step, step_adaptive or advance found, in time order: a list of
         (t, index, direction) (see ga_get_event)."""
         count = ctypes.c_int()
@@ -1071,29 +1183,42 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def interpolate(self, t):
-        """(q, v, lam) at t inside the last step (dense output, see ga_interpolate)."""
-        q, v, lam = np.empty(self.nq), np.empty(self.n), np.empty(max(self.m, 1))
-        self._check(_ffi.ga_interpolate(self._handle(), float(t), self._dp(q), self._dp(v),
-                                        self._dp(lam)))
-        return q, v, lam[:self.m]
+    def interpolate(self, t: Union[float, ArrayLike]
+                    ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q, v, lam) at t inside the last step (dense output, see ga_interpolate): arrays of
+        shapes (nq,), (n,), (m,) for a number t; for an array of k times, (k, nq), (k, n),
+        (k, m), a row per time (as integrate's histories)."""
+        times = np.asarray(t, dtype=float)
+        q, v = np.empty((times.size, self.nq)), np.empty((times.size, self.n))
+        lam = np.empty((times.size, max(self.m, 1)))
+        for k, tk in enumerate(times.ravel()):
+            self._check(_ffi.ga_interpolate(self._handle(), float(tk), self._dp(q[k]),
+                                            self._dp(v[k]), self._dp(lam[k])))
+        lam = lam[:, :self.m]
+        if times.ndim == 0:
+            return q[0], v[0], lam[0]
+        return q, v, lam
 
     @_serialized
     @_runs_callbacks
-    def interpolate_qdd(self, t):
-        """qdd at t inside the last step (see ga_interpolate_qdd)."""
-        qdd = np.empty(self.n)
-        self._check(_ffi.ga_interpolate_qdd(self._handle(), float(t), self._dp(qdd)))
-        return qdd
+    def interpolate_qdd(self, t: Union[float, ArrayLike]) -> np.ndarray:
+        """qdd at t inside the last step (see ga_interpolate_qdd): shape (n,) for a number t,
+        (k, n) for k times."""
+        times = np.asarray(t, dtype=float)
+        qdd = np.empty((times.size, self.n))
+        for k, tk in enumerate(times.ravel()):
+            self._check(_ffi.ga_interpolate_qdd(self._handle(), float(tk), self._dp(qdd[k])))
+        return qdd[0] if times.ndim == 0 else qdd
 
     @property
     @_serialized
-    def linear_solver_name(self):
+    def linear_solver_name(self) -> str:
+        """The linear solver in use (ga_linear_solver_name), e.g. "dense unblocked LU"."""
         return _ffi.ga_linear_solver_name(self._handle()).decode()
 
     @property
     @_serialized
-    def active_constraints(self):
+    def active_constraints(self) -> np.ndarray:
         """Flags of the constraints in use (True) or dropped as redundant (False)."""
         flags = (ctypes.c_int * max(self.m, 1))()
         self._check(_ffi.ga_get_active_constraints(self._handle(), flags))
@@ -1102,27 +1227,48 @@ class Solver:
     # ---- state ------------------------------------------------------------------------------
     @property
     @_serialized
-    def t(self):
+    def t(self) -> float:
+        """Time of the last accepted step (or of init)."""
         x = ctypes.c_double()
         self._check(_ffi.ga_get_t(self._handle(), ctypes.byref(x)))
         return x.value
 
     @property
     @_serialized
-    def h_last(self):
+    def h_last(self) -> float:
+        """Size of the last accepted step (0 before the first)."""
         x = ctypes.c_double()
         self._check(_ffi.ga_get_h_last(self._handle(), ctypes.byref(x)))
         return x.value
 
-    q = property(lambda self: self._get(_ffi.ga_get_q, self.nq), doc="positions (copy; nq)")
-    v = property(lambda self: self._get(_ffi.ga_get_v, self.n), doc="velocities (copy)")
-    qdd = property(lambda self: self._get(_ffi.ga_get_qdd, self.n), doc="accelerations (copy)")
-    lam = property(lambda self: self._get(_ffi.ga_get_lambda, self.m), doc="multipliers (copy)")
-    a = property(lambda self: self._get(_ffi.ga_get_a, self.n), doc="auxiliary vector a (copy)")
+    @property
+    def q(self) -> np.ndarray:
+        """Positions of the last accepted step (a copy; nq numbers)."""
+        return self._get(_ffi.ga_get_q, self.nq)
+
+    @property
+    def v(self) -> np.ndarray:
+        """Velocities (a copy)."""
+        return self._get(_ffi.ga_get_v, self.n)
+
+    @property
+    def qdd(self) -> np.ndarray:
+        """Accelerations (a copy; consistent with q and v unless output=GA_OUTPUT_STEP)."""
+        return self._get(_ffi.ga_get_qdd, self.n)
+
+    @property
+    def lam(self) -> np.ndarray:
+        """Multipliers (a copy; consistent with q and v unless output=GA_OUTPUT_STEP)."""
+        return self._get(_ffi.ga_get_lambda, self.m)
+
+    @property
+    def a(self) -> np.ndarray:
+        """The auxiliary vector a of the method (a copy)."""
+        return self._get(_ffi.ga_get_a, self.n)
 
     @property
     @_serialized
-    def stats(self):
+    def stats(self) -> dict:
         """Work counters as a dict (steps, failed_steps, newton_iters, factorizations, ...)."""
         out = {}
         for key, name in enumerate(_ffi.COUNTERS):
@@ -1132,12 +1278,14 @@ class Solver:
         return out
 
     @_serialized
-    def reset_counters(self):
+    def reset_counters(self) -> None:
         """Set every work counter of `stats` to zero."""
         self._check(_ffi.ga_reset_counters(self._handle()))
 
     @_serialized
-    def check_derivatives(self, t, q, v, qdd=None, lam=None, y=None, tol=1e-6):
+    def check_derivatives(self, t: float, q: ArrayLike, v: ArrayLike,
+                          qdd: Optional[ArrayLike] = None, lam: Optional[ArrayLike] = None,
+                          y: Optional[ArrayLike] = None, tol: float = 1e-6) -> None:
         """Every derivative callback given (jacobian, stiffness, damping, constraint_accel,
         constraint_dt, coupling, force_p, mass_p, constraint_p) at (t, q, v, qdd, lam, y)
         against central differences of what it derives (ga_check_derivatives). Returns the
@@ -1173,7 +1321,8 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def static_equilibrium(self, q0, t=0.0, tol=1e-10, max_iter=50):
+    def static_equilibrium(self, q0: ArrayLike, t: float = 0.0, tol: float = 1e-10,
+                           max_iter: int = 50) -> Equilibrium:
         """The static equilibrium f(q, 0, t) = Phi_q^T lam, Phi(q, t) = 0 by Newton from q0
         (ga_static_equilibrium): an Equilibrium(q, lam). Raises ConvergenceError (no
         equilibrium in reach), SingularMatrixError (a limit point, or an unrestrained motion),
@@ -1186,7 +1335,8 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def static_equilibrium_y(self, q0, y0, t=0.0, tol=1e-10, max_iter=50):
+    def static_equilibrium_y(self, q0: ArrayLike, y0: ArrayLike, t: float = 0.0,
+                             tol: float = 1e-10, max_iter: int = 50) -> EquilibriumY:
         """The static equilibrium with the first-order states as unknowns too (f(q, 0, y) =
         Phi_q^T lam, g(q, 0, y) = 0, Phi = 0; ga_static_equilibrium_y) from (q0, y0): an
         EquilibriumY(q, y, lam)."""
@@ -1205,7 +1355,8 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def state_space(self, q, y=None, lam=None, t=0.0):
+    def state_space(self, q: ArrayLike, y: Optional[ArrayLike] = None,
+                    lam: Optional[ArrayLike] = None, t: float = 0.0) -> StateSpace:
         """The first-order form x' = A x of the small motions about (q, y, lam) at rest, x =
         (z, z', y) in the minimal coordinates q = q0 + N z (ga_state_space): a StateSpace(N,
         A), A (2 dof + r square). y: the first-order states (None without them); lam None:
@@ -1232,7 +1383,8 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def state_space_motion(self, q, v, y=None, t=0.0):
+    def state_space_motion(self, q: ArrayLike, v: ArrayLike, y: Optional[ArrayLike] = None,
+                           t: float = 0.0) -> StateSpace:
         """The first-order form x' = A x of the small motions about a moving state
         (t, q, v, y) on the constraints, x = (z, w, y) in the chart q + N z of the constraint
         manifold (ga_state_space_motion): a StateSpace(N, A), with the centripetal and
@@ -1259,7 +1411,8 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def linearize(self, q, lam=None, t=0.0):
+    def linearize(self, q: ArrayLike, lam: Optional[ArrayLike] = None, t: float = 0.0
+                  ) -> Linearization:
         """The small motions about (q, lam) at rest in minimal coordinates q = q0 + N z
         (ga_linearize): a Linearization(N, M, C, K) with N (n x dof) orthonormal, Phi_q N = 0,
         and M z'' + C z' + K z = 0. lam None: the multipliers that balance f at q."""
@@ -1276,7 +1429,9 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def static_path(self, q0, load, ds, max_points=1000, tol=1e-10, t=0.0, stop=None):
+    def static_path(self, q0: ArrayLike, load: np.ndarray, ds: float, max_points: int = 1000,
+                    tol: float = 1e-10, t: float = 0.0,
+                    stop: Optional[Callable[..., bool]] = None) -> StaticPath:
         """The equilibrium path in a load factor through limit points (ga_static_path):
         `load` is a float array of one entry that the callbacks read (the call writes the
         load there as it goes; afterwards it holds the last point's); from the equilibrium at
@@ -1315,7 +1470,8 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def damped_modes(self, q, lam=None, count=None, t=0.0):
+    def damped_modes(self, q: ArrayLike, lam: Optional[ArrayLike] = None,
+                     count: Optional[int] = None, t: float = 0.0) -> DampedModes:
         """The `count` modes of the linearized damped (possibly non-conservative) system at an
         equilibrium (ga_modes_damped; count None: all 2 dof): DampedModes(s, shapes)."""
         q, lam = self._rest_arrays(q, lam)
@@ -1332,7 +1488,8 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def modes(self, q, lam=None, count=None, t=0.0):
+    def modes(self, q: ArrayLike, lam: Optional[ArrayLike] = None,
+              count: Optional[int] = None, t: float = 0.0) -> Modes:
         """The `count` lowest undamped vibration modes at an equilibrium (q, lam) (ga_modes;
         count None: every degree of freedom): Modes(omega2, omega, shapes), shapes (n x count)
         with unit modal mass. Raises InconsistentError when q is no equilibrium."""
@@ -1352,7 +1509,8 @@ class Solver:
 
     @_serialized
     @_runs_callbacks
-    def modes_near(self, q, lam=None, sigma=0.0, count=6, t=0.0):
+    def modes_near(self, q: ArrayLike, lam: Optional[ArrayLike] = None, sigma: float = 0.0,
+                   count: int = 6, t: float = 0.0) -> Modes:
         """The `count` undamped modes at an equilibrium (q, lam) whose omega^2 lie nearest
         `sigma`, by shift-invert Lanczos on the solver's (sparse, when patterns are declared)
         factorization (ga_modes_near): Modes(omega2, omega, shapes), omega2 ascending, shapes
@@ -1370,13 +1528,16 @@ class Solver:
         return Modes(w2, omega, shapes[:self.n * count].reshape((self.n, count), order="F").copy())
 
     @_serialized
-    def info(self, key):
+    def info(self, key: int) -> float:
+        """A diagnostic of the last step by key (ga_get_info): galpha.GA_INFO_NEWTON_ITERS,
+        GA_INFO_NEWTON_RATIO, GA_INFO_RCOND, GA_INFO_ERROR_ESTIMATE, GA_INFO_H_NEXT,
+        GA_INFO_VELOCITY_RESIDUAL."""
         x = ctypes.c_double()
         self._check(_ffi.ga_get_info(self._handle(), int(key), ctypes.byref(x)))
         return x.value
 
     @_serialized
-    def get_state(self):
+    def get_state(self) -> np.ndarray:
         """Checkpoint: the full state as a flat float array (see ga_get_state)."""
         size = ctypes.c_size_t()
         self._check(_ffi.ga_state_size(self._handle(), ctypes.byref(size)))
@@ -1385,6 +1546,8 @@ class Solver:
         return out
 
     @_serialized
-    def set_state(self, state):
+    def set_state(self, state: ArrayLike) -> None:
+        """Restore a checkpoint of get_state (ga_set_state): the run continues bit for bit as
+        from where it was taken (also in another solver built the same way)."""
         state = np.ascontiguousarray(state, dtype=float)
         self._check(_ffi.ga_set_state(self._handle(), self._dp(state), state.size))
