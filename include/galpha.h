@@ -89,7 +89,7 @@ extern "C" {
  *  version of the library actually loaded; a binding should compare them at load time. */
 /**@{*/
 #define GA_VERSION_MAJOR 0
-#define GA_VERSION_MINOR 2
+#define GA_VERSION_MINOR 3
 #define GA_VERSION_PATCH 0
 /** major * 10000 + minor * 100 + patch */
 #define GA_VERSION_NUMBER (GA_VERSION_MAJOR * 10000 + GA_VERSION_MINOR * 100 + GA_VERSION_PATCH)

@@ -7,6 +7,9 @@ python=$1; pkg=$2; work=$3; prefix=$4
 rm -rf "$work"
 export PKG_CONFIG_PATH="$(dirname "$(find "$prefix" -name galpha.pc)")"
 unset GALPHA_LIBRARY
+# the pure-Python package over the installed library (the wheel that carries the library is
+# scripts/package.sh's)
+export GALPHA_WHEEL_LIBRARY=none
 for mode in copy editable; do
 "$python" -m venv --system-site-packages "$work/$mode"
 if [ $mode = copy ]; then

@@ -2,9 +2,10 @@
 
 The library is looked for, in order, at
   1. the path in the environment variable GALPHA_LIBRARY,
-  2. the library installed with this package by `cmake --install` (galpha/_install.py),
-  3. the installed library (pkg-config's libdir for galpha, then ctypes.util.find_library),
-  4. the build tree next to this source tree (build*/libgalpha.so*).
+  2. the library a wheel carries in this package (galpha/_libs, listed by galpha/_bundled.py),
+  3. the library installed with this package by `cmake --install` (galpha/_install.py),
+  4. the installed library (pkg-config's libdir for galpha, then ctypes.util.find_library),
+  5. the build tree next to this source tree (build*/libgalpha.so*).
 """
 import ctypes
 import ctypes.util
@@ -26,6 +27,15 @@ def _candidates():
         return
     yield "environment variable GALPHA_LIBRARY", None
     here = os.path.dirname(os.path.abspath(__file__))
+    try:  # a wheel's: the library and what it needs, in load order
+        from ._bundled import LIBRARIES
+    except ImportError:
+        yield "this package's own copy (a wheel that carries the library)", None
+    else:
+        try:
+            yield "this package's own copy (a wheel)", _load_bundled(here, LIBRARIES)
+        except OSError as e:
+            yield "this package's own copy (a wheel): %s" % e, None
     try:  # written by `cmake --install` next to this file: where the library went
         from ._install import LIBDIR_FROM_PACKAGE
         yield "install tree", os.path.normpath(os.path.join(
@@ -57,6 +67,21 @@ def _candidates():
             yield "build tree %s (a sanitizer build: skipped)" % path, None
             continue
         yield "build tree", path
+
+
+def _load_bundled(here, libraries):
+    """Loads the dependencies a wheel carries (each unless a library of that name is in the
+    process already, as libgomp may be through numpy: one copy of a runtime), so that
+    libgalpha's own load finds them by name; the path of libgalpha."""
+    try:
+        with open("/proc/self/maps") as f:
+            loaded = {os.path.basename(line.split()[-1]) for line in f if "/" in line}
+    except OSError:
+        loaded = set()
+    for name in libraries[:-1]:
+        if not any(x.startswith(name) for x in loaded):
+            ctypes.CDLL(os.path.join(here, "_libs", name))
+    return os.path.join(here, "_libs", libraries[-1])
 
 
 def _needs_asan(path):
