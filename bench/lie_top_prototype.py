@@ -3,7 +3,7 @@
 which formulation, and why. Plain numpy, full Newton with difference Jacobians -- a study of
 the discretization, not of cost.
 
-The top (docs/algorithms.md sec. 14): m = 15, centroidal inertia diag(0.234375, 0.46875,
+The top (docs/algorithms.md sec. 13): m = 15, centroidal inertia diag(0.234375, 0.46875,
 0.234375), centre of mass X = (0, 1, 0) in the body, a fixed spherical joint at the origin,
 gravity (0, 0, -9.81), body angular velocity (0, 150, -4.61538) at t = 0, R(0) = I.
 

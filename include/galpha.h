@@ -190,14 +190,14 @@ typedef enum {
                                       position x in space, then R's unit quaternion w, x, y,
                                       z) and 6 in v, the body-frame twist (u, w) = (R^T x',
                                       omega), moved by (x, R) o exp(u, w) = (x + R V(w) u,
-                                      R exp(w)), V(w) = T(w)^T (docs/algorithms.md sec. 16) */
+                                      R exp(w)), V(w) = T(w)^T (docs/algorithms.md sec. 14) */
 } ga_space_kind;
 
 /** Create a solver whose configuration is a product of blocks, block i of kind kinds[i]
  *  holding counts[i] coordinates (GA_SPACE_VECTOR), counts[i] rotations in a row (the SO(3)
  *  kinds) or counts[i] poses (GA_SPACE_SE3), and m constraints. Rotations and poses move on
  *  the group, by right increments with body-frame velocities, q_{n+1} = q_n o exp(xi) (the
- *  conventions of the rotation and pose maps below; docs/algorithms.md sec. 14, 16): no
+ *  conventions of the rotation and pose maps below; docs/algorithms.md sec. 13, 14): no
  *  unit-norm constraint, and no Euler parameters' velocities.
  *
  *  Storage and algebra: q (ga_init's q0, ga_get_q, ga_interpolate, every callback's q) holds
@@ -658,7 +658,7 @@ GA_API ga_status ga_interpolate_qdd(const ga_solver *s, double t, double *qdd);
  *  where a search starts does not fire there; its sign just past that point (1e-6 of the
  *  step, or 100 u |t|) stands for it, so that it fires where it next crosses zero within the
  *  step (a restart at an event whose function crosses again in the first step).
- *  docs/algorithms.md sec. 12. */
+ *  docs/algorithms.md sec. 10. */
 /**@{*/
 typedef enum ga_event_direction {
     GA_EVENT_BOTH = 0,    /**< any sign change */
@@ -737,7 +737,7 @@ GA_API ga_status ga_get_event(const ga_solver *s, int i, double *t, int *index, 
  *  by the first-order generalized-alpha method of Jansen, Whiting and Hulbert with parameters
  *  from the same rho_inf (its spectral radius at infinity is rho_inf; with ga_set_params,
  *  rho_inf = alpha_f / (1 - alpha_f)), second order in y and y'. The coupling blocks enter
- *  the iteration matrix exactly (docs/algorithms.md sec. 11). Without them (r = 0, the
+ *  the iteration matrix exactly (docs/algorithms.md sec. 9). Without them (r = 0, the
  *  default) the solver is the one it was before they existed, bit for bit. The mechanical
  *  iteration matrix stays as it is (dense or sparse): the Newton system is solved by block
  *  elimination onto y, r more solves with each matrix. */
@@ -817,7 +817,7 @@ GA_API ga_status ga_set_events_y(ga_solver *s, int count, ga_event_y_fn fn, cons
 /* ------------------------------------------------------------------------------------------ */
 /** @name Sensitivities
  *  Derivatives of the discrete solution with respect to np parameters p (docs/algorithms.md
- *  sec. 13), forward (after each accepted step, dq/dp_j, dv/dp_j, dqdd/dp_j and dlambda/dp_j of
+ *  sec. 11), forward (after each accepted step, dq/dp_j, dv/dp_j, dqdd/dp_j and dlambda/dp_j of
  *  that step's own q, v, qdd and lambda) or by the discrete adjoint of a cost -- the derivative
  *  of what galpha computes (with the step sizes held fixed as inputs), not of the exact
  *  solution. The iteration matrix is factorized again at each converged step with every
@@ -1185,7 +1185,7 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value);
  *  states only in ga_static_equilibrium_y, ga_state_space and ga_state_space_motion
  *  (GA_ERR_STATE otherwise). Callable before or after ga_init:
  *  the solver's state and set-up are not touched, the evaluations are counted.
- *  docs/algorithms.md sec. 17. */
+ *  docs/algorithms.md sec. 15. */
 /**@{*/
 /** Static equilibrium at time t: f(q, 0, t) = Phi_q^T lambda, Phi(q, t) = 0, by Newton from
  *  the q given, in the null space of Phi_q (redundant constraints take the minimum-norm
@@ -1351,7 +1351,7 @@ GA_API ga_status ga_static_path(ga_solver *s, double t, double *load, double *q,
  *  - the tangent operator T(psi) is the right-trivialized derivative of exp:
  *    exp(psi + d) = exp(psi) o exp(T(psi) d + O(|d|^2)),
  *    T(psi) = I + ((cos t - 1) / t^2) psi~ + ((t - sin t) / t^3) psi~^2, t = |psi|, psi~ x =
- *    psi cross x (docs/algorithms.md sec. 15).
+ *    psi cross x (docs/algorithms.md sec. 13).
  *
  *  Each function maps `count` items at once (count >= 0): arrays of count consecutive
  *  3-vectors, quaternions (4 doubles) or 3 x 3 matrices (9, column-major). An output may be
@@ -1388,7 +1388,7 @@ GA_API ga_status ga_so3_tangent_inverse(long count, const double *psi, double *T
  *    exp(u, w) is (V(w) u, exp(w)), and compose is (xa, Ra) o (xb, Rb) = (xa + Ra xb, Ra Rb);
  *  - the tangent operator T(xi) (exp(xi + d) = exp(xi) o exp(T(xi) d + O(|d|^2))) is
  *    [T_SO3(w), C(u, w); 0, T_SO3(w)], C the series sum_k (-1)^k U_k / (k+1)! of the
- *    off-diagonal blocks U_k of ad_xi^k, ad_xi = [w~ u~; 0 w~] (docs/algorithms.md sec. 16).
+ *    off-diagonal blocks U_k of ad_xi^k, ad_xi = [w~ u~; 0 w~] (docs/algorithms.md sec. 14).
  *
  *  Arrays, counts, in-place use and errors as for ga_so3_*: twists 6 doubles, poses 7,
  *  matrices 6 x 6 column-major (36); GA_ERR_ARG (nothing written) also for a pose whose

@@ -1,4 +1,4 @@
-// The discrete adjoint of the steps taken (docs/algorithms.md sec. 13). A recorded run is the
+// The discrete adjoint of the steps taken (docs/algorithms.md sec. 11). A recorded run is the
 // composition of the maps sensitivity.cpp differentiates: per step the predictor P, the
 // residual linearized at the converged step, the solve with the exact iteration matrix S and
 // the update U of eq. (7). The sweep applies their transposes in reverse order, step by step
@@ -339,7 +339,7 @@ ga_status Adjoint::step_back(long k, Work &w)
     // dq = w - B^T e, dw = w in index 2 (first_order.cpp eliminates it; here it is assembled).
     const FirstOrderParams &p1 = k_.params1;
     const double c1 = R > 0 ? first_order_newton_coefficient(p1, h) : 0.0;
-    // On a group q_{n+1} moves by T(xi) times the increment (sec. 16): K_t, the constraint
+    // On a group q_{n+1} moves by T(xi) times the increment (sec. 14): K_t, the constraint
     // rows, Z and g_q take it as a right factor, Phi_q^T does not.
     const bool group = !space.euclidean();
     if (group)
@@ -581,7 +581,7 @@ ga_status Adjoint::step_back(long k, Work &w)
         if ((st = forward_.correction_derivative(e0[0], q_n, w.eta, w.qpt, w.tmp)))
             return st;
         // That is the derivative of B^T eta along qpt; the adjoint wants its transpose, which
-        // is the same only where second derivatives commute (sec. 16): on a group it differs
+        // is the same only where second derivatives commute (sec. 14): on a group it differs
         // by qpt x (B^T eta) on each rotation.
         if (!space.euclidean()) {
             w.bt_eta.setZero();

@@ -66,7 +66,7 @@ struct AdjointRecord {
 class Stepper;
 class Solver;
 
-// The discrete adjoint as a service of the step (docs/algorithms.md sec. 13): at the doors of
+// The discrete adjoint as a service of the step (docs/algorithms.md sec. 11): at the doors of
 // the transaction it records the run (its first entry at ga_init, room and how the step began
 // once a step converged, the step at commit, its removal on undo); ga_adjoint_gradient sweeps
 // the record backwards, recomputing checkpointed segments through the kernel (`k_`). The

@@ -52,7 +52,7 @@ public:
     int m() const { return m_; }
     int r() const { return r_; }
 
-    // First-order states (docs/algorithms.md sec. 11): the force sees y, which stays alive
+    // First-order states (docs/algorithms.md sec. 9): the force sees y, which stays alive
     // while this is used; y' = g(q, 0, y).
     void states(const Vec &y) { model_.y_now = &y; }
     ga_status rate(const Vec &q, const Vec &y, Vec &g)

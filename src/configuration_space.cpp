@@ -1,4 +1,4 @@
-// The group blocks of ga::ConfigurationSpace (docs/algorithms.md sec. 14, 16): rotations stored
+// The group blocks of ga::ConfigurationSpace (docs/algorithms.md sec. 13, 14): rotations stored
 // as unit quaternions or as column-major rotation matrices, and rigid poses of SE(3) (a
 // position and a quaternion), moved by right increments, q o exp(xi), with xi in the body
 // frame; vector blocks as in R^n. Each group block of width w (3 or 6) goes through the same

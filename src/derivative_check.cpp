@@ -1,5 +1,5 @@
 // ga_check_derivatives: every derivative callback the solver was given, at one state, against
-// central differences of the callbacks it derives (docs/algorithms.md sec. 15). A wrong sign
+// central differences of the callbacks it derives (docs/algorithms.md sec. 13). A wrong sign
 // in a K_t otherwise shows only as "Newton did not converge". Its own scratch throughout: the
 // solver's workspace, state and set-up are not touched (the evaluations are counted).
 #include <algorithm>

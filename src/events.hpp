@@ -1,4 +1,4 @@
-// Event location on a step's interpolant (docs/algorithms.md sec. 12): the earliest root, over
+// Event location on a step's interpolant (docs/algorithms.md sec. 10): the earliest root, over
 // [t0, t1], among event functions whose sign changes in the requested direction, found by the
 // Illinois variant of the secant method (Hiebert & Shampine; SUNDIALS IDA does the same) on
 // values the caller interpolates, so that no step is ever taken again.

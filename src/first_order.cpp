@@ -1,9 +1,9 @@
-// First-order states y' = g(t, q, v, y) in the step of Algorithm 1 (docs/algorithms.md sec. 11):
+// First-order states y' = g(t, q, v, y) in the step of Algorithm 1 (docs/algorithms.md sec. 9):
 // the generalized-alpha of Jansen, Whiting and Hulbert in the paper's non-weighted form,
 //     (1 - alpha_m1) w_{n+1} + alpha_m1 w_n = (1 - alpha_f1) y'_{n+1} + alpha_f1 y'_n,
 //     y_{n+1} = y_n + h ((1 - gamma1) w_n + gamma1 w_{n+1}),   y'_{n+1} = g(t_{n+1}, ...),
 // with y the Newton unknown beside q and lambda. The Newton system is solved by block
-// elimination onto y (sec. 11, "Solve"): with the mechanical solve x = Sol(r) (S x = -r, the
+// elimination onto y (sec. 9, "Solve"): with the mechanical solve x = Sol(r) (S x = -r, the
 // step's own, dense or sparse, either formulation) and its responses Z = Sol(f_y) to the
 // columns of f_y, the r x r Schur complement C = c1 I - g_y + G Z (G x = g_q dq + gamma' g_v dw)
 // gives dy = C^-1 (-r^y + G x0) and the mechanical update x0 - Z dy. The mechanical matrix,
@@ -56,13 +56,13 @@ void Stepper::first_order_start(const State &from, double h)
 
 // The start of a fresh step's recursion for y. h y''_0 by a central difference of g along the
 // Taylor polynomial of the start at t0 -+ h (the h^2 y''_0 / 2 left out of y cancels in the
-// difference); w_0 = y'_0 + delta h y''_0 with the corrected start (sec. 11), y'_0 without.
+// difference); w_0 = y'_0 + delta h y''_0 with the corrected start (sec. 9), y'_0 without.
 // A state whose rate changes by more than itself within the step, |h y''_0| > |y'_0|, does not
 // follow its start over the step -- a stiff one off its equilibrium, tau' = (u - tau) / T with
 // h / T = 1e4: its y'_0 = 6 / T carried into the step put tau 3 755 off -- and starts the
 // recursion from rest instead, w_0 = y'_0 = 0 in the step: its first step is then implicit in
 // y' alone, monotone, and what it drops, h |y'_0| < h^2 |y''_0|, is within the step's local
-// error where y is smooth (sec. 11, "Stiff start"). Rates that overflow along the polynomial
+// error where y is smooth (sec. 9, "Stiff start"). Rates that overflow along the polynomial
 // (a stiff nonlinear g) count as such for every state. Fixed steps only: an adaptive step's
 // error control shrinks h until the start is followed. qdd_start_ is the start's qdd.
 ga_status Stepper::first_order_starting_values(const State &from, double h)
@@ -117,7 +117,7 @@ ga_status Stepper::first_order_matrix(double t, const State &x, bool central)
     if (auto st = model.coupling(t, x.q, x.v, x.y, f_, rate_, blocks_, central))
         return st;
     if (!model.space.euclidean()) {
-        // Newton's dq moves q by T(xi) dq (sec. 16): g_q T for the matrix and G x; at the
+        // Newton's dq moves q by T(xi) dq (sec. 14): g_q T for the matrix and G x; at the
         // accepted state xi = 0
         g_q_step_ = blocks_.g_q;
         if (&x == &trial_)

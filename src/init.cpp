@@ -165,7 +165,7 @@ ga_status Stepper::consistent_accelerations(double t, const Vec &q, const Vec &v
 }
 
 // The saddle-point solve of the consistent start and of consistent output (docs/algorithms.md
-// sec. 3.3, 10) in the workspace w. The first block row is multiplied by
+// sec. 3.3, 8) in the workspace w. The first block row is multiplied by
 // sigma = max|Phi_q| / max|M| (active constraints) so that both blocks have the same size;
 // the unknown in the second block is then sigma lambda.
 ga_status Stepper::acceleration_level(double t, const Vec &q, const Vec &v, SaddleWorkspace &w,

@@ -86,7 +86,7 @@ public:
 
     bool ready() const { return cb.mass != nullptr && (m_ == 0 || (cb.constraint && cb.jacobian)); }
 
-    // First-order states (docs/algorithms.md sec. 11): their number, and the states the force
+    // First-order states (docs/algorithms.md sec. 9): their number, and the states the force
     // callback sees. The solver points y_now at the states that belong with each (t, q, v) it
     // evaluates f at; with r = 0 the force is that of ga_set_callbacks and y_now is unused.
     int first_order_count() const { return r_; }

@@ -1,4 +1,4 @@
-// The undamped modes nearest a shift sigma of a large model (docs/algorithms.md sec. 17,
+// The undamped modes nearest a shift sigma of a large model (docs/algorithms.md sec. 15,
 // "Large models"):
 // Lanczos on the shift-inverted operator
 //     Op x = y,   [K_t - sigma M, Phi_q^T; Phi_q, 0] [y; mu] = [M x; 0],

@@ -1,4 +1,4 @@
-// The small motions about a moving state (t, q, v) (docs/algorithms.md sec. 17, "About a
+// The small motions about a moving state (t, q, v) (docs/algorithms.md sec. 15, "About a
 // moving state"): in the chart q(z) = q0 + N z + R h(z) of the constraint manifold at q0
 // (N, R orthonormal bases of Phi_q's null space and of its rows' span; h keeps Phi = 0) with
 // v(z, w) = N w + R k(z, w) (k keeps Phi_q v + Phi_t = 0), z' = N^T v = w exactly, so
@@ -174,7 +174,7 @@ ga_status motion_state_space(Stepper &kernel, double t, const double *q_in, cons
     Vec y = nr > 0 ? Vec(Eigen::Map<const Vec>(y_in, nr)) : Vec(0);
     if (!all_finite(q0) || !all_finite(v0) || !all_finite(y))
         return diag.fail(GA_ERR_ARG, "%s: q, v or y is not finite", name);
-    // the force sees y (first-order states, docs/algorithms.md sec. 11)
+    // the force sees y (first-order states, docs/algorithms.md sec. 9)
     const Restore<const Vec *> keep(kernel.model.y_now);
     kernel.model.y_now = &y;
     Chart chart(kernel, t);

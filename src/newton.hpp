@@ -27,7 +27,7 @@
 //     (accelerations), or q and the accelerations so (multipliers): on an ill-conditioned
 //     system (a 100 000-link chain) the solve resolves lambda and w only to what it makes of
 //     the residual's round-off, above the floors from v, and the iteration would never end.
-// First-order states (docs/algorithms.md sec. 11) are two more quantities of the same kind:
+// First-order states (docs/algorithms.md sec. 9) are two more quantities of the same kind:
 // e_y = |dy| / (tol |y|) and e_y' = |c1 dy| / (tol |y'|), floor 64 ulps of |y| (times c1), where
 // |y| and |y'| include what q's own size makes of them through the coupling (first_order.cpp); with
 // none (r = 0) both are 0 and at their floor, and the test is the one before them.

@@ -1,4 +1,4 @@
-// Operating points (docs/algorithms.md sec. 17): static equilibrium by Newton in the null
+// Operating points (docs/algorithms.md sec. 15): static equilibrium by Newton in the null
 // space of Phi_q, the small motions about it in minimal coordinates, their undamped modes.
 // Dense; its own scratch throughout, so that the solver's workspace and state stay as they
 // were (the evaluations are counted).

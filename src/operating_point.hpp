@@ -1,4 +1,4 @@
-// Operating points of the model (docs/algorithms.md sec. 17): its static equilibrium, the
+// Operating points of the model (docs/algorithms.md sec. 15): its static equilibrium, the
 // linearization about one in minimal coordinates, and the undamped vibration modes there.
 // From the callbacks the dynamics already uses; the solver's state and set-up are not touched.
 #pragma once

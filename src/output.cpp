@@ -1,5 +1,5 @@
 // What the solver reports besides its state: accelerations and multipliers consistent with
-// (q, v) (docs/algorithms.md sec. 10), at the last accepted step or at any t inside it, and dense
+// (q, v) (docs/algorithms.md sec. 8), at the last accepted step or at any t inside it, and dense
 // output of q and v over the last step.
 //
 // Index-3 multipliers and accelerations carry eps |q| / (beta h^2) of round-off (paper, sec.

@@ -24,7 +24,7 @@ struct NewtonCoefficients {
 };
 NewtonCoefficients newton_coefficients(const Params &p, double h);
 
-// First-order states y' = g (docs/algorithms.md sec. 11): the generalized-alpha of Jansen,
+// First-order states y' = g (docs/algorithms.md sec. 9): the generalized-alpha of Jansen,
 // Whiting and Hulbert in the paper's non-weighted form, an auxiliary w for y' as a is for q'',
 //     (1 - alpha_m) w_{n+1} + alpha_m w_n = (1 - alpha_f) y'_{n+1} + alpha_f y'_n,
 //     y_{n+1} = y_n + h ((1 - gamma) w_n + gamma w_{n+1}),

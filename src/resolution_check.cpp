@@ -1,4 +1,4 @@
-// The index-3 step's check of its own resolution (docs/algorithms.md sec. 14). Index 3 holds
+// The index-3 step's check of its own resolution (docs/algorithms.md sec. 12). Index 3 holds
 // Phi(q) = 0 at every step and leaves the velocity constraint Phi_q v + Phi_t = 0 to the
 // discretization: O(h^2) where the motion is resolved. Where it is not -- a link turning by
 // more than about 0.1 rad per step at rho_inf = 0.9, 0.2 at 0.8, 0.3 at 0.7 -- the step map

@@ -87,7 +87,7 @@ ga_status SaddleAtRest::stiffness(const Vec &q, const Vec &lambda)
         Vec unused;
         return model_.stiffness(t_, q, zero_, zero_, lambda, unused, M, K);
     }
-    // central differences (docs/algorithms.md sec. 17: truncation and round-off balanced)
+    // central differences (docs/algorithms.md sec. 15: truncation and round-off balanced)
     qq_ = q;
     const ConfigurationSpace &space = model_.space;
     if (K.dense()) {

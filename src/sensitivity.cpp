@@ -1,5 +1,5 @@
 // Forward sensitivities: the derivative of the discrete map of one step (docs/algorithms.md
-// sec. 13). A converged step solves R(x_{n+1}, x_n, p) = 0; its derivative
+// sec. 11). A converged step solves R(x_{n+1}, x_n, p) = 0; its derivative
 //     R_{x_{n+1}} s_{n+1} = -R_{x_n} s_n - R_p
 // is one more Newton iteration of Algorithm 1 on a linear problem: the predictor (eqs. 3-5
 // with qdd_{n+1} = 0) applied to s_n, the residual linearized at the converged step, one solve

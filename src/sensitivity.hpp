@@ -1,4 +1,4 @@
-// Forward sensitivities of the discrete solution (docs/algorithms.md sec. 13): what they are
+// Forward sensitivities of the discrete solution (docs/algorithms.md sec. 11): what they are
 // taken with respect to, their values at the accepted step and the step being computed, and
 // the scratch of their step; and the service that computes them (ForwardSensitivity,
 // sensitivity.cpp), attached to the step transaction at its doors.
@@ -83,7 +83,7 @@ struct Sensitivities {
 
 class Stepper;
 
-// The forward sensitivities as a service of the step (docs/algorithms.md sec. 13): their start
+// The forward sensitivities as a service of the step (docs/algorithms.md sec. 11): their start
 // at ga_init, the starts by differences before Taylor steps and fresh starts, the linear step
 // once a step converged, their half of a commit and of its undoing; and the derivatives in p
 // of the residual and the constraints, which the adjoint sweep uses too. It works through the

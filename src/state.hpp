@@ -20,7 +20,7 @@ struct State {
     Vec c, c_prev;
     double c_dt = 0.0;
     int c_count = 0;
-    // First-order states (docs/algorithms.md sec. 11): y, y' = g, the auxiliary w of y' (as a
+    // First-order states (docs/algorithms.md sec. 9): y, y' = g, the auxiliary w of y' (as a
     // is of qdd) and w of the state before; empty when r = 0.
     Vec y, ydot, w, w_prev;
 

@@ -1,4 +1,4 @@
-// The static path through limit points (docs/algorithms.md sec. 17): pseudo-arclength
+// The static path through limit points (docs/algorithms.md sec. 15): pseudo-arclength
 // continuation in the load factor mu that the callbacks read at *load, Newton in the null
 // space of Phi_q bordered by the arc-length equation.
 #include <algorithm>

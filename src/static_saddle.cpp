@@ -1,5 +1,5 @@
 // Static equilibrium of a large model on the saddle-point factorization (docs/algorithms.md
-// sec. 17, "Large models"): Newton on (r, Phi) = 0 bordered by the constraints,
+// sec. 15, "Large models"): Newton on (r, Phi) = 0 bordered by the constraints,
 //     [K_t  Phi_q^T] [dq      ]   [ f  ]
 //     [Phi_q   0   ] [lambda+ ] = [-Phi],
 // with the backtracking line search of the dense path. The dense path's null space would be

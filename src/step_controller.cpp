@@ -9,7 +9,7 @@ namespace ga {
 
 namespace {
 const double kEps = std::numeric_limits<double>::epsilon();
-// Tolerance calibration (docs/algorithms.md sec. 9): the local error test is against
+// Tolerance calibration (docs/algorithms.md sec. 7): the local error test is against
 // kCalibration sqrt(rtol) times the weights atol + rtol |y|, i.e. a tolerance ~ tol^(3/2). An
 // order-2 method whose steps keep the local error at tol' ends with a global error
 // ~ tol'^(2/3); controlled so, it ends ~ tol, from 1e-3 to 1e-8 (docs/design-notes.md,

@@ -1,5 +1,5 @@
 // The special Euclidean group SE(3), a pose (x, R) stored as its position and a unit quaternion,
-// with the maps of the Lie-group method (docs/algorithms.md sec. 14, 16): right increments,
+// with the maps of the Lie-group method (docs/algorithms.md sec. 13, 14): right increments,
 // body-frame twists xi = (u, w) (u the translation, w the rotation, in that order),
 // (x, R) o exp(xi) = (x + R V(w) u, R exp(w)) with V(w) = T(w)^T the left Jacobian of SO(3).
 // In that ordering ad_xi = [w~ u~; 0 w~]; the tangent operator is T(xi) = sum_k (-ad_xi)^k /

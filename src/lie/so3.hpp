@@ -1,5 +1,5 @@
 // The rotation group SO(3) stored as unit quaternions (S^3, its double cover), with the maps
-// the Lie-group generalized-alpha method needs (docs/algorithms.md sec. 14): right increments
+// the Lie-group generalized-alpha method needs (docs/algorithms.md sec. 13): right increments
 // and body-frame velocities, q_{n+1} = q_n o exp(psi), the exponential and logarithm, the
 // tangent operator T(psi) of the increment and its inverse.
 //

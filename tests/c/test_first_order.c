@@ -1,4 +1,4 @@
-/* First-order states y' = g(t, q, v, y) in the same solve (issue 19, docs/algorithms.md sec. 11):
+/* First-order states y' = g(t, q, v, y) in the same solve (issue 19, docs/algorithms.md sec. 9):
  * the stiff limit measured by stepping galpha, order 2 in every quantity against an exact
  * solution (a matrix exponential computed here), Newton with and without the coupling blocks,
  * restart and checkpoints, and the API's refusals. */

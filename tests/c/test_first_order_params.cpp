@@ -1,4 +1,4 @@
-// The first-order generalized-alpha parameters (src/params.cpp, docs/algorithms.md sec. 11),
+// The first-order generalized-alpha parameters (src/params.cpp, docs/algorithms.md sec. 9),
 // checked by stepping the scheme they define: on y' = mu y its amplification matrix has
 // spectral radius rho_inf in the stiff limit (the trapezoidal rule, rho_inf = 1, keeps 1) and
 // roots 1 and -alpha_m/(1 - alpha_m) at h mu = 0; the solution converges at order 2 on
