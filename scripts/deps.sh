@@ -23,4 +23,7 @@ BUILD_PACKAGES=(build-essential cmake pkg-config libeigen3-dev liblapack-dev lib
 TEST_PACKAGES=(libcmocka-dev gfortran python3 python3-numpy python3-pytest python3-venv python3-numba python3-tqdm
                python3-distributed python3-mpi4py openmpi-bin binutils
                valgrind abigail-tools)
+# The documentation site and its browser check (scripts/docs.sh); not needed by the library.
+DOCS_PACKAGES=(doxygen python3-sphinx python3-myst-parser python3-breathe chromium
+               tesseract-ocr tesseract-ocr-eng)
 JOBS=$(nproc 2>/dev/null || echo 2)

@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/deps.sh
-ensure_packages "${BUILD_PACKAGES[@]}" "${TEST_PACKAGES[@]}"
+ensure_packages "${BUILD_PACKAGES[@]}" "${TEST_PACKAGES[@]}" "${DOCS_PACKAGES[@]}"
 
 common=(-DGALPHA_WERROR=ON -DPython3_EXECUTABLE=/usr/bin/python3 -DGALPHA_REQUIRE_PYTHON=ON
         -DGALPHA_REQUIRE_FORTRAN=ON)
@@ -25,8 +25,9 @@ run_suite build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGALPHA_SANITIZE=ON 
     -DGALPHA_BUILD_BENCH=OFF
 # The ABI against its baseline (abi/libgalpha.abi): an incompatible change fails; the
 # sanitizer build carries the debug information libabigail reads.
-echo "=== ABI"
+echo "=== ABI and the version policy"
 bash scripts/abi.sh check build-sanitize/libgalpha.so
+bash tests/check_version_policy.sh build-sanitize/libgalpha.so
 # Valgrind's memcheck on the release build's C suites: reads of uninitialized memory, which the
 # sanitizers do not see. (test_alloc and test_alloc_failures replace malloc themselves, so
 # memcheck cannot watch them; the accuracy sweeps, test_newton_sweep, test_tolerance and
@@ -42,6 +43,13 @@ find build/tests/c -maxdepth 1 -type f -name 'test_*' -perm -u+x ! -name 'test_a
 # Helgrind on the suite that runs solvers in parallel threads: data races.
 echo "=== helgrind: build/tests/c/test_threads"
 valgrind --tool=helgrind --error-exitcode=9 --quiet build/tests/c/test_threads >/dev/null
+# The documentation site: Doxygen and Sphinx with warnings as errors, then the start page and
+# the API page in headless Chromium, their screenshots read back.
+echo "=== documentation site"
+bash scripts/docs.sh
+# The source tarball, the .deb and the wheel, each installed and used (scripts/package.sh).
+echo "=== packages"
+DOCS_HTML=$PWD/build-docs/html bash scripts/package.sh
 # A deterministic libFuzzer run over the C API (clang, ASan + UBSan; scripts/fuzz.sh): a fixed
 # seed and number of inputs from the committed corpus, so that CI's verdict never depends on
 # luck; the longer explorations run before a stop (scripts/fuzz.sh explore).
