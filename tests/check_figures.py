@@ -7,9 +7,11 @@ A quoted figure carries, right after it, a comment that says where it comes from
 FORMAT is a printf format; the expression after it, Python over csv(FILE, COLUMN, KEY=VALUE...)
 (the COLUMN of the one row of docs/FILE whose KEY columns hold those values, as a number),
 the work-precision readings of the bench's charts (scripts/plot_bench.py) --
-cheapest(FILE, ERROR, KEY=VALUE...), the least cpu_seconds among the rows with error <= ERROR,
+cheapest(FILE, ERROR, KEY=VALUE...), the least cpu_seconds among the rows with error <= ERROR
+(with of=COLUMN: that row's COLUMN),
 and at_error(FILE, ERROR, KEY=VALUE...), cpu_seconds interpolated log-log between the two
-rows whose errors bracket ERROR -- and the functions min, max, abs, round. The figure (the number just before the comment; digits
+rows whose errors bracket ERROR, largest(FILE, COLUMN, KEY=VALUE...) over the rows -- and the
+functions min, max, abs, round. The figure (the number just before the comment; digits
 grouped with spaces or commas are read as one) must equal the expression as FORMAT prints it.
 
 In README.md every figure of a measurement (a number followed by a unit of time, "times", "x",
@@ -56,12 +58,14 @@ class Figures:
             raise ValueError("%s: no rows with %r" % (name, keys))
         return rows
 
-    def cheapest(self, name, error, **keys):
-        ok = [float(r["cpu_seconds"]) for r in self.rows(name, **keys)
-              if float(r["error"]) <= error]
+    def cheapest(self, name, error, of="cpu_seconds", **keys):
+        ok = [r for r in self.rows(name, **keys) if float(r["error"]) <= error]
         if not ok:
             raise ValueError("%s: no row with %r reaches error %g" % (name, keys, error))
-        return min(ok)
+        return float(min(ok, key=lambda r: float(r["cpu_seconds"]))[of])
+
+    def largest(self, name, column, **keys):
+        return max(float(r[column]) for r in self.rows(name, **keys))
 
     def at_error(self, name, error, **keys):
         pts = sorted((float(r["error"]), float(r["cpu_seconds"]))
@@ -74,7 +78,8 @@ class Figures:
 
     def value(self, expr):
         return eval(expr, {"__builtins__": {}}, {"csv": self.csv, "cheapest": self.cheapest,
-                                                  "at_error": self.at_error, "min": min,
+                                                  "at_error": self.at_error,
+                                                  "largest": self.largest, "min": min,
                                                   "max": max, "abs": abs, "round": round})
 
 
