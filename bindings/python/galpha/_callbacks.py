@@ -7,8 +7,6 @@ number of positional arguments the function takes; a function that would take bo
 arguments of either convention: mass(t, q, M, *args) or mass(t, q, *args)."""
 import inspect
 
-from .errors import CallbackRetry  # noqa: F401  (raised by callbacks: see Solver)
-
 
 def _positional_range(fn):
     """(least, most) positional arguments fn accepts, or None when it cannot be told."""
@@ -54,7 +52,7 @@ def adapt(fn, name, inputs, outputs, args):
     """fn as a function that fills its outputs and takes no extra arguments: fn itself when
     it is one already, else a wrapper (once, at set-up: the convention is not decided per
     call). None and compiled callbacks are returned unchanged."""
-    if fn is None or not callable(fn) or isinstance(fn, int):
+    if fn is None or not callable(fn):
         return fn
     args = tuple(args)
     if not returns_output(fn, name, inputs, outputs, len(args)):
