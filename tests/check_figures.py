@@ -30,7 +30,7 @@ import shutil
 import sys
 import tempfile
 
-MARK = re.compile(r"(?P<figure>-?(?:\d{1,3}(?:[ ,]\d{3})+|\d+)(?:\.\d+)?(?:e-?\d+)?)"
+MARK = re.compile(r"(?P<figure>(?:(?<=[\s(])-)?(?:\d{1,3}(?:[ ,]\d{3})+|\d+)(?:\.\d+)?(?:e-?\d+)?)"
                   r"(?P<close>\)?)<!-- fig (?P<fmt>%[-+ #0-9.]*[a-zA-Z]) (?P<expr>.*?) -->",
                   re.S)
 UNIT = re.compile(r"\b\d[\d.]*(?:e-?\d+)? ?(?:us|ms|s|times|x|%|runs/s|instructions)\b")
