@@ -838,8 +838,19 @@ static void run_sequence(int seq, const uint8_t *data, size_t size, seq_stats *s
         case 13: call = "ga_set_corrected_start"; st = ga_set_corrected_start(s, pick(&md, 3)); break;
         case 14: {
             const double rtol = edge_value(&md);
-            call = "ga_set_tolerances";
-            st = ga_set_tolerances(s, rtol, edge_value(&md));
+            if (pick(&md, 3)) {
+                call = "ga_set_tolerances";
+                st = ga_set_tolerances(s, rtol, edge_value(&md));
+                break;
+            }
+            /* one atol per coordinate: one entry an edge value, the others a plain one */
+            double atol[2 * VMAX + 1];
+            const int len = 2 * md.nv + md.r;
+            for (int k = 0; k < len; ++k)
+                atol[k] = 1e-6 * (1 + k);
+            atol[pick(&md, len)] = edge_value(&md);
+            call = "ga_set_tolerances_vector";
+            st = ga_set_tolerances_vector(s, rtol, pick(&md, 16) ? atol : NULL);
             break;
         }
         case 15: {
