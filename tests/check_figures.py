@@ -10,7 +10,10 @@ the work-precision readings of the bench's charts (scripts/plot_bench.py) --
 cheapest(FILE, ERROR, KEY=VALUE...), the least cpu_seconds among the rows with error <= ERROR
 (with of=COLUMN: that row's COLUMN),
 and at_error(FILE, ERROR, KEY=VALUE...), cpu_seconds interpolated log-log between the two
-rows whose errors bracket ERROR, largest(FILE, COLUMN, KEY=VALUE...) over the rows -- and the
+rows whose errors bracket ERROR, largest and smallest(FILE, COLUMN, KEY=VALUE...) over the rows,
+sweep(FILE, METHOD, AGAINST, KEY=VALUE...) -- for each row of METHOD (with upto=RTOL: whose
+setting is at most RTOL), its cpu_seconds over AGAINST's at_error of that row's error, where
+AGAINST's rows bracket it (the adaptive rows against the fixed step, as a list) -- and the
 functions min, max, abs, round. The figure (the number just before the comment; digits
 grouped with spaces or commas are read as one) must equal the expression as FORMAT prints it.
 
@@ -76,10 +79,29 @@ class Figures:
                 return math.exp(math.log(c1) + w * (math.log(c2) - math.log(c1)))
         raise ValueError("%s: the rows with %r do not bracket error %g" % (name, keys, error))
 
+    def smallest(self, name, column, **keys):
+        return min(float(r[column]) for r in self.rows(name, **keys))
+
+    def sweep(self, name, method, against, upto=None, **keys):
+        ratios = []
+        for r in self.rows(name, method=method, **keys):
+            if upto is not None and float(r["setting"]) > upto * (1 + 1e-9):
+                continue
+            try:
+                fixed = self.at_error(name, float(r["error"]), method=against, **keys)
+            except ValueError:  # outside the fixed steps' range
+                continue
+            ratios.append(float(r["cpu_seconds"]) / fixed)
+        if not ratios:
+            raise ValueError("%s: no row of %s within %s's range" % (name, method, against))
+        return ratios
+
     def value(self, expr):
         return eval(expr, {"__builtins__": {}}, {"csv": self.csv, "cheapest": self.cheapest,
                                                   "at_error": self.at_error,
-                                                  "largest": self.largest, "min": min,
+                                                  "largest": self.largest, "smallest": self.smallest,
+                                                  "sweep": self.sweep,
+                                                  "min": min,
                                                   "max": max, "abs": abs, "round": round})
 
 
