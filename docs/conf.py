@@ -4,6 +4,7 @@
 # three are Debian packages (python3-sphinx, python3-myst-parser, python3-breathe, doxygen).
 import os
 import re
+import sys
 
 here = os.path.dirname(os.path.abspath(__file__))
 with open(os.path.join(here, "..", "CMakeLists.txt")) as f:
@@ -13,7 +14,7 @@ project = "galpha"
 author = "the galpha developers"
 copyright = "2026, the galpha developers"
 
-extensions = ["myst_parser", "breathe"]
+extensions = ["myst_parser", "breathe", "sphinx.ext.autodoc", "sphinx.ext.napoleon"]
 source_suffix = {".md": "markdown"}
 root_doc = "index"
 exclude_patterns = ["_build", "site", "README.md"]
@@ -27,7 +28,18 @@ html_title = "galpha %s" % release
 html_theme_options = {"description": "generalized-alpha for constrained mechanical systems",
                       "page_width": "1100px", "sidebar_width": "230px"}
 html_show_sourcelink = False
+html_static_path = ["_static"]
 # Pygments: the guides' code blocks are C, Fortran, Python and shell
 highlight_language = "none"
 # standard C types the header uses, which no page defines
 nitpick_ignore = [("c:identifier", "size_t")]
+
+# The Python reference (api-python.md) imports the package from the source tree; it loads
+# libgalpha (GALPHA_LIBRARY: scripts/docs.sh points it at a build). The docstrings are
+# numpy-style, read by napoleon.
+sys.path.insert(0, os.path.join(here, "..", "bindings", "python"))
+autodoc_member_order = "bysource"
+napoleon_use_param = False  # the types as written, not cross-references
+napoleon_use_rtype = False
+autodoc_typehints = "none"  # numpy.typing.ArrayLike would print as its whole Union
+

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The documentation site: Doxygen reads include/galpha.h (XML), Sphinx with MyST and Breathe
-# renders docs/*.md and the API reference into build-docs/html, every warning an error. Then,
-# unless --no-browser, the start page and the API page are opened in headless Chromium and
-# their screenshots read back (tests/check_site.py): the rendered title and a code block must
+# renders docs/*.md, the C API reference and the Python one (autodoc over the package's
+# docstrings, napoleon for their numpy-style sections) into build-docs/html, every warning an
+# error. Then, unless --no-browser, the start page and the API page are opened in headless
+# Chromium and their screenshots read back (tests/check_site.py): the rendered title and a code block must
 # be on them. Debian's python3-sphinx, python3-myst-parser, python3-breathe, doxygen, chromium,
 # tesseract-ocr; none is needed by the library.
 set -euo pipefail
@@ -10,6 +11,18 @@ cd "$(dirname "$0")/.."
 . scripts/deps.sh
 ensure_packages "${DOCS_PACKAGES[@]}"
 out=$PWD/build-docs
+# The Python reference imports the package, which loads libgalpha: GALPHA_LIBRARY if set, else
+# the release build's, else a library built here.
+if [ -z "${GALPHA_LIBRARY:-}" ]; then
+    GALPHA_LIBRARY=$PWD/build/libgalpha.so.0
+    if [ ! -e "$GALPHA_LIBRARY" ]; then
+        cmake -S . -B build-docs-lib -DCMAKE_BUILD_TYPE=Release -DGALPHA_BUILD_TESTS=OFF \
+            -DGALPHA_BUILD_EXAMPLES=OFF -DGALPHA_BUILD_BENCH=OFF -DGALPHA_FORTRAN=OFF >/dev/null
+        cmake --build build-docs-lib -j "$JOBS" --target galpha >/dev/null
+        GALPHA_LIBRARY=$PWD/build-docs-lib/libgalpha.so.0
+    fi
+fi
+export GALPHA_LIBRARY
 rm -rf "$out"
 mkdir -p "$out/doxygen"
 # (Doxygen's paths are relative to docs/, where the Doxyfile is)

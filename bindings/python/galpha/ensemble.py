@@ -1,6 +1,7 @@
 """One model over many parameter sets (and initial values): parameter sweeps, Monte-Carlo,
 the inner loop of an optimization -- on local threads, local processes, a Dask cluster or MPI
 ranks, with the same results bit for bit whatever the engine and the number of workers.
+For example::
 
     def crank():                       # module level: workers import it by name
         p = np.zeros(2)                # the array the callbacks read
@@ -188,6 +189,14 @@ def run(model: Callable[[], "Case"], parameters: Any, times: Any, *, initial: An
     """Run `model` once per row of `parameters` (runs x np) and record q, v, lam (and y) at
     `times` (increasing; a time equal to the start records the initial state).
 
+    Parameters
+    ----------
+    model : callable
+        Builds the Case (module level, so that workers import it by name).
+    parameters : array (runs, np)
+        One parameter set per run.
+    times : array
+        The output times.
     initial : (q0s, v0s) or (q0s, v0s, y0s), optional
         Per-run initial values (arrays with a row per run) instead of the Case's.
     h : float, optional
@@ -195,13 +204,21 @@ def run(model: Callable[[], "Case"], parameters: Any, times: Any, *, initial: An
         with the solver's tolerances).
     engine : "serial", "threads", "processes", "dask" or "mpi"
         "dask" with client= (a dask.distributed.Client; given a client, engine may be left).
+    client : dask.distributed.Client, optional
+        The cluster for engine="dask".
     workers : int, optional
         Threads or processes (default: os.cpu_count()).
     chunk_size : int, optional
         Runs per task (default: about four tasks per worker, each worker reusing its case).
-    comm : an mpi4py communicator (default COMM_WORLD) for engine="mpi".
-    progress : a progress bar over the runs (tqdm, optional; not under MPI): None shows it on
-        a terminal once the sweep has lasted a second, True always, False never.
+    comm : mpi4py communicator, optional
+        For engine="mpi" (default COMM_WORLD).
+    progress : bool or None, optional
+        A progress bar over the runs (tqdm, optional; not under MPI): None shows it on a
+        terminal once the sweep has lasted a second, True always, False never.
+
+    Returns
+    -------
+    EnsembleResult
     """
     # A script without `if __name__ == "__main__":` runs its sweep again in every process that
     # imports it as __mp_main__ (the spawned workers of processes, Dask's LocalCluster): they

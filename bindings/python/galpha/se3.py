@@ -5,11 +5,13 @@ body's origin in space, then the unit quaternion q (w, x, y, z) of its rotation 
 xi = (u, w) is 6 numbers, the body-frame translation u, then the rotation w. Increments are
 right: (x, R) o exp(u, w) = (x + R V(w) u, R exp(w)), V(w) = so3.tangent(w)^T; compose is
 (xa, Ra) o (xb, Rb) = (xa + Ra xb, Ra Rb); the tangent operator T(xi) is the right-trivialized
-derivative of exp, exp(xi + d) = exp(xi) o exp(T(xi) d + O(|d|^2)).
+derivative of exp::
+
+    exp(xi + d) = exp(xi) o exp(T(xi) d + O(|d|^2))
 
 Arrays as in galpha.so3: the last axis is the item (6 for a twist, 7 for a pose), matrices
 come as (..., 6, 6). Invalid input raises galpha.ArgumentError (a value not finite, a pose's
-quaternion whose norm is not 1 within 1e-6, |w| >= 2 pi for tangent_inverse).
+quaternion whose norm is not 1 within 1e-6, ``|w| >= 2 pi`` for tangent_inverse).
 
     import numpy as np, galpha.se3 as se3
     p = se3.exp([1.0, 0.0, 0.0, 0.0, 0.0, np.pi / 2])   # a screw: x (2/pi, 2/pi, 0), 90 deg
@@ -32,7 +34,7 @@ def exp(xi: ArrayLike) -> np.ndarray:
 
 
 def log(p: ArrayLike) -> np.ndarray:
-    """The twist xi with exp(xi) = p, |w| <= pi: (..., 7) -> (..., 6)."""
+    """The twist xi with exp(xi) = p, ``|w| <= pi``: (..., 7) -> (..., 6)."""
     return _call(_ffi.ga_se3_log, "se3.log", [_items(p, 7, "p")], (6,), _REFUSED)
 
 
@@ -49,5 +51,5 @@ def tangent(xi: ArrayLike) -> np.ndarray:
 
 
 def tangent_inverse(xi: ArrayLike) -> np.ndarray:
-    """T(xi)^-1 (|w| < 2 pi): (..., 6) -> (..., 6, 6)."""
+    """T(xi)^-1 (``|w| < 2 pi``): (..., 6) -> (..., 6, 6)."""
     return _matrices(_ffi.ga_se3_tangent_inverse, "se3.tangent_inverse", xi, 6, 6, _REFUSED)

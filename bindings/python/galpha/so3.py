@@ -2,13 +2,14 @@
 
 Conventions (those of the solver): a quaternion is (w, x, y, z), w the scalar part;
 R(q) x = q x q^-1 maps body to space; increments are right (body-frame), q o exp(psi); the
-tangent operator T(psi) is the right-trivialized derivative of exp,
-exp(psi + d) = exp(psi) o exp(T(psi) d + O(|d|^2)).
+tangent operator T(psi) is the right-trivialized derivative of exp::
+
+    exp(psi + d) = exp(psi) o exp(T(psi) d + O(|d|^2))
 
 Every function takes arrays whose last axis is the item (3 for a rotation vector, 4 for a
 quaternion) and maps all items in one call: psi of shape (..., 3) gives q of shape (..., 4);
 matrices come as (..., 3, 3). Invalid input raises galpha.ArgumentError (a value not finite, a
-quaternion whose norm is not 1 within 1e-6, |psi| >= 2 pi for tangent_inverse).
+quaternion whose norm is not 1 within 1e-6, ``|psi| >= 2 pi`` for tangent_inverse).
 
     import numpy as np, galpha.so3 as so3
     q = so3.exp(np.array([[0.0, 0.0, np.pi / 2]]))   # a quarter turn about z
@@ -46,12 +47,12 @@ def _call(fn, name, inputs, out_shape, refused=_REFUSED):
 
 
 def exp(psi: ArrayLike) -> np.ndarray:
-    """q = exp(psi) = (cos(t/2), sin(t/2) psi / t), t = |psi|: (..., 3) -> (..., 4)."""
+    """q = exp(psi) = (cos(t/2), sin(t/2) psi / t), ``t = |psi|``: (..., 3) -> (..., 4)."""
     return _call(_ffi.ga_so3_exp, "so3.exp", [_items(psi, 3, "psi")], (4,))
 
 
 def log(q: ArrayLike) -> np.ndarray:
-    """The rotation vector psi with exp(psi) = +-q, |psi| <= pi: (..., 4) -> (..., 3)."""
+    """The rotation vector psi with exp(psi) = +-q, ``|psi| <= pi``: (..., 4) -> (..., 3)."""
     return _call(_ffi.ga_so3_log, "so3.log", [_items(q, 4, "q")], (3,))
 
 
@@ -79,5 +80,5 @@ def tangent(psi: ArrayLike) -> np.ndarray:
 
 
 def tangent_inverse(psi: ArrayLike) -> np.ndarray:
-    """T(psi)^-1 (|psi| < 2 pi): (..., 3) -> (..., 3, 3)."""
+    """T(psi)^-1 (``|psi| < 2 pi``): (..., 3) -> (..., 3, 3)."""
     return _matrices(_ffi.ga_so3_tangent_inverse, "so3.tangent_inverse", psi, 3)

@@ -325,7 +325,7 @@ class Solver:
     adjoint_checkpoints : (interval, count)
         Checkpointing for records that do not fit (ga_set_adjoint_checkpoints): one segment
         of `interval` steps kept, a checkpoint after every interval-th step, runs of up to
-        interval * count steps; adjoint_gradient() computes earlier segments again.
+        interval times count steps; adjoint_gradient() computes earlier segments again.
     space : sequence of (kind, count), optional
         A configuration space that is a product of blocks (ga_create_space): kind "vector"
         (count coordinates), "so3" (count rotations stored as unit quaternions (w, x, y, z)),
@@ -339,7 +339,7 @@ class Solver:
         adjoint sensitivities; on the sparse path (pattern=) index 3 and 2 without
         sensitivities.
     user : None, int, numpy array or ctypes object
-        The `user` pointer compiled callbacks receive (void *user: an address, a numpy
+        The `user` pointer compiled callbacks receive (``void *user``: an address, a numpy
         array's data, a ctypes object's address); NULL by default. Python callbacks ignore it.
     zero_copy : bool
         False (default): callbacks get copies of their inputs and an array of their own to
@@ -348,7 +348,7 @@ class Solver:
         call (inputs read-only; nothing may be kept, written or read after the call returns).
 
     Every callback may instead be compiled: a numba cfunc (`numba.cfunc(sig)(fn)`), a ctypes
-    function pointer or an int address, with the C signature of the header's ga_*_fn; it is
+    function pointer or an int address, with the C signature of the header's ``ga_*_fn``; it is
     called directly from C, without Python (examples/python/numba_pendulum.py). Arrays arrive
     as raw pointers: column-major, dense or pattern values as with Python callbacks.
 
@@ -1124,8 +1124,8 @@ class Solver:
         to stop the stepping call after this step, which then returns True. An exception it
         raises stops the call too and is re-raised from it (the step stays accepted). fn may
         also be compiled (numba cfunc, ctypes function pointer, address) with the C signature
-        int(const ga_solver *s, double t, const double *q, const double *v,
-        const double *lambda, void *user); `user` as the Solver's (default: the Solver's)."""
+        ``int(const ga_solver *s, double t, const double *q, const double *v, const double
+        *lambda, void *user)``; `user` as the Solver's (default: the Solver's)."""
         if fn is None:
             self._check(_ffi.ga_set_step_hook(self._handle(), _ffi.STEP_HOOK_FN(), None, 0))
             self._hook = None
@@ -1169,8 +1169,8 @@ class Solver:
     @property
     @_serialized
     def events(self) -> list:
-        """The events the last step, step_adaptive or advance found, in time order: a list of
-        (t, index, direction) (see ga_get_event)."""
+        """The events found by the last step, step_adaptive or advance, in time order -- a list
+        of (t, index, direction) (see ga_get_event)."""
         count = ctypes.c_int()
         self._check(_ffi.ga_get_event_count(self._handle(), ctypes.byref(count)))
         out = []
@@ -1435,7 +1435,7 @@ class Solver:
         """The equilibrium path in a load factor through limit points (ga_static_path):
         `load` is a float array of one entry that the callbacks read (the call writes the
         load there as it goes; afterwards it holds the last point's); from the equilibrium at
-        load[0] near q0, points at arc length |ds| apart (ds > 0: the load rising first), up
+        load[0] near q0, points at arc length ``|ds|`` apart (ds > 0: the load rising first), up
         to max_points or until stop(load, q, lam) returns True. A StaticPath of the points
         after the start. Raises as static_equilibrium; the points before a failure are lost
         with it (the exception's solver state is the last point)."""
