@@ -218,8 +218,9 @@ typedef enum {
  *  2, for the step and its finite-difference tangents; there sensitivities return GA_ERR_ARG
  *  at ga_init, saying so, as does a coupling pattern of g_q. q0 of ga_init (and q in
  *  ga_set_state) must hold rotations (a quaternion's norm, a pose's quaternion's, a matrix's
- *  orthonormality within 1e-6, det > 0; storage more than 1e-10 off is taken as its
- *  nearest rotation, closer storage as it is), else GA_ERR_ARG names the block.
+ *  orthonormality within 1e-6, det > 0; storage more than 1e-10 off at ga_init, 1e-8 off at
+ *  ga_set_state, is taken as its nearest rotation, closer storage as it is: a solver's own
+ *  checkpoint is restored bit for bit), else GA_ERR_ARG names the block.
  *  Errors: GA_ERR_ARG (out, kinds or counts NULL with count > 0, count < 1, an unknown kind, a
  *  count < 1, nq or nv above INT_MAX, m < 0 or m > nv), GA_ERR_NOMEM. */
 GA_API ga_status ga_create_space(int count, const int *kinds, const int *counts, int m,

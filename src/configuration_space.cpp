@@ -522,14 +522,13 @@ Eigen::Index ConfigurationSpace::invalid_rotation(const double *q) const
     return -1;
 }
 
-void ConfigurationSpace::normalize_rotations(double *q) const
+void ConfigurationSpace::normalize_rotations(double *q, double exact) const
 {
-    constexpr double kExact = 1e-10;
     for (const Part &p : parts_) {
         if (p.kind == Kind::Vector)
             continue;
         double *b = q + rotation_storage(p.kind, p.q0);
-        if (!(rotation_error(p.kind, b) > kExact))
+        if (!(rotation_error(p.kind, b) > exact))
             continue;
         if (p.kind != Kind::Matrix) {
             const double n = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3]);

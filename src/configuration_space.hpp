@@ -98,11 +98,13 @@ public:
     // matrix's orthonormality or determinant off by more than 1e-6), as the index of its
     // first coordinate in q (a pose's quaternion's); -1 if none.
     Eigen::Index invalid_rotation(const double *q) const;
-    // Storage accepted by invalid_rotation but more than 1e-10 off a rotation, made one (a
+    // Storage accepted by invalid_rotation but more than `exact` off a rotation, made one (a
     // quaternion normalized, a matrix's nearest rotation): else the state's rotations would
     // stay 1e-6 off, and a checkpoint of it could drift past the check that accepted it.
-    // Closer storage is left bit for bit as it is.
-    void normalize_rotations(double *q) const;
+    // Closer storage is left bit for bit as it is. ga_init takes 1e-10 (kInitExact); a
+    // restore a larger bound (kRestoreExact), which no state a solver writes reaches.
+    static constexpr double kInitExact = 1e-10, kRestoreExact = 1e-8;
+    void normalize_rotations(double *q, double exact) const;
 
     // eq. (4) on a segment: q = q_n + h v_n + h^2 ((1/2 - beta) a_n + beta a)
     template <class Out, class Q, class V, class A0, class A1>

@@ -104,7 +104,7 @@ ga_status Stepper::start(double t0, const double *q0, const double *v0)
                          "matrix with det 1, within 1e-6)",
                          static_cast<long>(bad));
     if (!model.space.euclidean())
-        model.space.normalize_rotations(x.q.data());
+        model.space.normalize_rotations(x.q.data(), ConfigurationSpace::kInitExact);
 
     if (redundancy == GA_REDUNDANT_DROP && m_ > 0)
         if (auto st = select_active_constraints(t0, x.q))

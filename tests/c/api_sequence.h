@@ -700,7 +700,14 @@ static int restart_twin(model *md, ga_solver *s, const double *ckpt, size_t len,
             ga_get_t(s, &t);
             st[run][i] = adaptive[i] ? ga_step_adaptive(s, t + h[i]) : ga_step(s, h[i]);
 #ifdef SEQ_TRACE
-            fprintf(stderr, "  twin run %d step %d: %s\n", run, i, ga_last_error(s));
+            {
+                long long it = 0, fa = 0, re = 0;
+                ga_get_counter(s, GA_COUNT_NEWTON_ITERS, &it);
+                ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &fa);
+                ga_get_counter(s, GA_COUNT_RESIDUALS, &re);
+                fprintf(stderr, "  twin run %d step %d: %s (counters: %lld iterations, %lld "
+                        "factorizations, %lld residuals)\n", run, i, ga_last_error(s), it, fa, re);
+            }
 #endif
         }
         SEQ_REQUIRE(ga_get_state(s, end[run], len) == GA_OK);

@@ -1004,6 +1004,79 @@ static void test_storage_near_a_rotation_is_made_one(void **state)
     }
 }
 
+/* The largest entry of R^T R - I of the matrix stored at x[3..11] */
+static double orthonormality_error(const double *x)
+{
+    double err = 0.0;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            double d = 0.0;
+            for (int k = 0; k < 3; ++k)
+                d += x[3 + k + 3 * i] * x[3 + k + 3 * j];
+            err = fmax(err, fabs(d - (i == j)));
+        }
+    return err;
+}
+
+/* A matrix taken as it is (just within 1e-10 of a rotation) whose error the steps carry past
+ * 1e-10: its checkpoint restores bit for bit, and the steps after it repeat (fuzzer finding:
+ * ga_set_state made such storage exact, and the restored run differed by 5e-11) */
+static void test_a_state_drifted_past_1e_10_restores_bit_for_bit(void **state)
+{
+    (void)state;
+    lie_top t = lie_top_make(1);
+    ga_solver *s = top_solver(&t, GA_INDEX3);
+    double q[12], v[6], x[12], ck_q[12];
+    lie_top_initial(&t, q, v);
+    /* R (I + eps/2 w w^T), w = (1, 1, 1)/sqrt(3): R^T R - I = eps w w^T, whose entries are
+     * eps/3 = 0.97e-10 until the body's rotation turns w towards an axis */
+    const double eps = 2.9e-10;
+    double r[9];
+    memcpy(r, q + 3, sizeof r);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k)
+                q[3 + i + 3 * j] += r[i + 3 * k] * 0.5 * eps / 3.0;
+    assert_true(orthonormality_error(q) <= 1e-10);
+    assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
+    assert_int_equal(ga_get_q(s, x), GA_OK);
+    assert_memory_equal(x, q, sizeof q); /* within 1e-10: as given */
+    int steps = 0;
+    double err = orthonormality_error(x);
+    while (err <= 1e-10 && steps < 1000) {
+        assert_int_equal(ga_step(s, 1e-3), GA_OK);
+        assert_int_equal(ga_get_q(s, x), GA_OK);
+        err = orthonormality_error(x);
+        ++steps;
+    }
+    print_message("  %.3e off at ga_init, %.3e after %d steps\n", orthonormality_error(q), err,
+                  steps);
+    assert_true(err > 1e-10 && err < 1e-8);
+    size_t len = 0;
+    assert_int_equal(ga_state_size(s, &len), GA_OK);
+    double *ck = malloc(len * sizeof(double)), *end[2];
+    end[0] = malloc(len * sizeof(double));
+    end[1] = malloc(len * sizeof(double));
+    assert_true(ck && end[0] && end[1]);
+    assert_int_equal(ga_get_state(s, ck, len), GA_OK);
+    memcpy(ck_q, x, sizeof x);
+    for (int run = 0; run < 2; ++run) {
+        if (run == 1) {
+            assert_int_equal(ga_set_state(s, ck, len), GA_OK);
+            assert_int_equal(ga_get_q(s, x), GA_OK);
+            assert_memory_equal(x, ck_q, sizeof x);
+        }
+        for (int k = 0; k < 10; ++k)
+            assert_int_equal(ga_step(s, 1e-3), GA_OK);
+        assert_int_equal(ga_get_state(s, end[run], len), GA_OK);
+    }
+    assert_memory_equal(end[0], end[1], len * sizeof(double));
+    free(ck);
+    free(end[0]);
+    free(end[1]);
+    ga_free(s);
+}
+
 /* ga_interpolate with the step's own output (GA_OUTPUT_STEP) gives the q and v of the
  * consistent mode (fuzzer finding: on a group it wrote q into a vector that mode never
  * sized, a crash) */
@@ -1452,6 +1525,7 @@ int main(void)
         cmocka_unit_test(test_init_refuses_what_is_not_a_rotation),
         cmocka_unit_test(test_what_rotations_do_not_offer_is_refused),
         cmocka_unit_test(test_storage_near_a_rotation_is_made_one),
+        cmocka_unit_test(test_a_state_drifted_past_1e_10_restores_bit_for_bit),
         cmocka_unit_test(test_interpolation_with_the_step_output),
         cmocka_unit_test(test_sensitivities_across_a_taylor_step),
         cmocka_unit_test(test_sparse_path_is_the_dense_one),
