@@ -270,7 +270,7 @@ ga_status Stepper::load_checkpoint(const double *buf, bool internal, bool keep_m
     // A state the check let through up to 1e-6 off is made exact; a solver's own is restored
     // bit for bit: from ga_init's 1e-10 its error moves as the step rotates it (the largest
     // entry of R^T R - I by up to 3x) and by round-off, and passed 1e-10 (fuzzer finding:
-    // the restored run then differed by 5e-11), but stays far from 1e-8.
+    // the restored run then differed by 5e-11), but stays far below 1e-8.
     if (!model.space.euclidean())
         model.space.normalize_rotations(s.q.data(), ConfigurationSpace::kRestoreExact);
     s.c_count = c_count;

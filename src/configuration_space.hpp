@@ -102,7 +102,8 @@ public:
     // quaternion normalized, a matrix's nearest rotation): else the state's rotations would
     // stay 1e-6 off, and a checkpoint of it could drift past the check that accepted it.
     // Closer storage is left bit for bit as it is. ga_init takes 1e-10 (kInitExact); a
-    // restore a larger bound (kRestoreExact), which no state a solver writes reaches.
+    // restore 1e-8 (kRestoreExact), far above a solver's own states: ga_init's 1e-10, turned
+    // by the steps (at most tripled), plus round-off.
     static constexpr double kInitExact = 1e-10, kRestoreExact = 1e-8;
     void normalize_rotations(double *q, double exact) const;
 
