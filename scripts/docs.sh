@@ -3,8 +3,8 @@
 # renders docs/*.md, the C API reference and the Python one (autodoc over the package's
 # docstrings, napoleon for their numpy-style sections) into build-docs/html, every warning an
 # error. Then, unless --no-browser, the start page and the API page are opened in headless
-# Chromium and their screenshots read back (tests/check_site.py): the rendered title and a code block must
-# be on them. Debian's python3-sphinx, python3-myst-parser, python3-breathe, doxygen, chromium,
+# Chromium and their screenshots read back (tests/check_site.py): the rendered title and a
+# code block must be on them. Debian's python3-sphinx, python3-myst-parser, python3-breathe, doxygen, chromium,
 # tesseract-ocr; none is needed by the library.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -706,7 +706,8 @@ static int restart_twin(model *md, ga_solver *s, const double *ckpt, size_t len,
                 ga_get_counter(s, GA_COUNT_FACTORIZATIONS, &fa);
                 ga_get_counter(s, GA_COUNT_RESIDUALS, &re);
                 fprintf(stderr, "  twin run %d step %d: %s (counters: %lld iterations, %lld "
-                        "factorizations, %lld residuals)\n", run, i, ga_last_error(s), it, fa, re);
+                        "factorizations, %lld residuals)\n",
+                        run, i, ga_last_error(s), it, fa, re);
             }
 #endif
         }
