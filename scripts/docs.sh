@@ -4,8 +4,8 @@
 # docstrings, napoleon for their numpy-style sections) into build-docs/html, every warning an
 # error. Then, unless --no-browser, the start page and the API page are opened in headless
 # Chromium and their screenshots read back (tests/check_site.py): the rendered title and a
-# code block must be on them. Debian's python3-sphinx, python3-myst-parser, python3-breathe, doxygen, chromium,
-# tesseract-ocr; none is needed by the library.
+# code block must be on them. Debian's python3-sphinx, python3-myst-parser, python3-breathe,
+# doxygen, chromium, tesseract-ocr; none is needed by the library.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/deps.sh
