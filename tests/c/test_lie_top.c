@@ -955,6 +955,20 @@ static void test_init_refuses_what_is_not_a_rotation(void **state)
     }
 }
 
+/* The largest entry of R^T R - I of the matrix stored at x[3..11] */
+static double orthonormality_error(const double *x)
+{
+    double err = 0.0;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            double d = 0.0;
+            for (int k = 0; k < 3; ++k)
+                d += x[3 + k + 3 * i] * x[3 + k + 3 * j];
+            err = fmax(err, fabs(d - (i == j)));
+        }
+    return err;
+}
+
 /* Storage within the check's 1e-6 but not a rotation is taken as its nearest one (fuzzer
  * finding: a matrix 1e-6 off stayed so, drifted past 1e-6 in a few steps, and the solver
  * refused its own checkpoint); storage within 1e-10 is taken bit for bit */
@@ -970,18 +984,9 @@ static void test_storage_near_a_rotation_is_made_one(void **state)
         q[at] += 9e-7;
         assert_int_equal(ga_init(s, 0.0, q, v), GA_OK);
         assert_int_equal(ga_get_q(s, x), GA_OK);
-        double err = 0.0;
-        if (!matrix) {
-            err = fabs(sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6]) - 1.0);
-        } else {
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) {
-                    double d = 0.0;
-                    for (int k = 0; k < 3; ++k)
-                        d += x[3 + k + 3 * i] * x[3 + k + 3 * j];
-                    err = fmax(err, fabs(d - (i == j)));
-                }
-        }
+        const double err =
+            matrix ? orthonormality_error(x)
+                   : fabs(sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6]) - 1.0);
         print_message("  %s 9e-7 off: %.1e off after ga_init\n", matrix ? "matrix" : "quaternion",
                       err);
         assert_true(err < 1e-14);
@@ -1002,20 +1007,6 @@ static void test_storage_near_a_rotation_is_made_one(void **state)
         assert_memory_equal(x, q, (size_t)lie_top_nq(&t) * sizeof(double));
         ga_free(s);
     }
-}
-
-/* The largest entry of R^T R - I of the matrix stored at x[3..11] */
-static double orthonormality_error(const double *x)
-{
-    double err = 0.0;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-            double d = 0.0;
-            for (int k = 0; k < 3; ++k)
-                d += x[3 + k + 3 * i] * x[3 + k + 3 * j];
-            err = fmax(err, fabs(d - (i == j)));
-        }
-    return err;
 }
 
 /* A matrix taken as it is (just within 1e-10 of a rotation) whose error the steps carry past
