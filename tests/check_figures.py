@@ -97,12 +97,10 @@ class Figures:
         return ratios
 
     def value(self, expr):
-        return eval(expr, {"__builtins__": {}}, {"csv": self.csv, "cheapest": self.cheapest,
-                                                  "at_error": self.at_error,
-                                                  "largest": self.largest, "smallest": self.smallest,
-                                                  "sweep": self.sweep,
-                                                  "min": min,
-                                                  "max": max, "abs": abs, "round": round})
+        names = {"csv": self.csv, "cheapest": self.cheapest, "at_error": self.at_error,
+                 "largest": self.largest, "smallest": self.smallest, "sweep": self.sweep,
+                 "min": min, "max": max, "abs": abs, "round": round}
+        return eval(expr, {"__builtins__": {}}, names)
 
 
 def documents(root):
