@@ -1131,7 +1131,9 @@ typedef enum ga_info {
     GA_INFO_RCOND = 0,        /**< reciprocal condition number (1-norm estimate) of the
                                    iteration matrix factorized last, as solved: scaled by
                                    eq. (10) or not; 1/value is its condition number. Dense:
-                                   LAPACK's dgecon on the LU factors; sparse: KLU's
+                                   galpha's own estimate on the LU factors (Hager-Higham, the
+                                   algorithm of LAPACK's dgecon, whose bits would be the system
+                                   BLAS's); sparse: KLU's
                                    klu_condest on a factorization made for it, of the matrix
                                    with its rows equilibrated as factorized. Computed when
                                    asked for (a few solves; on the sparse path also a

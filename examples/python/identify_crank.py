@@ -39,7 +39,9 @@ def model(p):
                       2 * x - math.cos(ph) - A * math.cos(th),
                       x * math.sin(ph) - 0.5 * A * math.sin(ph - th)])  # d(l^2)/dq
         l = math.sqrt(l2)
-        tension = p[0] * (l - L0) + p[1] * (g @ v) / (2 * l)
+        # (g . v written out: numpy's g @ v is the system BLAS's ddot, whose order of
+        # summation, and so whose last bit, differs from one BLAS to another)
+        tension = p[0] * (l - L0) + p[1] * (g[0] * v[0] + g[1] * v[1] + g[2] * v[2]) / (2 * l)
         f[:] = -tension * g / (2 * l)
         f[1] += F
         f[2] -= F * math.sin(ph)

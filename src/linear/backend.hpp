@@ -72,7 +72,7 @@ public:
         (void)b1, (void)c1, (void)b2, (void)c2, (void)x1, (void)x2, (void)div2;
         return false;
     }
-    // Reciprocal condition estimate of the last factorization (dense: LAPACK dgecon, 1-norm;
+    // Reciprocal condition estimate of the last factorization (dense: condition.hpp, 1-norm;
     // sparse: KLU's klu_condest, 1-norm, on a factorization made for it).
     virtual double rcond() const = 0;
     virtual const char *name() const = 0;

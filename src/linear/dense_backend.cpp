@@ -1,6 +1,6 @@
 // Dense backend: S as an (n+m) x (n+m) column-major matrix, LU with partial pivoting by
 // LAPACK (dgetrf/dgetrs), Eigen (PartialPivLU) or galpha's unblocked kernel (unblocked_lu.hpp),
-// condition estimate by LAPACK's dgecon on the factors in every case. By default (Auto) each
+// condition estimate by galpha's own (condition.hpp) on the factors in every case. By default (Auto) each
 // factorization takes the unblocked kernel when S is small or mostly zero, Eigen's otherwise;
 // bench/linear_algebra measures all of them.
 #include <Eigen/LU>
@@ -9,6 +9,7 @@
 
 #include "assemble.hpp"
 #include "backend.hpp"
+#include "condition.hpp"
 #include "lapack.hpp"
 #include "unblocked_lu.hpp"
 
@@ -31,8 +32,7 @@ public:
         ipiv_.setZero(N);
         extent_.setZero(2 * N);
         inverse_diagonal_.setZero(N);
-        iwork_.setZero(N);
-        work_.setZero(4 * static_cast<Eigen::Index>(N));
+        work_.setZero(2 * static_cast<Eigen::Index>(N));
         x_.setZero(N);
         if (kind_ == DenseKind::Eigen || kind_ == DenseKind::Auto)
             eigen_lu_ = Eigen::PartialPivLU<Mat>(N);
@@ -78,7 +78,7 @@ public:
         rcond_valid_ = false;
         unblocked_ = kind_ == DenseKind::Unblocked ||
                      (kind_ == DenseKind::Auto && unblocked_lu_preferred(N, S_.data()));
-        // The condition estimate (dgecon, as expensive as the LU for small sizes) is computed
+        // The condition estimate (as expensive as the LU for small sizes) is computed
         // only when asked for; it needs the 1-norm of S, which in-place factors overwrite.
         if (kind_ == DenseKind::Lapack || unblocked_)
             anorm_ = S_.cwiseAbs().colwise().sum().maxCoeff();
@@ -110,8 +110,8 @@ public:
         if (!rcond_valid_ && pivot_ratio_ > 0.0) {
             const int N = n_ + m_;
             if (in_eigen())  // S is intact: Eigen factorizes a copy
-                anorm_ = norm1(N, S_.data(), work_.data());
-            rcond_ = lu_rcond(N, factors().data(), anorm_, work_.data(), iwork_.data());
+                anorm_ = norm1(N, S_.data());
+            rcond_ = lu_rcond(N, factors().data(), anorm_, work_.data());
             rcond_valid_ = true;
         }
         return pivot_ratio_ > 0.0 ? rcond_ : 0.0;
@@ -149,7 +149,6 @@ private:
     const Mat &factors() const { return in_eigen() ? eigen_lu_.matrixLU() : S_; }
 
     Mat S_;
-    mutable Eigen::VectorXi iwork_;
     Eigen::VectorXi ipiv_, extent_;
     mutable Vec work_;
     Vec x_, inverse_diagonal_;

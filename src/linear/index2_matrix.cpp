@@ -9,7 +9,7 @@
 
 #include "assemble.hpp"
 #include "klu_system.hpp"
-#include "lapack.hpp"
+#include "condition.hpp"
 #include "unblocked_lu.hpp"
 
 namespace ga {
@@ -29,13 +29,12 @@ struct Index2Matrix::Dense {
     Eigen::VectorXi ipiv, extent;
     Vec rhs, x, inverse_diagonal;
     double pivot_ratio = 0.0;
-    // condition estimate on demand (dgecon on the factors, LAPACK layout from either LU): the
+    // condition estimate on demand (condition.hpp on the factors, LAPACK layout from either LU): the
     // 1-norm of S is taken before the unblocked kernel overwrites it
     double anorm = 0.0;
     mutable double rcond = 0.0;
     mutable bool rcond_valid = false;
     mutable Vec work;
-    mutable Eigen::VectorXi iwork;
 };
 
 #ifdef GALPHA_HAVE_KLU
@@ -106,8 +105,7 @@ void Index2Matrix::setup(int n, int m, bool sparse, DenseKind dense_kind, const 
     d->inverse_diagonal.setZero(N);
     d->rhs.setZero(N);
     d->x.setZero(N);
-    d->work.setZero(4 * static_cast<Eigen::Index>(N));
-    d->iwork.setZero(N);
+    d->work.setZero(2 * static_cast<Eigen::Index>(N));
     dense_ = std::move(d);
 }
 
@@ -461,8 +459,8 @@ double Index2Matrix::rcond() const
         const int N = static_cast<int>(d.S.rows());
         const Mat &factors = d.unblocked ? d.S : d.lu.matrixLU();
         // unblocked: S holds the factors, its norm was taken before; Eigen factorized a copy
-        const double anorm = d.unblocked ? d.anorm : norm1(N, d.S.data(), d.work.data());
-        d.rcond = lu_rcond(N, factors.data(), anorm, d.work.data(), d.iwork.data());
+        const double anorm = d.unblocked ? d.anorm : norm1(N, d.S.data());
+        d.rcond = lu_rcond(N, factors.data(), anorm, d.work.data());
         d.rcond_valid = true;
     }
     return d.rcond;

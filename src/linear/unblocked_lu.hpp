@@ -12,7 +12,7 @@
 //
 // Layout and pivots as LAPACK's dgetrf (column-major, leading dimension N, unit lower factor
 // below the diagonal, ipiv[k]: the row exchanged with row k at step k, zero-based), so that
-// dgecon can estimate the condition of the factors.
+// lu_rcond (condition.hpp) can estimate the condition of the factors.
 #pragma once
 
 namespace ga {
