@@ -26,4 +26,6 @@ TEST_PACKAGES=(libcmocka-dev gfortran python3 python3-numpy python3-pytest pytho
 # The documentation site and its browser check (scripts/docs.sh); not needed by the library.
 DOCS_PACKAGES=(doxygen python3-sphinx python3-myst-parser python3-breathe chromium
                tesseract-ocr tesseract-ocr-eng)
+# The other BLAS/LAPACK builds the deep tier runs the release suite under (scripts/test.sh).
+BLAS_PACKAGES=(libopenblas0-pthread libopenblas0-serial libblis4-pthread)
 JOBS=$(nproc 2>/dev/null || echo 2)

@@ -3,8 +3,8 @@
 # builds galpha with clang, coverage instrumentation, ASan and UBSan in build-fuzz, then
 #
 #   scripts/fuzz.sh [RUNS]          CI: deterministic. A fixed seed, a fixed number of inputs
-#                                   (default 25000, each on the chain and the rotor: about
-#                                   three minutes here, 135 inputs a second), no corpus
+#                                   (default 40000, each on the chain and the rotor: about
+#                                   five minutes here, 135 inputs a second), no corpus
 #                                   reloading, from the committed corpus (tests/fuzz/corpus) and
 #                                   findings (tests/fuzz/regressions) into a fresh directory:
 #                                   the same inputs on every machine, so that a red run means
@@ -26,7 +26,7 @@ mode=${1:-ci}
 case "$mode" in
     explore) seconds=${2:?explore SECONDS} ;;
     merge) ;;
-    ci) runs=25000 ;;
+    ci) runs=40000 ;;
     *) runs=$mode; mode=ci ;;
 esac
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo \
