@@ -119,8 +119,16 @@ def test_terminal_after_a_count():
     r = run(h=1e-3, events=[crossing])
     assert r.status == 1 and len(r.t_events[0]) == 2 and r.t[-1] == r.t_events[0][1]
     crossing.terminal = 0.5
-    with pytest.raises(ValueError, match="positive count"):
+    with pytest.raises(ValueError, match="a bool or a count >= 0"):
         run(h=1e-3, events=[crossing])
+    crossing.terminal = -1
+    with pytest.raises(ValueError, match="a bool or a count >= 0"):
+        run(h=1e-3, events=[crossing])
+    # scipy's falsy terminal: 0 never ends the run (it was refused)
+    for never in (0, False, None):
+        crossing.terminal = never
+        r = run(h=1e-3, events=[crossing])
+        assert r.status == 0 and len(r.t_events[0]) == 2 and r.t[-1] > r.t_events[0][1]
 
 
 def test_slack_rope_on_the_multiplier():

@@ -249,3 +249,19 @@ def test_state_space_along_a_motion_at_rest_equals_the_tangent_system(solver):
     np.testing.assert_allclose(moving.A, rest.A, atol=1e-7 * np.abs(rest.A).max())
     with pytest.raises(galpha.InconsistentError, match="velocity constraint"):
         solver.state_space_motion(eq.q, [0.0, 1.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("q", [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+def test_operating_points_on_a_rotation_space_say_why(q):
+    """On a space with rotations the operating points are refused for the space, whatever q
+    is: the quaternion's four numbers were refused as "3 values expected, got 4"."""
+    def body_mass(t, q, M):
+        M[:] = np.eye(3)
+
+    def no_torque(t, q, v, f):
+        f[:] = 0.0
+    with galpha.Solver(3, 0, body_mass, no_torque, space=[("so3", 1)]) as s:
+        for call in (lambda: s.modes(q), lambda: s.static_equilibrium(q),
+                     lambda: s.linearize(q)):
+            with pytest.raises(galpha.StateError, match="R\\^n only"):
+                call()

@@ -182,6 +182,62 @@ def test_a_returning_callback_is_checked():
         galpha.Solver(2, 1, mass_f, lambda t: None, constraint_f, jacobian_f)
 
 
+def test_a_returned_value_is_never_broadcast():
+    """A value of another shape than its output is refused, as scipy refuses fun's: a scalar
+    force for n = 2 filled both entries, a vector for the 2 x 2 mass both rows."""
+    with pytest.raises(ValueError, match=r"force returned float of shape \(\); f has shape \(2,\)"):
+        galpha.integrate(mass_f, lambda t, q, v: -G, constraint_f, jacobian_f, (0.0, 0.1),
+                         Q0, V0, 1e-3, m=1)
+    with pytest.raises(ValueError, match=r"mass returned .* of shape \(2,\); M has shape \(2, 2\)"):
+        galpha.integrate(lambda t, q: np.ones(2), force_f, constraint_f, jacobian_f, (0.0, 0.1),
+                         Q0, V0, 1e-3, m=1)
+    # two constraints returned as one number (the pendulum's twice): refused, not copied
+    with pytest.raises(ValueError, match=r"constraint returned float64 of shape \(\); phi has shape \(2,\)"):
+        galpha.integrate(mass_f, force_f, lambda t, q: 0.5 * (q @ q - 1.0),
+                         lambda t, q: np.vstack([q, q]), (0.0, 0.1), Q0, V0, 1e-3, m=2)
+    # one constraint: a number is its one entry
+    r = galpha.integrate(mass_f, force_f, lambda t, q: 0.5 * (q @ q - 1.0), lambda t, q: q,
+                         (0.0, 0.1), Q0, V0, 1e-3, m=1)
+    assert r.success
+
+
+def test_args_and_an_ambiguous_callback_are_named():
+    # args must be a tuple (scipy: "supply args as a tuple")
+    with pytest.raises(TypeError, match=r"args must be a tuple .* args=\(9.81,\)"):
+        galpha.integrate(mass_r, force_r, constraint_r, jacobian_r, (0.0, 0.1), Q0, V0, 1e-3,
+                         m=1, args=9.81)
+    # constraint(t, q, phi) with args=(g,): three arguments, taken as constraint(t, q, g) -> phi;
+    # its failure says which convention was taken and how to write the other
+    with pytest.raises(TypeError) as e:
+        galpha.integrate(lambda t, q, M, g: mass_f(t, q, M),
+                         lambda t, q, v, f, g: force_f(t, q, v, f), constraint_f,
+                         lambda t, q, J, g: jacobian_f(t, q, J), (0.0, 0.1), Q0, V0, 1e-3,
+                         m=1, args=(G,))
+    notes = "\n".join(getattr(e.value, "__notes__", []))
+    assert "constraint was taken as returning its output, constraint(t, q, *args) -> phi" in notes
+    assert "constraint(t, q, phi, *args)" in notes
+
+
+@pytest.mark.parametrize("fail_at", range(3, 40))
+def test_a_failure_while_an_accepted_step_is_recorded(fail_at):
+    """An adaptive run without events records each accepted step from the step hook, and the
+    consistent qdd and lam it reads evaluate the force: a CallbackRetry there ended integrate
+    with an internal "cannot reshape" (ts, q, v were appended, qdd not). Now every run
+    returns a result: success, or the failure's status and message, the rows all as long."""
+    calls = [0]
+
+    def force(t, q, v, f):
+        calls[0] += 1
+        if calls[0] == fail_at:
+            raise galpha.CallbackRetry("not now")
+        f[:] = (0.0, -G)
+    r = galpha.integrate(mass_f, force, constraint_f, jacobian_f, (0.0, 1.0), Q0, V0, m=1,
+                         rtol=1e-6)
+    assert r.success or (r.status == galpha.CallbackRetry.status and "force" in r.message)
+    assert r.q.shape == (len(r.t), 2) and r.lam.shape == (len(r.t), 1)
+    assert r.qdd.shape == (len(r.t), 2) and r.y.shape == (4, len(r.t))
+
+
 def test_callback_retry_raised_in_a_callback_is_recoverable():
     failed = []
 
@@ -201,6 +257,26 @@ def test_callback_retry_raised_in_a_callback_is_recoverable():
         with pytest.raises(galpha.CallbackRetry):
             s.step(0.1)  # fixed steps: the failure is reported, the state kept
         assert s.t == pytest.approx(0.2)
+
+
+@pytest.mark.parametrize("bare", [True, False])
+def test_callback_retry_raised_without_a_message(bare):
+    """`raise galpha.CallbackRetry`, the class as Python code raises it, is the same
+    recoverable failure as with a message (it was a TypeError from __init__)."""
+    failed = []
+
+    def force(t, q, v):
+        if t > 0.2 and not failed:
+            failed.append(t)
+            if bare:
+                raise galpha.CallbackRetry
+            raise galpha.CallbackRetry()
+        return (0.0, -G)
+    sol = galpha.integrate(mass_f, force, constraint_f, jacobian_f, (0.0, 0.5), Q0, V0, m=1,
+                           rtol=1e-5)
+    assert sol.success and failed and sol.stats["failed_steps"] >= 1
+    assert str(galpha.CallbackRetry()) == ("A callback asked for a retry (it returned a positive "
+                                           "value or raised CallbackRetry).")
 
 
 def _reference(t_end, steps=20000):

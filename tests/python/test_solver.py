@@ -708,6 +708,10 @@ def test_integrate_result_attributes_repr_and_qdd_at_t_eval():
     assert np.all(np.isfinite(sol.qdd))
     # the pendulum's acceleration at t_eval against the step's at the same time nearby
     assert sol.qdd.shape == (3, 2)
+    # t_eval=[]: no output times, and a repr that says so (it read t[-1])
+    empty = galpha.integrate(mass, force, constraint, jacobian, (0.0, 0.5), Q0, V0, 0.01, m=1,
+                             t_eval=[])
+    assert empty.success and len(empty.t) == 0 and "outputs=0" in repr(empty)
 
 
 def test_calls_from_two_threads_are_serialized():

@@ -7,6 +7,8 @@ number of positional arguments the function takes; a function that would take bo
 arguments of either convention: mass(t, q, M, *args) or mass(t, q, *args)."""
 import inspect
 
+import numpy as np
+
 
 def _positional_range(fn):
     """(least, most) positional arguments fn accepts, or None when it cannot be told."""
@@ -54,7 +56,6 @@ def adapt(fn, name, inputs, outputs, args):
     call). None and compiled callbacks are returned unchanged."""
     if fn is None or not callable(fn):
         return fn
-    args = tuple(args)
     if not returns_output(fn, name, inputs, outputs, len(args)):
         if not args:
             return fn
@@ -65,19 +66,38 @@ def adapt(fn, name, inputs, outputs, args):
         if value is None:
             raise TypeError("%s returned None: a callback that returns its output must return "
                             "%s (one that fills it takes it as an argument)" % (name, what))
-        try:
-            out[...] = value
-        except ValueError:
+        # the output's own shape up to axes of length 1 (one constraint's Jacobian as a
+        # vector, its value as a number), never broadcast: a scalar for m = 2 constraints
+        # filled both (scipy refuses fun's wrong shape too)
+        shape = np.shape(value)
+        if [d for d in shape if d != 1] != [d for d in out.shape if d != 1]:
             raise ValueError("%s returned %s of shape %s; %s has shape %s" % (
-                name, type(value).__name__, getattr(value, "shape", "?"), what,
-                out.shape)) from None
+                name, type(value).__name__, shape, what, out.shape))
+        out[...] = np.reshape(value, out.shape)
+
+    # fn(t, q, phi) with args=(g,) takes as many arguments as the returning convention: say
+    # which one was taken when the call fails on its arguments
+    ambiguous = len(args) == k
+
+    def call(*a):
+        try:
+            return fn(*a, *args)
+        except TypeError as e:
+            if ambiguous and hasattr(e, "add_note"):
+                e.add_note("galpha: %s was taken as returning its output, %s(%s, *args) -> %s "
+                           "(it takes %d arguments and args has %d); one that fills it takes "
+                           "the args after its outputs, %s(%s, *args)" % (
+                               name, name, ", ".join(inputs), ", ".join(outputs),
+                               len(inputs) + len(args), len(args), name,
+                               ", ".join(inputs + outputs)))
+            raise
 
     if k == 1:
         def filled(*a):
-            store(a[-1], fn(*a[:-1], *args), outputs[0])
+            store(a[-1], call(*a[:-1]), outputs[0])
     else:
         def filled(*a):
-            values = fn(*a[:-k], *args)
+            values = call(*a[:-k])
             if not isinstance(values, (tuple, list)) or len(values) != k:
                 raise TypeError("%s returned %r: expected a tuple (%s)" % (
                     name, type(values).__name__, ", ".join(outputs)))

@@ -7,7 +7,10 @@ class GalphaError(Exception):
 
     status = None
 
-    def __init__(self, message, status=None):
+    def __init__(self, message=None, status=None):
+        # `raise galpha.CallbackRetry` as Python code raises it: the class says what happened
+        if message is None:
+            message = (type(self).__doc__ or type(self).__name__).strip().split("\n")[0]
         super().__init__(message)
         if status is not None:
             self.status = status
@@ -40,7 +43,7 @@ class RecoverableError(GalphaError, RuntimeError):
 
 
 class CallbackRetry(RecoverableError):
-    """A callback returned a positive value: the step was rejected."""
+    """A callback asked for a retry (it returned a positive value or raised CallbackRetry)."""
     status = _ffi.GA_ERR_CALLBACK_RETRY
 
 

@@ -1,6 +1,7 @@
 """One call from initial values to time histories, with scipy's solve_ivp conventions."""
 from __future__ import annotations
 
+import numbers
 import sys
 from typing import Any, Optional, Sequence, Tuple, Union
 
@@ -37,7 +38,8 @@ class IntegrateResult(_Fields):
 
     def __repr__(self) -> str:
         return "IntegrateResult(success=%r, message=%r, outputs=%d, steps=%d, t_end=%g)" % (
-            self.success, self.message, len(self.t), self.stats.get("steps", 0), self.t[-1])
+            self.success, self.message, len(self.t), self.stats.get("steps", 0),
+            self.t[-1] if len(self.t) else float("nan"))  # t_eval=[]: no output times
 
 
 def _hermite(th, h, x0, x1, d0, d1):
@@ -275,12 +277,14 @@ def integrate(mass: Any, force: Any, constraint: Any, jacobian: Any,
     left = []  # occurrences left before each terminal event ends the run (None: never)
     for g in events:
         terminal = getattr(g, "terminal", False)
+        # scipy's convention: False, None or 0 never ends the run, True or a count k >= 1
+        # ends it at the k-th occurrence
         if terminal is True or terminal is False or terminal is None:
             left.append(1 if terminal else None)
-        elif int(terminal) >= 1 and int(terminal) == terminal:
-            left.append(int(terminal))
+        elif isinstance(terminal, numbers.Real) and terminal >= 0 and int(terminal) == terminal:
+            left.append(int(terminal) if int(terminal) > 0 else None)
         else:
-            raise ValueError("event %r: terminal = %r must be a bool or a positive count"
+            raise ValueError("event %r: terminal = %r must be a bool or a count >= 0"
                              % (getattr(g, "__name__", g), terminal))
     t_ev = [[] for _ in events]
     q_ev = [[] for _ in events]
@@ -298,9 +302,22 @@ def integrate(mass: Any, force: Any, constraint: Any, jacobian: Any,
         else:
             s.init(t0, q0, v0)
 
-        def states_at(te):
+        # A row of the outputs is computed whole before any list grows: the consistent qdd
+        # and lam evaluate callbacks, which may fail (the run then ends with that failure,
+        # every list as long as ts).
+        def append_row(te, qi, vi, ai, li, xi=None):
+            ts.append(te)
+            qs.append(qi)
+            vs.append(vi)
+            as_.append(ai)
+            ls.append(li)
             if with_states:
-                xs.append(s.y if te == s.t else s.interpolate_y(te)[0])
+                xs.append(xi)
+
+        def state_y(te):
+            if not with_states:
+                return None
+            return s.y if te == s.t else s.interpolate_y(te)[0]
         if events:
             # all logged, none terminal in C: the run ends here, after the terminal one's
             # occurrence, and every event of a step lies in the step just taken
@@ -315,53 +332,39 @@ def integrate(mass: Any, force: Any, constraint: Any, jacobian: Any,
                          states=with_states)
 
         def knot():
-            knots[0].append(s.t)
-            knots[1].append(s.q)
-            knots[2].append(s.v)
-            knots[3].append(s.qdd)
-            knots[4].append(s.lam)
-            if with_states:
-                knots[5].append(s.y)
-                knots[6].append(s.ydot)
+            values = (s.t, s.q, s.v, s.qdd, s.lam) + ((s.y, s.ydot) if with_states else ())
+            for x, y in zip(knots, values):
+                x.append(y)
 
         def record_events():
             """Records the events of the last step; the time of a terminal one, else None."""
             for te, k, _ in s.events:
                 qi, vi, li = s.interpolate(te)
+                xi = s.interpolate_y(te)[0] if with_states else None
                 t_ev[k].append(te)
                 q_ev[k].append(qi)
                 v_ev[k].append(vi)
                 l_ev[k].append(li)
                 if with_states:
-                    x_ev[k].append(s.interpolate_y(te)[0])
+                    x_ev[k].append(xi)
                 if left[k] is not None:
                     left[k] -= 1
                     if left[k] == 0:
                         return te
             return None
 
-        def record():
-            states_at(s.t)
-            ts.append(s.t)
-            qs.append(s.q)
-            vs.append(s.v)
-            as_.append(s.qdd)
-            ls.append(s.lam)
+        def record(te=None):
+            append_row(s.t if te is None else te, s.q, s.v, s.qdd, s.lam, state_y(s.t))
 
         def record_eval(t_prev):
             while pending and pending[0] <= s.t:
-                te = pending.pop(0)
+                te = pending[0]
                 if te == s.t or te == t_prev:
-                    record()
-                    ts[-1] = te
+                    record(te)
                 else:
                     qi, vi, li = s.interpolate(te)
-                    states_at(te)
-                    ts.append(te)
-                    qs.append(qi)
-                    vs.append(vi)
-                    as_.append(s.interpolate_qdd(te))
-                    ls.append(li)
+                    append_row(te, qi, vi, s.interpolate_qdd(te), li, state_y(te))
+                pending.pop(0)
 
         pending = sorted(float(t) for t in t_eval) if t_eval is not None else None
         if pending is None:
@@ -413,22 +416,15 @@ def integrate(mass: Any, force: Any, constraint: Any, jacobian: Any,
                 # the run ends at the event: outputs up to it, then its state
                 while pending and pending[0] < t_end:
                     te = pending.pop(0)
-                    qi, vi, li = s.interpolate(te) if te > t_prev else (qs[-1], vs[-1], ls[-1])
-                    if with_states:
-                        xs.append(s.interpolate_y(te)[0] if te > t_prev else xs[-1])
-                    ts.append(te)
-                    qs.append(qi)
-                    vs.append(vi)
-                    as_.append(s.interpolate_qdd(te) if te > t_prev else as_[-1])
-                    ls.append(li)
+                    if te > t_prev:
+                        qi, vi, li = s.interpolate(te)
+                        append_row(te, qi, vi, s.interpolate_qdd(te), li, state_y(te))
+                    else:
+                        append_row(te, qs[-1], vs[-1], as_[-1], ls[-1],
+                                   xs[-1] if with_states else None)
                 qi, vi, li = s.interpolate(t_end)
                 ai = s.interpolate_qdd(t_end)
-                states_at(t_end)
-                ts.append(t_end)
-                qs.append(qi)
-                vs.append(vi)
-                as_.append(ai)
-                ls.append(li)
+                append_row(t_end, qi, vi, ai, li, state_y(t_end))
                 if dense_output:
                     ends = (t_end, qi, vi, ai, li)
                     if with_states:

@@ -30,7 +30,7 @@ except ImportError:  # pragma: no cover
 
 from . import _ffi
 from ._callbacks import adapt
-from .errors import CallbackRetry, error_for
+from .errors import CallbackRetry, StateError, error_for
 
 _vp = ctypes.c_void_p
 _i = ctypes.c_int
@@ -386,11 +386,13 @@ class Solver:
                             f"Solver(n={self.n}, m={self.m}): needs n >= 1 coordinates and "
                             "0 <= m <= n constraints")
         handle = ctypes.c_void_p()
+        self._euclidean = space is None
         if space is None:
             self.nq = self.n
             self._check(_ffi.ga_create(self.n, self.m, ctypes.byref(handle)))
         else:
             kinds, counts, self.nq, nv = _space_blocks(space)
+            self._euclidean = all(kind == _SPACE_KINDS["vector"] for kind in kinds)
             if nv != self.n:
                 raise error_for(_ffi.GA_ERR_ARG,
                                 f"Solver(n={self.n}, space={space!r}): the blocks have "
@@ -440,6 +442,9 @@ class Solver:
             return (nnz[name],) if name in nnz else dense
         # Python callbacks that return their output, or take `args`, become ones that fill it
         # (decided here, once; _callbacks.py)
+        if not isinstance(args, (tuple, list)):
+            raise TypeError("args must be a tuple of the callbacks' extra arguments, e.g. "
+                            "args=(%r,) for one; got %s" % (args, type(args).__name__))
         self._args = args = tuple(args)
 
         def adapted(fn, name, inputs, outputs):
@@ -1310,6 +1315,10 @@ class Solver:
         return worst.value
 
     def _rest_arrays(self, q, lam):
+        # the space before the sizes: on a space with rotations the C call refuses whatever q is
+        if not self._euclidean:
+            raise StateError("operating points (statics, paths, linearization, modes): on "
+                             "coordinates in R^n only (not yet on a space with rotations)")
         q = np.array(q, dtype=float).ravel()
         if q.size != self.n:
             raise ValueError(f"q: {self.n} values expected, got {q.size}")
