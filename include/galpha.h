@@ -471,7 +471,11 @@ typedef enum ga_linear_solver {
                                      matrix is nonzero, Eigen's otherwise */
     GA_LINEAR_SPARSE = 2,       /**< sparse LU (galpha's, in KLU's ordering; named "sparse
                                      KLU"); needs the patterns */
-    GA_LINEAR_DENSE_LAPACK = 3, /**< dense LU by LAPACK dgetrf/dgetrs */
+    GA_LINEAR_DENSE_LAPACK = 3, /**< dense LU by the system's LAPACK dgetrf/dgetrs: their
+                                     bits, and any allocation they make, are the BLAS's
+                                     (BLIS allocates in every call, about 100 times a
+                                     step of a 12-link chain; reference BLAS and OpenBLAS
+                                     do not); galpha's own kernels do neither */
     GA_LINEAR_DENSE_EIGEN = 4,  /**< dense LU by Eigen's (blocked) PartialPivLU */
     GA_LINEAR_DENSE_UNBLOCKED = 5 /**< dense LU by galpha's unblocked kernel, which skips the
                                      zero entries of a saddle-point matrix */
@@ -1206,7 +1210,9 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value);
  *  first-order states, from a callback), GA_ERR_SINGULAR (the stiffness in the constraints'
  *  free directions is singular: a limit point, or a motion nothing restrains),
  *  GA_ERR_NEWTON (no equilibrium in max_iter iterations, or none in reach along Newton's
- *  direction), callback errors. */
+ *  direction), GA_ERR_INCONSISTENT (redundant constraints that contradict each other, as
+ *  Phi = (x, x - 1): Newton stops where |Phi| is least, and |Phi| there is more than 100 tol
+ *  times the sizes of q and Phi_q), callback errors. */
 GA_API ga_status ga_static_equilibrium(ga_solver *s, double t, double *q, double *lambda,
                                        double tol, int max_iter);
 

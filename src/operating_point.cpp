@@ -79,6 +79,17 @@ ga_status static_equilibrium_y(Stepper &kernel, double t, double *q_io, double *
                max_abs(phi) <= 8.0 * eps * std::max(1.0, max_abs(q)) && rates;
     };
     const auto accept = [&] {
+        // Constraints that contradict each other (Phi = (x, x - 1)) stall Newton at their
+        // least-squares point, where the minimum-norm step is zero: no equilibrium on them.
+        const double eps = std::numeric_limits<double>::epsilon();
+        const double reach = std::max(100.0 * tol, 8.0 * eps) * std::max(1.0, max_abs(q)) *
+                             std::max(1.0, J.size() ? J.cwiseAbs().maxCoeff() : 0.0);
+        if (m > 0 && !(max_abs(phi) <= reach))
+            return at.diag().fail(GA_ERR_INCONSISTENT,
+                                  "%s: the constraints cannot all hold: |Phi| = %.3g at the "
+                                  "point nearest to them (constraints that contradict each "
+                                  "other)",
+                                  name, max_abs(phi));
         lambda = multipliers(J, f);  // the multipliers at the root itself (least squares)
         Eigen::Map<Vec>(q_io, n) = q;
         if (nr > 0)
@@ -277,7 +288,7 @@ ga_status state_space(Stepper &kernel, double t, const double *q0, const double 
     const int d = static_cast<int>(ns.N.cols());
     const Mat Mr = ns.N.transpose() * M * ns.N;
     const Eigen::PartialPivLU<Mat> mass(Mr);
-    if (d > 0 && (!(std::fabs(Mr.determinant()) > 0.0) || !(mass.rcond() > 1e-13)))
+    if (d > 0 && !invertible(mass))
         return at.diag().fail(GA_ERR_SINGULAR,
                               "ga_state_space: the mass in the free directions is singular "
                               "(reciprocal condition %.3g)",
@@ -412,7 +423,7 @@ ga_status damped_modes(Stepper &kernel, double t, const double *q0, const double
     const int d = lin.dof;
     const Eigen::PartialPivLU<Mat> mass(lin.M);
     const double mscale = std::max(lin.M.cwiseAbs().maxCoeff(), std::numeric_limits<double>::min());
-    if (!(std::fabs(lin.M.determinant()) > 0.0) || !(mass.rcond() > 1e-13))
+    if (!rest::invertible(mass))
         return kernel.diag.fail(GA_ERR_SINGULAR,
                                 "ga_modes_damped: the mass in the free directions is singular "
                                 "(reciprocal condition %.3g, size %.3g)",

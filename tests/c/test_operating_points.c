@@ -1200,6 +1200,106 @@ static void test_rotations_and_first_order_states_are_refused_by_name(void **sta
     ga_free(s);
 }
 
+/* ---- D12: a tiny but well-conditioned mass (40 oscillators of 1e-9 kg, omega_i = i) ---- */
+enum { kTiny = 40 };
+static const double kTinyMass = 1e-9;
+static int tiny_mass(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    memset(M, 0, sizeof(double) * kTiny * kTiny);
+    for (int i = 0; i < kTiny; ++i)
+        M[i + kTiny * i] = kTinyMass;
+    return 0;
+}
+static int tiny_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)v, (void)u;
+    for (int i = 0; i < kTiny; ++i)
+        f[i] = -kTinyMass * (i + 1) * (i + 1) * q[i];
+    return 0;
+}
+
+/* Its determinant, 1e-360, underflows; its condition is 1. ga_modes_damped and
+ * ga_state_space refused it as singular (a determinant test beside the condition's). */
+static void test_a_tiny_mass_is_no_singular_mass(void **state)
+{
+    (void)state;
+    ga_solver *s = NULL;
+    assert_int_equal(ga_create(kTiny, 0, &s), GA_OK);
+    assert_int_equal(ga_set_callbacks(s, tiny_mass, tiny_force, NULL, NULL, NULL), GA_OK);
+    double q[kTiny] = {0}, re[4], im[4];
+    assert_int_equal(ga_modes_damped(s, 0.0, q, NULL, 4, re, im, NULL, NULL), GA_OK);
+    /* s = +-i, +-2i: by |s|, the positive imaginary part first */
+    const double want_im[4] = {1.0, -1.0, 2.0, -2.0};
+    for (int k = 0; k < 4; ++k) {
+        assert_true(fabs(re[k]) < 1e-9);
+        assert_true(fabs(im[k] - want_im[k]) < 1e-9);
+    }
+    int dim = 0;
+    static double A[4 * kTiny * kTiny];
+    assert_int_equal(ga_state_space(s, 0.0, q, NULL, NULL, 2 * kTiny, &dim, NULL, A), GA_OK);
+    assert_int_equal(dim, 2 * kTiny);
+    /* A = [0, I; -diag(i^2), 0] in the free coordinates: the last row block's diagonal */
+    for (int i = 0; i < kTiny; ++i)
+        assert_true(fabs(A[(kTiny + i) + dim * i] + (double)(i + 1) * (i + 1)) <
+                    1e-9 * (i + 1) * (i + 1));
+    ga_free(s);
+}
+
+/* ---- D3: redundant constraints that contradict each other, Phi = (x, x - 1) ------------ */
+static int contra_mass(double t, const double *q, double *M, void *u)
+{
+    (void)t, (void)q, (void)u;
+    M[0] = 1, M[1] = 0, M[2] = 0, M[3] = 1;
+    return 0;
+}
+static int contra_force(double t, const double *q, const double *v, double *f, void *u)
+{
+    (void)t, (void)v, (void)u;
+    f[0] = -q[0], f[1] = -q[1] - 1.0;
+    return 0;
+}
+static int contra_phi(double t, const double *q, double *p, void *u)
+{
+    (void)t;
+    const double gap = *(const double *)u; /* 1: contradicting, 0: the same constraint twice */
+    p[0] = q[0], p[1] = q[0] - gap;
+    return 0;
+}
+static int contra_jac(double t, const double *q, double *J, void *u)
+{
+    (void)t, (void)q, (void)u;
+    J[0] = 1, J[1] = 1, J[2] = 0, J[3] = 0;
+    return 0;
+}
+
+/* Newton stalled at their least-squares point x = 1/2 (|Phi| = 1/2), where the minimum-norm
+ * step is zero, and "a full step within tol" returned GA_OK there. The same constraint twice
+ * (gap 0) still has its equilibrium (0, -1). */
+static void test_contradicting_constraints_have_no_equilibrium(void **state)
+{
+    (void)state;
+    for (int k = 0; k < 2; ++k) {
+        double gap = k == 0 ? 1.0 : 0.0;
+        ga_solver *s = NULL;
+        assert_int_equal(ga_create(2, 2, &s), GA_OK);
+        assert_int_equal(ga_set_callbacks(s, contra_mass, contra_force, contra_phi, contra_jac,
+                                          &gap),
+                         GA_OK);
+        double q[2] = {0.2, 0.3}, lambda[2] = {7.0, 7.0};
+        const ga_status st = ga_static_equilibrium(s, 0.0, q, lambda, 1e-10, 50);
+        if (k == 0) {
+            assert_int_equal(st, GA_ERR_INCONSISTENT);
+            assert_non_null(strstr(ga_last_error(s), "cannot all hold: |Phi| = 0.5"));
+            assert_true(q[0] == 0.2 && q[1] == 0.3 && lambda[0] == 7.0 && lambda[1] == 7.0);
+        } else {
+            assert_int_equal(st, GA_OK);
+            assert_true(fabs(q[0]) < 1e-12 && fabs(q[1] + 1.0) < 1e-12);
+        }
+        ga_free(s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1220,6 +1320,8 @@ int main(void)
         cmocka_unit_test(test_arguments_state_and_callbacks),
         cmocka_unit_test(test_a_running_solver_is_left_as_it_was),
         cmocka_unit_test(test_rotations_and_first_order_states_are_refused_by_name),
+        cmocka_unit_test(test_a_tiny_mass_is_no_singular_mass),
+        cmocka_unit_test(test_contradicting_constraints_have_no_equilibrium),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
