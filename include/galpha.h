@@ -1366,9 +1366,10 @@ GA_API ga_status ga_static_path(ga_solver *s, double t, double *load, double *q,
  *  3-vectors, quaternions (4 doubles) or 3 x 3 matrices (9, column-major). An output may be
  *  the same array as an input of its shape (in place). They need no solver and touch no state.
  *  Errors (nothing is written): GA_ERR_ARG for count < 0 or too large for its arrays' lengths,
- *  a NULL array with count > 0, a value that is not finite, a quaternion whose norm is not 1
- *  within 1e-6 (ga_so3_log, ga_so3_matrix), and |psi| >= 2 pi in ga_so3_tangent_inverse
- *  (T is singular there); ga_strerror names the status. */
+ *  a NULL array with count > 0, a value that is not finite, a finite input whose image is
+ *  not (|psi| of 1e200, whose square overflows; ga_so3_compose of quaternions as large), a
+ *  quaternion whose norm is not 1 within 1e-6 (ga_so3_log, ga_so3_matrix), and |psi| >= 2 pi
+ *  in ga_so3_tangent_inverse (T is singular there); ga_strerror names the status. */
 /**@{*/
 /** q_i = exp(psi_i): the unit quaternion (cos(t/2), sin(t/2) psi_i / t), t = |psi_i|. */
 GA_API ga_status ga_so3_exp(long count, const double *psi, double *q);

@@ -95,10 +95,17 @@ std::array<double, 7> pose(const so3::Vec3 &x, const so3::Quat &q)
 
 // out_i = f(in_i) for count items of In doubles in and Out out, each input accepted by `check`
 // before the first output is written
+template <std::size_t N> bool finite_result(const std::array<double, N> &x)
+{
+    return finite(x.data(), N);
+}
+// ... and whose image is finite: a finite input too large for the map (|psi| = 1e200, whose
+// square overflows) is refused, not answered with NaN
 template <std::size_t In, std::size_t Out, class Check, class Map>
 ga_status map_items(long count, const double *in, double *out, Check &&check, Map &&f)
 {
-    if (!valid(count, std::max(In, Out), {in, out}) || !all_items<In>(count, in, check))
+    const auto maps = [&](const double *x) { return check(x) && finite_result(f(x)); };
+    if (!valid(count, std::max(In, Out), {in, out}) || !all_items<In>(count, in, maps))
         return GA_ERR_ARG;
     for (long i = 0; i < count; ++i)
         put(f(in + In * i), out + Out * i);
@@ -123,6 +130,11 @@ GA_API ga_status ga_so3_compose(long count, const double *a, const double *b, do
     if (!valid(count, 4, {a, b, ab}) || !all_items<4>(count, a, any) ||
         !all_items<4>(count, b, any))
         return GA_ERR_ARG;
+    for (long i = 0; i < count; ++i) {  // a finite product of finite factors, before writing
+        const double *x = a + 4 * i, *y = b + 4 * i;
+        if (!finite_result(so3::compose({x[0], x[1], x[2], x[3]}, {y[0], y[1], y[2], y[3]})))
+            return GA_ERR_ARG;
+    }
     for (long i = 0; i < count; ++i) {
         const double *x = a + 4 * i, *y = b + 4 * i;
         put(so3::compose({x[0], x[1], x[2], x[3]}, {y[0], y[1], y[2], y[3]}), ab + 4 * i);

@@ -85,6 +85,14 @@ void Stepper::restore_active(const std::vector<unsigned char> &before)
 
 ga_status Stepper::start(double t0, const double *q0, const double *v0)
 {
+    // The arguments first: a refused restart leaves the kept matrix and pivots as they were.
+    if (!all_finite(q0, nq_) || !all_finite(v0, nv_))
+        return diag.fail(GA_ERR_ARG, "q0 or v0 contains NaN or Inf");
+    if (const Eigen::Index bad = model.space.invalid_rotation(q0); bad >= 0)
+        return diag.fail(GA_ERR_ARG,
+                         "q0[%ld..] is not a rotation (a unit quaternion, or an orthonormal "
+                         "matrix with det 1, within 1e-6)",
+                         static_cast<long>(bad));
     invalidate_jacobian();
     jacobian_valid_ = false;
     // A restart (after a jump in q or v) is a new solver with the same options and patterns:
@@ -96,13 +104,6 @@ ga_status Stepper::start(double t0, const double *q0, const double *v0)
     x.sliver_span = 0.0;
     x.q = Eigen::Map<const Vec>(q0, nq_);
     x.v = Eigen::Map<const Vec>(v0, nv_);
-    if (!all_finite(x.q) || !all_finite(x.v))
-        return diag.fail(GA_ERR_ARG, "q0 or v0 contains NaN or Inf");
-    if (const Eigen::Index bad = model.space.invalid_rotation(x.q.data()); bad >= 0)
-        return diag.fail(GA_ERR_ARG,
-                         "q0[%ld..] is not a rotation (a unit quaternion, or an orthonormal "
-                         "matrix with det 1, within 1e-6)",
-                         static_cast<long>(bad));
     if (!model.space.euclidean())
         model.space.normalize_rotations(x.q.data(), ConfigurationSpace::kInitExact);
 

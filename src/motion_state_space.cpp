@@ -137,6 +137,10 @@ public:
             const Mat JR = J * R;
             const Vec dh = R * JR.completeOrthogonalDecomposition().solve(-phi), qk = q;
             model_.space.shifted(qk, 1.0, dh, q);
+            // a correction at q's round-off ends it too: Phi = x^2 + y^2 - L^2 in mm units
+            // keeps a residual of eps L^2, far above 1e-15 |q|
+            if (rest::max_abs(dh) <= 8.0 * std::numeric_limits<double>::epsilon() * scale)
+                break;
             if (it == 29)
                 return diag_.fail(GA_ERR_NEWTON, "ga_state_space_motion: the chart's projection "
                                                  "onto the constraints did not converge near q");

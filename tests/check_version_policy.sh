@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The version policy (docs/releases.md) as scripts/abi.sh enforces it, tried on copies of the
 # tree's version files with baselines edited to stand for other releases: each case must pass
-# or fail as the policy says. LIB: a library with debug information (build-sanitize's).
+# or fail as the policy says. LIB: a library with debug information (build-abi's).
 set -euo pipefail
-lib=$(realpath "${1:?the library, e.g. build-sanitize/libgalpha.so}")
+lib=$(realpath "${1:?the library, e.g. build-abi/libgalpha.so}")
 root=$(cd "$(dirname "$0")/.." && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

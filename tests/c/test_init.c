@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <galpha.h>
@@ -213,6 +214,46 @@ static void failed_init_keeps_previous_state(void **state)
     assert_true(t == 0.01);
     assert_true(fabs(q[0] * q[0] + q[1] * q[1] - 1.0) < 1e-14);
     ga_free(s);
+}
+
+/* D7: a restart refused for its arguments (NaN in q0) dropped the kept iteration matrix and
+ * the pivots before it looked at q0: the checkpoint differed right after the refusal, and the
+ * run continued differed from an untouched twin's. Now both are the twin's, bit for bit. */
+static void refused_restart_leaves_the_run_as_it_was(void **state)
+{
+    (void)state;
+    pendulum p = {1.0, 1.0, 9.81};
+    ga_solver *s = make(&p, 1), *twin = make(&p, 1);
+    double q0[2], v0[2];
+    pendulum_state(&p, 0.3, 0.2, q0, v0);
+    assert_int_equal(ga_init(s, 0.0, q0, v0), GA_OK);
+    assert_int_equal(ga_init(twin, 0.0, q0, v0), GA_OK);
+    for (int i = 0; i < 10; ++i) {
+        assert_int_equal(ga_step(s, 0.01), GA_OK);
+        assert_int_equal(ga_step(twin, 0.01), GA_OK);
+    }
+    size_t len = 0;
+    assert_int_equal(ga_state_size(s, &len), GA_OK);
+    double *before = malloc(len * sizeof(double)), *after = malloc(len * sizeof(double));
+    assert_non_null(before);
+    assert_non_null(after);
+    assert_int_equal(ga_get_state(s, before, len), GA_OK);
+    const double bad[2] = {NAN, 0.0};
+    assert_int_equal(ga_init(s, 5.0, bad, v0), GA_ERR_ARG);
+    assert_non_null(strstr(ga_last_error(s), "NaN or Inf"));
+    assert_int_equal(ga_get_state(s, after, len), GA_OK);
+    assert_memory_equal(before, after, len * sizeof(double));
+    for (int i = 0; i < 10; ++i) {
+        assert_int_equal(ga_step(s, 0.01), GA_OK);
+        assert_int_equal(ga_step(twin, 0.01), GA_OK);
+    }
+    assert_int_equal(ga_get_state(s, before, len), GA_OK);
+    assert_int_equal(ga_get_state(twin, after, len), GA_OK);
+    assert_memory_equal(before, after, len * sizeof(double));
+    free(before);
+    free(after);
+    ga_free(s);
+    ga_free(twin);
 }
 
 /* Rheonomic pendulum: the rod length follows L(t) = L0 + A sin(w t).
@@ -447,6 +488,7 @@ int main(void)
         cmocka_unit_test(inconsistent_positions_and_velocities_are_projected),
         cmocka_unit_test(consistent_values_are_kept),
         cmocka_unit_test(failed_init_keeps_previous_state),
+        cmocka_unit_test(refused_restart_leaves_the_run_as_it_was),
         cmocka_unit_test(failed_first_start_leaves_the_setup_open),
         cmocka_unit_test(unconstrained_diagonal_mass_needs_no_factorization),
         cmocka_unit_test(time_dependent_constraint_start),

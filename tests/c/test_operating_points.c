@@ -1200,6 +1200,31 @@ static void test_rotations_and_first_order_states_are_refused_by_name(void **sta
     ga_free(s);
 }
 
+/* D11: the chart's projection stopped only at |Phi| <= 1e-15 |q|, below the round-off of a
+ * constraint of size L^2: a pendulum of 10 m at rest, of 100 m or 1000 m (models in mm)
+ * swinging, failed with GA_ERR_NEWTON. Now each is the closed form. */
+static void test_the_chart_projection_works_at_any_length(void **state)
+{
+    (void)state;
+    const double lengths[3] = {10.0, 100.0, 1000.0};
+    for (int k = 0; k < 3; ++k) {
+        Pendulums p = {1, {1.0, 0}, {lengths[k], 0}, 0, 0};
+        const double L = p.L[0], th0 = 0.7, rate = 2.0;
+        ga_solver *s = pendulums(&p);
+        const double q[2] = {L * sin(th0), -L * cos(th0)};
+        const double v[2] = {L * rate * cos(th0), L * rate * sin(th0)};
+        const double qr[2] = {0.0, -L}, vr[2] = {0.0, 0.0};
+        double A[4];
+        int dim = 0;
+        assert_int_equal(ga_state_space_motion(s, 0.0, q, v, NULL, 2, &dim, NULL, A), GA_OK);
+        const double w0 = L * rate;
+        assert_rel(A[1], -(g_acc * cos(th0) + w0 * w0 / L) / L, 1e-6);
+        assert_int_equal(ga_state_space_motion(s, 0.0, qr, vr, NULL, 2, &dim, NULL, A), GA_OK);
+        assert_rel(A[1], -g_acc / L, 1e-6);
+        ga_free(s);
+    }
+}
+
 /* ---- D12: a tiny but well-conditioned mass (40 oscillators of 1e-9 kg, omega_i = i) ---- */
 enum { kTiny = 40 };
 static const double kTinyMass = 1e-9;
@@ -1321,6 +1346,7 @@ int main(void)
         cmocka_unit_test(test_a_running_solver_is_left_as_it_was),
         cmocka_unit_test(test_rotations_and_first_order_states_are_refused_by_name),
         cmocka_unit_test(test_a_tiny_mass_is_no_singular_mass),
+        cmocka_unit_test(test_the_chart_projection_works_at_any_length),
         cmocka_unit_test(test_contradicting_constraints_have_no_equilibrium),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

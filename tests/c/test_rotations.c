@@ -228,6 +228,13 @@ static void refusals_write_nothing(void **state)
     assert_int_equal(ga_so3_compose(1, q_far, q_nan, out[0]), GA_ERR_ARG);
     const double full_turn[3] = {0.0, 2.0 * kPi, 0.0};
     assert_int_equal(ga_so3_tangent_inverse(1, full_turn, out[0]), GA_ERR_ARG);
+    /* D6: finite inputs whose images are not (|psi|^2 overflows): GA_OK with NaN before */
+    const double huge[3] = {1e200, 0.0, 0.0}, q_huge[4] = {1e200, 1e200, 0.0, 0.0};
+    assert_int_equal(ga_so3_exp(1, huge, out[0]), GA_ERR_ARG);
+    assert_int_equal(ga_so3_tangent(1, huge, out[0]), GA_ERR_ARG);
+    assert_int_equal(ga_so3_compose(1, q_huge, q_huge, out[0]), GA_ERR_ARG);
+    assert_int_equal(ga_se3_exp(1, (const double[6]){0, 0, 0, 1e200, 0, 0}, out[0]),
+                     GA_ERR_ARG);
     for (int i = 0; i < 2; ++i)
         for (int j = 0; j < 9; ++j)
             assert_true(out[i][j] == 0.0); /* no refusal wrote anything */
