@@ -1344,8 +1344,11 @@ typedef int (*ga_path_fn)(double load, const double *q, const double *lambda, vo
  *  after max_points points, GA_STOPPED when fn stopped it. Errors: GA_ERR_ARG (NULL load or
  *  q, ds = 0 or not finite, max_points < 1, tol not finite and > 0, a value not finite),
  *  GA_ERR_STATE as ga_static_equilibrium, GA_ERR_NEWTON (the path does not go on: the message
- *  says from which load), GA_ERR_SINGULAR (no tangent: a bifurcation), the start's errors,
- *  callback errors. */
+ *  says from which load), GA_ERR_SINGULAR (no tangent at a converged point: one exactly on
+ *  a bifurcation), the start's errors, callback errors. A bifurcation between two points is
+ *  not detected: the path steps over it and stays on its branch (past a pitchfork, on the
+ *  branch that has become unstable); ga_modes at the points shows where omega^2 changed
+ *  sign. */
 GA_API ga_status ga_static_path(ga_solver *s, double t, double *load, double *q, double *lambda,
                                 double ds, int max_points, double tol, ga_path_fn fn,
                                 void *user);
