@@ -6,12 +6,12 @@
 #   the major version was raised (a new SONAME);
 #   additions fail unless the minor (or major) version was raised above the release's;
 #   and the version is the same in every place that states it (scripts/versions.sh).
-# `update LIB` makes LIB's ABI the baseline, at a release. LIB needs debug information (the
-# sanitizer build of scripts/test.sh has it).
+# `update LIB` makes LIB's ABI the baseline, at a release. LIB needs full debug information
+# (build-abi, the debug build of the library that `scripts/test.sh --deep` makes).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mode=${1:?check or update}
-lib=${2:?the library, e.g. build-sanitize/libgalpha.so}
+lib=${2:?the library, e.g. build-abi/libgalpha.so}
 dump() { abidw --headers-dir include --no-corpus-path --drop-private-types \
                --exported-interfaces-only "$lib"; }
 version=$(bash scripts/versions.sh)

@@ -3,8 +3,8 @@
 # builds galpha with clang, coverage instrumentation, ASan and UBSan in build-fuzz, then
 #
 #   scripts/fuzz.sh [RUNS]          CI: deterministic. A fixed seed, a fixed number of inputs
-#                                   (default 40000, each on the chain and the rotor: about
-#                                   five minutes here, 135 inputs a second), no corpus
+#                                   (default 40000, each on the chain and the rotor: 12.6
+#                                   minutes in CI's deep run here, docs/perf/test_tiers.csv), no corpus
 #                                   reloading, from the committed corpus (tests/fuzz/corpus) and
 #                                   findings (tests/fuzz/regressions) into a fresh directory:
 #                                   the same inputs on every machine, so that a red run means
