@@ -406,3 +406,10 @@ def test_every_public_name_has_a_docstring_and_type_hints():
     assert not unhinted, "no return annotation: " + ", ".join(unhinted)
     package = os.path.dirname(galpha.__file__)
     assert os.path.isfile(os.path.join(package, "py.typed"))
+
+
+def test_an_unknown_keyword_is_integrates():
+    """A misspelt keyword is reported as integrate's, not as Solver.__init__()'s."""
+    with pytest.raises(TypeError, match=r"integrate\(\) got an unexpected keyword argument 'rtoll'"):
+        galpha.integrate(mass_f, force_f, constraint_f, jacobian_f, (0.0, 0.1), Q0, V0, m=1,
+                         rtoll=1e-6)

@@ -1,6 +1,7 @@
 """One call from initial values to time histories, with scipy's solve_ivp conventions."""
 from __future__ import annotations
 
+import inspect
 import numbers
 import sys
 from typing import Any, Optional, Sequence, Tuple, Union
@@ -246,6 +247,12 @@ def integrate(mass: Any, force: Any, constraint: Any, jacobian: Any,
     the failure's message and the histories up to the last accepted step; an exception raised
     by a callback is re-raised.
     """
+    # an unknown keyword is integrate's to name (Solver.__init__'s TypeError named its own)
+    known = inspect.signature(Solver.__init__).parameters
+    unknown = sorted(k for k in options if k not in known or k in ("self", "n", "m"))
+    if unknown:
+        raise TypeError("integrate() got an unexpected keyword argument %r (integrate takes "
+                        "solve_ivp's keywords and Solver's options)" % unknown[0])
     _solve_ivp_options(options, h, rtol, atol, max_step, first_step, method)
     t0, t1 = float(t_span[0]), float(t_span[1])
     if not t1 > t0:
