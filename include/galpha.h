@@ -1198,7 +1198,9 @@ GA_API ga_status ga_get_info(const ga_solver *s, int key, double *value);
  *  the q given, in the null space of Phi_q (redundant constraints take the minimum-norm
  *  multipliers) -- for a model on the sparse path (declared patterns of M, Phi_q and K_t, as
  *  the solver's linear-solver option chooses) on the sparse [K_t, Phi_q^T; Phi_q, 0] instead,
- *  where redundant constraints are GA_ERR_SINGULAR --, with a backtracking line search on
+ *  where redundant constraints are GA_ERR_SINGULAR, and whose starting multipliers come from
+ *  the sparse [M, Phi_q^T; Phi_q, 0]: a free direction without mass (a massless node) is
+ *  GA_ERR_SINGULAR there, though the dense path finds its equilibrium --, with a backtracking line search on
  *  |f - Phi_q^T lambda|^2 + |Phi|^2. Converged when a full Newton step moves q by at most
  *  tol max(1, |q|_inf) (taken, or not taken where round-off keeps it from reducing the
  *  residual), or when the residuals are
