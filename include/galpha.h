@@ -1407,8 +1407,9 @@ GA_API ga_status ga_so3_tangent_inverse(long count, const double *psi, double *T
  *
  *  Arrays, counts, in-place use and errors as for ga_so3_*: twists 6 doubles, poses 7,
  *  matrices 6 x 6 column-major (36); GA_ERR_ARG (nothing written) also for a pose whose
- *  quaternion is not of unit norm within 1e-6 (ga_se3_log, ga_se3_compose) and |w| >= 2 pi in
- *  ga_se3_tangent_inverse. */
+ *  quaternion is not of unit norm within 1e-6 (ga_se3_log, ga_se3_compose), |w| >= 2 pi in
+ *  ga_se3_tangent_inverse and |w| > 4 pi in ga_se3_tangent (its series loses accuracy
+ *  beyond: a relative error of about eps e^|w|). */
 /**@{*/
 /** p_i = exp(xi_i) = (V(w_i) u_i, exp(w_i)). */
 GA_API ga_status ga_se3_exp(long count, const double *xi, double *p);

@@ -235,6 +235,12 @@ static void refusals_write_nothing(void **state)
     assert_int_equal(ga_so3_compose(1, q_huge, q_huge, out[0]), GA_ERR_ARG);
     assert_int_equal(ga_se3_exp(1, (const double[6]){0, 0, 0, 1e200, 0, 0}, out[0]),
                      GA_ERR_ARG);
+    /* D4: ga_se3_tangent's series at |w| = 25 was 0.33 off with GA_OK; beyond 4 pi refused */
+    double T[36] = {0};
+    assert_int_equal(ga_se3_tangent(1, (const double[6]){1, 0, 0, 0, 25.0, 0}, T), GA_ERR_ARG);
+    for (int j = 0; j < 36; ++j)
+        assert_true(T[j] == 0.0);
+    assert_int_equal(ga_se3_tangent(1, (const double[6]){1, 0, 0, 0, 12.0, 0}, T), GA_OK);
     for (int i = 0; i < 2; ++i)
         for (int j = 0; j < 9; ++j)
             assert_true(out[i][j] == 0.0); /* no refusal wrote anything */
